@@ -1,0 +1,47 @@
+//! Rays, ray/primitive intersection methods and ray-origin offsets (lecture: "Ray/Surface
+//! Intersection"; robust variants from Ray Tracing Gems ch. 6–7, Woop–Benthin–Wald 2013 and
+//! pbrt-v4). Every method is selectable so the speed/accuracy sweeps can compare them.
+
+pub mod offset;
+pub mod sphere;
+pub mod triangle;
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+pub use offset::{OffsetMethod, offset_ray_origin};
+pub use sphere::{SphereMethod, intersect_sphere, sphere_hit_point};
+pub use triangle::{TriHit, TriangleMethod, intersect_triangle, triangle_hit_point};
+
+/// `P = origin + s·dir`, `dir` unit length, `s ≥ 0` (lecture: "Ray equation").
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Ray {
+    pub origin: Vec3,
+    pub dir: Vec3,
+}
+
+impl Ray {
+    pub fn new(origin: Vec3, dir: Vec3) -> Self {
+        Self { origin, dir }
+    }
+
+    pub fn at(&self, s: f32) -> Vec3 {
+        self.origin + s * self.dir
+    }
+}
+
+/// The intersection methods a render uses, one flat struct (yocto-gl style).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Methods {
+    pub sphere: SphereMethod,
+    pub triangle: TriangleMethod,
+    pub offset: OffsetMethod,
+}
+
+/// `γ(n) = n·u / (1 − n·u)` with `u` the f32 unit roundoff: bounds the relative error of `n`
+/// chained f32 operations (pbrt-v4, "Floating-point arithmetic").
+pub fn gamma(n: u32) -> f32 {
+    let u = f32::EPSILON * 0.5;
+    let nu = n as f32 * u;
+    nu / (1.0 - nu)
+}
