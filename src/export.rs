@@ -1,1 +1,161 @@
-//! todo
+//! Writing results: PNG (8-bit sRGB, with the render's settings in text chunks) and OpenEXR
+//! (linear 32-bit float). Every write goes to a temporary file in the destination folder and is
+//! renamed into place, so a failed or interrupted write never leaves a half-written file.
+
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+use glam::Vec3;
+
+use crate::render::Image;
+
+/// A write that failed: one sentence naming the file.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot write {path}: {reason}")]
+pub struct ExportError {
+    pub path: String,
+    pub reason: String,
+}
+
+fn export_error(path: &Path, reason: impl std::fmt::Display) -> ExportError {
+    ExportError {
+        path: path.display().to_string(),
+        reason: reason.to_string(),
+    }
+}
+
+/// The sRGB transfer function of a linear value, clamped to [0, 1].
+pub fn linear_to_srgb(c: f32) -> f32 {
+    let c = if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) };
+    if c <= 0.003_130_8 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// A linear colour as 8-bit sRGB (exposure 1, clamped).
+pub fn to_srgb8(c: Vec3) -> [u8; 3] {
+    let q = |v: f32| (linear_to_srgb(v) * 255.0 + 0.5) as u8;
+    [q(c.x), q(c.y), q(c.z)]
+}
+
+/// The image as 8-bit sRGB RGB bytes, row-major.
+pub fn srgb8_bytes(image: &Image) -> Vec<u8> {
+    image.pixels.iter().flat_map(|&c| to_srgb8(c)).collect()
+}
+
+/// Writes `path` through a temporary file in the same folder, then renames it into place.
+pub fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<&std::fs::File>) -> Result<(), String>,
+) -> Result<(), ExportError> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let tmp = tempfile::Builder::new()
+        .prefix(".raytree-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(|e| export_error(path, e))?;
+    {
+        let mut out = BufWriter::new(tmp.as_file());
+        write(&mut out).map_err(|e| export_error(path, e))?;
+        out.flush().map_err(|e| export_error(path, e))?;
+    }
+    tmp.as_file()
+        .sync_all()
+        .map_err(|e| export_error(path, e))?;
+    tmp.persist(path).map_err(|e| export_error(path, e.error))?;
+    Ok(())
+}
+
+/// Writes an 8-bit sRGB PNG with `text` as `tEXt` chunks (keyword, value).
+pub fn write_png(path: &Path, image: &Image, text: &[(String, String)]) -> Result<(), ExportError> {
+    let bytes = srgb8_bytes(image);
+    write_atomically(path, |out| {
+        let mut encoder = png::Encoder::new(out, image.width, image.height);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        for (key, value) in text {
+            encoder
+                .add_text_chunk(key.clone(), value.clone())
+                .map_err(|e| e.to_string())?;
+        }
+        let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+        writer.write_image_data(&bytes).map_err(|e| e.to_string())?;
+        writer.finish().map_err(|e| e.to_string())
+    })
+}
+
+/// Writes a linear 32-bit float RGB OpenEXR file.
+pub fn write_exr(path: &Path, image: &Image) -> Result<(), ExportError> {
+    use exr::prelude::*;
+    let w = image.width as usize;
+    let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+        let c = image.pixels[y * w + x];
+        (c.x, c.y, c.z)
+    });
+    let exr_image = exr::image::Image::from_channels((w, image.height as usize), channels);
+    write_atomically(path, |out| {
+        let mut cursor = std::io::Cursor::new(Vec::new());
+        exr_image
+            .write()
+            .to_buffered(&mut cursor)
+            .map_err(|e| e.to_string())?;
+        out.write_all(cursor.get_ref()).map_err(|e| e.to_string())
+    })
+}
+
+/// Writes `.png` or `.exr` by the extension of `path` (case-insensitive).
+pub fn write_image(
+    path: &Path,
+    image: &Image,
+    text: &[(String, String)],
+) -> Result<(), ExportError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("png") => write_png(path, image, text),
+        Some("exr") => write_exr(path, image),
+        _ => Err(export_error(
+            path,
+            "the file name must end in .png (8-bit sRGB) or .exr (linear float)",
+        )),
+    }
+}
+
+/// Writes text (a scene, a tree) atomically.
+pub fn write_text(path: &Path, text: &str) -> Result<(), ExportError> {
+    write_atomically(path, |out| {
+        out.write_all(text.as_bytes()).map_err(|e| e.to_string())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn srgb_endpoints_and_midpoint() {
+        assert_eq!(to_srgb8(Vec3::ZERO), [0, 0, 0]);
+        assert_eq!(to_srgb8(Vec3::ONE), [255, 255, 255]);
+        assert_eq!(to_srgb8(Vec3::splat(2.0)), [255, 255, 255]);
+        // Linear 0.214041 is sRGB 0.5 → 128.
+        assert_eq!(to_srgb8(Vec3::splat(0.214_041)), [128, 128, 128]);
+        assert_eq!(to_srgb8(Vec3::splat(f32::NAN)), [0, 0, 0]);
+    }
+
+    #[test]
+    fn failed_write_leaves_nothing() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("x.png");
+        let r = write_atomically(&path, |_| Err("simulated failure".into()));
+        assert!(r.is_err());
+        assert_eq!(std::fs::read_dir(dir.path()).expect("list").count(), 0);
+    }
+}

@@ -13,4 +13,5 @@ pub mod geometry;
 pub mod render;
 pub mod scene;
 pub mod shade;
+pub mod ray_tree;
 pub mod trace;

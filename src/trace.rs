@@ -1,1 +1,434 @@
-//! todo
+//! THE recursive trace of the lecture's pseudocode (SPEC §1), generic over a [`Recorder`]: tiles
+//! use [`NoRecord`], whose calls compile away; a clicked pixel uses the tree recorder of
+//! [`crate::ray_tree`], so the tree and the image can never disagree.
+//!
+//! ```text
+//! trace(p, d, step):
+//!     if step > max_depth            return background        (termination: maximum depth)
+//!     hit = intersect(p, d)
+//!     if hit is a light              return the light's colour (termination: light source)
+//!     if no hit                      return background        (termination: no intersection)
+//!     local = ambient + Σ_lights shadow-ray visibility · (diffuse + specular)
+//!     return local + kr·trace(q, R, step+1) + kt·trace(q, T, step+1)
+//! ```
+
+use std::sync::Arc;
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::accel::{Accel, AccelKind, PrimHit, PrimSet};
+use crate::geometry::{
+    Methods, Ray, intersect_sphere, offset_ray_origin, sphere_hit_point, triangle_hit_point,
+};
+use crate::scene::{MaterialId, ObjectId, Scene};
+use crate::shade::{LightTerms, ambient_term, light_terms, reflect, refract};
+
+/// What a ray is, in the tree and in the statistics.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RayKind {
+    Primary,
+    Reflected,
+    Refracted,
+    Shadow,
+}
+
+/// Why a branch of the tree ended without being shaded (SPEC §5b `end`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EndReason {
+    /// The ray met nothing: background.
+    NoHit,
+    /// The ray met a visible light: the light's colour.
+    HitLight,
+    /// The ray is deeper than `max_depth`: background, without being traced.
+    MaxDepth,
+    /// The ray's weight fell below the cutoff (adaptive depth): background, without being traced.
+    Cutoff,
+}
+
+/// Rays traced, by kind. Children past `max_depth` or below the cutoff are not traced and not
+/// counted.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RayCounts {
+    pub primary: u64,
+    pub reflected: u64,
+    pub refracted: u64,
+    pub shadow: u64,
+}
+
+impl RayCounts {
+    pub fn total(&self) -> u64 {
+        self.primary + self.reflected + self.refracted + self.shadow
+    }
+
+    pub fn add(&mut self, other: &RayCounts) {
+        self.primary += other.primary;
+        self.reflected += other.reflected;
+        self.refracted += other.refracted;
+        self.shadow += other.shadow;
+    }
+
+    fn count(&mut self, kind: RayKind) {
+        match kind {
+            RayKind::Primary => self.primary += 1,
+            RayKind::Reflected => self.reflected += 1,
+            RayKind::Refracted => self.refracted += 1,
+            RayKind::Shadow => self.shadow += 1,
+        }
+    }
+}
+
+/// Per-sample facts for the image modes: the deepest ray traced, how the primary ray's
+/// branch ended and the rays traced.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SampleInfo {
+    pub depth_reached: u32,
+    pub rays: u32,
+}
+
+/// The surface a ray met, as the tree shows it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceHit {
+    pub t: f32,
+    pub point: Vec3,
+    /// Unit normal turned towards the incoming ray.
+    pub normal: Vec3,
+    pub object: ObjectId,
+    pub material: MaterialId,
+    pub front_face: bool,
+    /// Barycentric weights of the triangle's vertices; `None` for spheres.
+    pub barycentric: Option<[f32; 3]>,
+}
+
+/// One light's shadow ray at a hit, as the tree shows it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowTest {
+    pub light: usize,
+    /// Unit vector from the hit point to the light's centre.
+    pub to_light: Vec3,
+    pub distance: f32,
+    /// The first object on the segment to the light, if any. `None` also when the light is
+    /// behind the surface (`N·L ≤ 0`), where no shadow ray is needed.
+    pub blocked_by: Option<ObjectId>,
+    pub terms: LightTerms,
+}
+
+/// Receives every step of one trace. All methods default to doing nothing.
+pub trait Recorder {
+    /// `false` lets the trace skip work done only for the recorder (finding the blocker's name).
+    const ENABLED: bool;
+    fn enter(&mut self, _kind: RayKind, _depth: u32, _ray: &Ray, _weight: Vec3) {}
+    fn end(&mut self, _reason: EndReason) {}
+    fn hit(&mut self, _hit: &SurfaceHit, _view: Vec3) {}
+    fn shadow(&mut self, _test: &ShadowTest) {}
+    fn local(&mut self, _ambient: Vec3, _diffuse: Vec3, _specular: Vec3) {}
+    fn total_internal_reflection(&mut self) {}
+    fn leave(&mut self, _color: Vec3) {}
+}
+
+/// The recorder of image tiles: records nothing.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoRecord;
+
+impl Recorder for NoRecord {
+    const ENABLED: bool = false;
+}
+
+/// How to trace, apart from what the scene's `[render]` section says: one flat struct with
+/// documented ranges.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TraceSettings {
+    pub accel: AccelKind,
+    pub methods: Methods,
+    /// Rays whose weight (largest channel of the product of kr/kt along the path) is below
+    /// this are not traced ("adaptive depth"). 0 disables it; range 0..1.
+    pub cutoff: f32,
+}
+
+impl Default for TraceSettings {
+    fn default() -> Self {
+        Self {
+            accel: AccelKind::Auto,
+            methods: Methods::default(),
+            cutoff: 0.0,
+        }
+    }
+}
+
+/// The spheres and triangles of a scene as the accelerators see them.
+pub fn prim_set(scene: &Scene) -> PrimSet {
+    PrimSet {
+        spheres: scene.spheres.iter().map(|s| (s.center, s.radius)).collect(),
+        triangles: scene.triangles.iter().map(|t| t.vertices).collect(),
+    }
+}
+
+/// A scene made ready to trace: the immutable snapshot workers read.
+pub struct Tracer {
+    pub scene: Arc<Scene>,
+    pub accel: Accel,
+    pub settings: TraceSettings,
+    /// Lights with a radius, which end the rays that meet them.
+    visible_lights: Vec<usize>,
+    /// Seconds spent building the accelerator.
+    pub build_secs: f64,
+}
+
+enum Found {
+    Nothing,
+    Light(usize),
+    Prim(PrimHit),
+}
+
+impl Tracer {
+    pub fn new(scene: Arc<Scene>, settings: TraceSettings) -> Self {
+        let start = std::time::Instant::now();
+        let accel = Accel::build(settings.accel, &prim_set(&scene));
+        let build_secs = start.elapsed().as_secs_f64();
+        let visible_lights = (0..scene.lights.len())
+            .filter(|&i| scene.lights[i].radius > 0.0)
+            .collect();
+        Self {
+            scene,
+            accel,
+            settings,
+            visible_lights,
+            build_secs,
+        }
+    }
+
+    fn methods(&self) -> &Methods {
+        &self.settings.methods
+    }
+
+    /// Closest object or visible light along the ray, strictly after `t_min`.
+    fn intersect(&self, ray: &Ray) -> Found {
+        let mut found = Found::Nothing;
+        let mut t_max = f32::INFINITY;
+        if let Some(hit) = self.accel.closest_hit(self.methods(), ray, 0.0, t_max) {
+            t_max = hit.t;
+            found = Found::Prim(hit);
+        }
+        for &i in &self.visible_lights {
+            let light = &self.scene.lights[i];
+            let sphere = self.methods().sphere;
+            if let Some(t) = intersect_sphere(sphere, light.position, light.radius, ray, 0.0, t_max)
+            {
+                t_max = t;
+                found = Found::Light(i);
+            }
+        }
+        found
+    }
+
+    /// Traces one ray of `kind` at `depth` (the primary ray has depth 0) whose contribution to
+    /// the pixel is scaled by `weight`; returns its colour.
+    pub fn trace<R: Recorder>(
+        &self,
+        ray: &Ray,
+        kind: RayKind,
+        depth: u32,
+        weight: Vec3,
+        counts: &mut RayCounts,
+        info: &mut SampleInfo,
+        rec: &mut R,
+    ) -> Vec3 {
+        rec.enter(kind, depth, ray, weight);
+        let color = self.trace_inner(ray, kind, depth, weight, counts, info, rec);
+        rec.leave(color);
+        color
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn trace_inner<R: Recorder>(
+        &self,
+        ray: &Ray,
+        kind: RayKind,
+        depth: u32,
+        weight: Vec3,
+        counts: &mut RayCounts,
+        info: &mut SampleInfo,
+        rec: &mut R,
+    ) -> Vec3 {
+        let background = self.scene.render.background;
+        if depth > self.scene.render.max_depth {
+            rec.end(EndReason::MaxDepth);
+            return background;
+        }
+        if weight.max_element() < self.settings.cutoff {
+            rec.end(EndReason::Cutoff);
+            return background;
+        }
+        counts.count(kind);
+        info.rays += 1;
+        info.depth_reached = info.depth_reached.max(depth);
+        match self.intersect(ray) {
+            Found::Nothing => {
+                rec.end(EndReason::NoHit);
+                background
+            }
+            Found::Light(i) => {
+                rec.end(EndReason::HitLight);
+                self.scene.lights[i].color
+            }
+            Found::Prim(hit) => self.shade(ray, &hit, depth, weight, counts, info, rec),
+        }
+    }
+
+    /// Hit point, its error bound, geometric normal, object, material and barycentrics.
+    fn surface(&self, ray: &Ray, hit: &PrimHit) -> (SurfaceHit, Vec3) {
+        let scene = &self.scene;
+        let n_spheres = scene.spheres.len();
+        let prim = hit.prim as usize;
+        let (point, error, normal, object, material, barycentric) = if prim < n_spheres {
+            let s = &scene.spheres[prim];
+            let (p, err) = sphere_hit_point(self.methods().sphere, s.center, s.radius, ray, hit.t);
+            let n = ((p - s.center) / s.radius).normalize();
+            (p, err, n, s.object, s.material, None)
+        } else {
+            let tri = &scene.triangles[prim - n_spheres];
+            let v = &tri.vertices;
+            let (p, err) = triangle_hit_point(v, hit.b1, hit.b2);
+            let n = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
+            let b = [1.0 - hit.b1 - hit.b2, hit.b1, hit.b2];
+            (p, err, n, tri.object, tri.material, Some(b))
+        };
+        let front_face = ray.dir.dot(normal) < 0.0;
+        let surface = SurfaceHit {
+            t: hit.t,
+            point,
+            normal: if front_face { normal } else { -normal },
+            object,
+            material,
+            front_face,
+            barycentric,
+        };
+        (surface, error)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn shade<R: Recorder>(
+        &self,
+        ray: &Ray,
+        hit: &PrimHit,
+        depth: u32,
+        weight: Vec3,
+        counts: &mut RayCounts,
+        info: &mut SampleInfo,
+        rec: &mut R,
+    ) -> Vec3 {
+        let scene = &*self.scene;
+        let offset = self.methods().offset;
+        let (surface, error) = self.surface(ray, hit);
+        let (p, n) = (surface.point, surface.normal);
+        let v = -ray.dir;
+        rec.hit(&surface, v);
+        let material = scene.material(surface.material);
+
+        let ambient = ambient_term(material, scene.render.ambient_light);
+        let mut diffuse = Vec3::ZERO;
+        let mut specular = Vec3::ZERO;
+        for (i, light) in scene.lights.iter().enumerate() {
+            let to_light = light.position - p;
+            let distance = to_light.length();
+            let l = to_light / distance;
+            let terms = light_terms(scene.render.shading, material, light.color, n, l, v);
+            let mut blocked_by = None;
+            if terms.n_dot_l > 0.0 {
+                // The shadow ray runs from the offset origin to the light's centre; only
+                // objects count as blockers, never lights.
+                let origin = offset_ray_origin(offset, p, error, n, l);
+                let segment = light.position - origin;
+                let length = segment.length();
+                let shadow_ray = Ray::new(origin, segment / length);
+                counts.count(RayKind::Shadow);
+                info.rays += 1;
+                let blocked = if R::ENABLED {
+                    let blocker = self.accel.closest_hit(self.methods(), &shadow_ray, 0.0, length);
+                    blocked_by = blocker.map(|b| self.object_of(b.prim));
+                    blocker.is_some()
+                } else {
+                    self.accel.occluded(self.methods(), &shadow_ray, 0.0, length)
+                };
+                if !blocked {
+                    diffuse += terms.diffuse;
+                    specular += terms.specular;
+                }
+            }
+            if R::ENABLED {
+                rec.shadow(&ShadowTest {
+                    light: i,
+                    to_light: l,
+                    distance,
+                    blocked_by,
+                    terms,
+                });
+            }
+        }
+        rec.local(ambient, diffuse, specular);
+        let mut color = ambient + diffuse + specular;
+
+        // Children: refraction first decides whether its weight moves to the reflected ray
+        // (total internal reflection); the sum is then formed in the fixed order R, T.
+        let kr = material.reflectivity;
+        let kt = material.transparency;
+        let mut reflected_weight = kr;
+        let mut refracted = None;
+        if kt != Vec3::ZERO {
+            // Entering the solid goes from air (η = 1) to the material, leaving goes back.
+            let eta = if surface.front_face {
+                1.0 / material.ior
+            } else {
+                material.ior
+            };
+            match refract(ray.dir, n, eta) {
+                Some(t) => refracted = Some(t),
+                None => {
+                    rec.total_internal_reflection();
+                    reflected_weight += kt;
+                }
+            }
+        }
+        if reflected_weight != Vec3::ZERO {
+            let r = reflect(ray.dir, n).normalize();
+            let child = Ray::new(offset_ray_origin(offset, p, error, n, r), r);
+            let c = self.trace(
+                &child,
+                RayKind::Reflected,
+                depth + 1,
+                weight * reflected_weight,
+                counts,
+                info,
+                rec,
+            );
+            color += reflected_weight * c;
+        }
+        if let Some(t) = refracted {
+            let child = Ray::new(offset_ray_origin(offset, p, error, n, t), t);
+            let c = self.trace(
+                &child,
+                RayKind::Refracted,
+                depth + 1,
+                weight * kt,
+                counts,
+                info,
+                rec,
+            );
+            color += kt * c;
+        }
+        color
+    }
+
+    /// The object a primitive id belongs to.
+    pub fn object_of(&self, prim: u32) -> ObjectId {
+        let prim = prim as usize;
+        let n_spheres = self.scene.spheres.len();
+        if prim < n_spheres {
+            self.scene.spheres[prim].object
+        } else {
+            self.scene.triangles[prim - n_spheres].object
+        }
+    }
+}

@@ -53,3 +53,8 @@ impl Accel {
         todo!()
     }
 }
+impl Accel {
+    pub fn kind(&self) -> AccelKind {
+        todo!()
+    }
+}

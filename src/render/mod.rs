@@ -1,1 +1,264 @@
-//! todo
+//! Rendering an image: settings with presets, tiles traced by a rayon pool, a linear `f32` film
+//! that accumulates samples in a fixed order per pixel (so the result never depends on the
+//! thread count or the tile order), and statistics.
+
+pub mod camera;
+pub mod sampling;
+
+use std::ops::Range;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+use glam::Vec3;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::accel::AccelKind;
+use crate::trace::{NoRecord, RayCounts, RayKind, SampleInfo, TraceSettings, Tracer};
+pub use camera::CameraFrame;
+pub use sampling::sample_offset;
+
+/// Side of a square tile in pixels.
+pub const TILE_SIZE: u32 = 32;
+
+/// How to render, beyond the scene's own `[render]` section.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RenderSettings {
+    pub trace: TraceSettings,
+    /// Worker threads; 0 uses every core.
+    pub threads: usize,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            trace: TraceSettings::default(),
+            threads: 0,
+        }
+    }
+}
+
+/// A linear RGB image, row-major, y = 0 at the top.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<Vec3>,
+}
+
+impl Image {
+    pub fn new(width: u32, height: u32) -> Self {
+        Self {
+            width,
+            height,
+            pixels: vec![Vec3::ZERO; width as usize * height as usize],
+        }
+    }
+
+    pub fn get(&self, x: u32, y: u32) -> Vec3 {
+        self.pixels[(y * self.width + x) as usize]
+    }
+}
+
+/// A rectangle of pixels: `x..x+width`, `y..y+height`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Rect {
+    pub x: u32,
+    pub y: u32,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// The tiles covering a `width × height` image, nearest the centre first.
+pub fn tiles(width: u32, height: u32, size: u32) -> Vec<Rect> {
+    let mut out = Vec::new();
+    for y in (0..height).step_by(size as usize) {
+        for x in (0..width).step_by(size as usize) {
+            out.push(Rect {
+                x,
+                y,
+                width: size.min(width - x),
+                height: size.min(height - y),
+            });
+        }
+    }
+    let (cx, cy) = (width as f32 * 0.5, height as f32 * 0.5);
+    let dist = |r: &Rect| {
+        let dx = r.x as f32 + r.width as f32 * 0.5 - cx;
+        let dy = r.y as f32 + r.height as f32 * 0.5 - cy;
+        dx * dx + dy * dy
+    };
+    out.sort_by(|a, b| dist(a).total_cmp(&dist(b)).then((a.y, a.x).cmp(&(b.y, b.x))));
+    out
+}
+
+/// Traces samples `samples` of every pixel of `rect`, adding each sample, in index order, to
+/// the running sums in `sums` (row-major within the rect). Returns the rays traced.
+pub fn trace_tile(
+    tracer: &Tracer,
+    frame: &CameraFrame,
+    rect: Rect,
+    samples: Range<u32>,
+    sums: &mut [Vec3],
+) -> RayCounts {
+    let mut counts = RayCounts::default();
+    for j in 0..rect.height {
+        for i in 0..rect.width {
+            let (x, y) = (rect.x + i, rect.y + j);
+            let sum = &mut sums[(j * rect.width + i) as usize];
+            for s in samples.clone() {
+                *sum += trace_sample(tracer, frame, x, y, s, &mut counts).0;
+            }
+        }
+    }
+    counts
+}
+
+/// Sample `s` of pixel (`x`, `y`): its colour and the facts the image modes show.
+pub fn trace_sample(
+    tracer: &Tracer,
+    frame: &CameraFrame,
+    x: u32,
+    y: u32,
+    s: u32,
+    counts: &mut RayCounts,
+) -> (Vec3, SampleInfo) {
+    let (u, v) = sample_offset(x, y, s);
+    let ray = frame.ray(x as f32 + u, y as f32 + v);
+    let mut info = SampleInfo::default();
+    let c = tracer.trace(
+        &ray,
+        RayKind::Primary,
+        0,
+        Vec3::ONE,
+        counts,
+        &mut info,
+        &mut NoRecord,
+    );
+    (c, info)
+}
+
+/// Figures of one render.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct RenderStats {
+    pub width: u32,
+    pub height: u32,
+    pub samples: u32,
+    pub threads: usize,
+    /// The accelerator actually used (`auto` resolved).
+    pub accel: Option<AccelKind>,
+    pub rays: RayCounts,
+    pub build_secs: f64,
+    pub render_secs: f64,
+}
+
+impl RenderStats {
+    /// Millions of rays (all kinds) per second of the render phase.
+    pub fn mrays_per_sec(&self) -> f64 {
+        self.rays.total() as f64 / self.render_secs.max(1e-9) / 1e6
+    }
+}
+
+/// A render that could not complete.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    #[error("a render worker failed on the tile at ({x}, {y}): {message}")]
+    WorkerPanicked { x: u32, y: u32, message: String },
+    #[error("cannot start {threads} render threads: {message}")]
+    Threads { threads: usize, message: String },
+}
+
+/// Renders the tracer's scene at its `[render]` size with `samples` samples per pixel on
+/// `threads` threads (0: all cores). `progress` is called with (pixels done, pixels in all)
+/// after every tile, from worker threads.
+pub fn render(
+    tracer: &Tracer,
+    samples: u32,
+    threads: usize,
+    progress: &(dyn Fn(u64, u64) + Sync),
+) -> Result<(Image, RenderStats), RenderError> {
+    let (width, height) = (tracer.scene.render.width, tracer.scene.render.height);
+    let frame = CameraFrame::new(&tracer.scene.camera, width, height);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| RenderError::Threads {
+            threads,
+            message: e.to_string(),
+        })?;
+    let tiles = tiles(width, height, TILE_SIZE);
+    let total = width as u64 * height as u64;
+    let done = AtomicU64::new(0);
+    let start = Instant::now();
+    let results: Vec<_> = pool.install(|| {
+        tiles
+            .par_iter()
+            .map(|&rect| {
+                let mut sums = vec![Vec3::ZERO; (rect.width * rect.height) as usize];
+                let outcome = catch_unwind(AssertUnwindSafe(|| {
+                    trace_tile(tracer, &frame, rect, 0..samples, &mut sums)
+                }));
+                let n = rect.width as u64 * rect.height as u64;
+                progress(done.fetch_add(n, Ordering::Relaxed) + n, total);
+                outcome.map(|counts| (rect, sums, counts)).map_err(|panic| {
+                    let message = panic
+                        .downcast_ref::<&str>()
+                        .map(|s| s.to_string())
+                        .or_else(|| panic.downcast_ref::<String>().cloned())
+                        .unwrap_or_else(|| "unknown panic".into());
+                    RenderError::WorkerPanicked {
+                        x: rect.x,
+                        y: rect.y,
+                        message,
+                    }
+                })
+            })
+            .collect()
+    });
+    let render_secs = start.elapsed().as_secs_f64();
+    let mut image = Image::new(width, height);
+    let mut rays = RayCounts::default();
+    for result in results {
+        let (rect, sums, counts) = result?;
+        rays.add(&counts);
+        for j in 0..rect.height {
+            for i in 0..rect.width {
+                let sum = sums[(j * rect.width + i) as usize];
+                image.pixels[((rect.y + j) * width + rect.x + i) as usize] = sum / samples as f32;
+            }
+        }
+    }
+    let stats = RenderStats {
+        width,
+        height,
+        samples,
+        threads: pool.current_num_threads(),
+        accel: Some(tracer.accel.kind()),
+        rays,
+        build_secs: tracer.build_secs,
+        render_secs,
+    };
+    Ok((image, stats))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tiles_cover_image_once() {
+        let (w, h) = (100, 70);
+        let mut seen = vec![0u8; (w * h) as usize];
+        for r in tiles(w, h, 32) {
+            for y in r.y..r.y + r.height {
+                for x in r.x..r.x + r.width {
+                    seen[(y * w + x) as usize] += 1;
+                }
+            }
+        }
+        assert!(seen.iter().all(|&c| c == 1));
+        let first = tiles(w, h, 32)[0];
+        assert!(first.x <= 50 && 50 < first.x + first.width + 32);
+    }
+}

@@ -1,0 +1,363 @@
+//! The ray tracing tree of one pixel as data (SPEC §5b): the recorder that builds it from the
+//! same [`Tracer::trace`] the image uses, and its JSON form.
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::geometry::Ray;
+use crate::render::{CameraFrame, sample_offset};
+use crate::scene::Scene;
+use crate::trace::{
+    EndReason, RayCounts, RayKind, Recorder, SampleInfo, ShadowTest, SurfaceHit, TraceSettings,
+    Tracer,
+};
+
+/// Nodes recorded at most; deeper or wider trees are cut and marked truncated. Glass at depth
+/// 64 has up to 2⁶⁵ branches, so the cap is what keeps a click responsive.
+pub const MAX_NODES: usize = 4096;
+
+/// Where a ray met a surface.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct HitRecord {
+    pub t: f32,
+    pub point: Vec3,
+    /// Unit normal turned towards the incoming ray.
+    pub normal: Vec3,
+    pub object: String,
+    pub material: String,
+    pub front_face: bool,
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub barycentric: Option<[f32; 3]>,
+}
+
+/// The local illumination terms at a hit, summed over lights.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LocalRecord {
+    pub ambient: Vec3,
+    pub diffuse: Vec3,
+    pub specular: Vec3,
+    pub total: Vec3,
+}
+
+/// One light's shadow ray.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ShadowRecord {
+    pub light: String,
+    /// `L`, unit vector from the hit point to the light's centre.
+    pub to_light: Vec3,
+    pub distance: f32,
+    /// The first object on the segment to the light, or `None` when lit (or facing away).
+    pub blocked_by: Option<String>,
+    /// `N·L ≤ 0`: the light is behind the surface, adds nothing and needs no shadow ray.
+    pub facing_away: bool,
+    pub n_dot_l: f32,
+    pub n_dot_h: f32,
+    pub r_dot_v: f32,
+    /// This light's diffuse and specular terms as added (zero when blocked).
+    pub diffuse: Vec3,
+    pub specular: Vec3,
+}
+
+/// One ray of the tree.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Node {
+    pub kind: RayKind,
+    pub depth: u32,
+    pub origin: Vec3,
+    pub direction: Vec3,
+    /// Product of kr / kt along the path from the root.
+    pub weight: Vec3,
+    pub end: Option<EndReason>,
+    pub hit: Option<HitRecord>,
+    /// `V`, unit vector from the hit towards the ray's origin.
+    pub view: Option<Vec3>,
+    pub local: Option<LocalRecord>,
+    pub shadow_rays: Vec<ShadowRecord>,
+    pub total_internal_reflection: bool,
+    /// `local + kr·reflected.color + kt·refracted.color`.
+    pub color: Vec3,
+    pub children: Vec<Node>,
+}
+
+/// What produced a tree.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TreeSettings {
+    pub max_depth: u32,
+    pub shading: crate::scene::Shading,
+    pub trace: TraceSettings,
+}
+
+/// The tree of one pixel's centre sample.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RayTree {
+    pub pixel: [u32; 2],
+    /// The pixel's sample-0 value: equal to the 1-sample render.
+    pub color: Vec3,
+    pub settings: TreeSettings,
+    /// Nodes recorded.
+    pub nodes: usize,
+    /// More rays were traced than [`MAX_NODES`]; the rest are in `color` but not in the tree.
+    pub truncated: bool,
+    pub rays: RayCounts,
+    pub root: Node,
+}
+
+/// Builds [`Node`]s from the trace's callbacks with a stack.
+struct TreeRecorder<'a> {
+    scene: &'a Scene,
+    stack: Vec<Node>,
+    /// Depth of unrecorded nesting below the cap.
+    skipped: u32,
+    nodes: usize,
+    truncated: bool,
+    root: Option<Node>,
+}
+
+impl TreeRecorder<'_> {
+    fn top(&mut self) -> Option<&mut Node> {
+        if self.skipped > 0 {
+            None
+        } else {
+            self.stack.last_mut()
+        }
+    }
+}
+
+impl Recorder for TreeRecorder<'_> {
+    const ENABLED: bool = true;
+
+    fn enter(&mut self, kind: RayKind, depth: u32, ray: &Ray, weight: Vec3) {
+        if self.skipped > 0 || self.nodes >= MAX_NODES {
+            self.skipped += 1;
+            self.truncated = true;
+            return;
+        }
+        self.nodes += 1;
+        self.stack.push(Node {
+            kind,
+            depth,
+            origin: ray.origin,
+            direction: ray.dir,
+            weight,
+            end: None,
+            hit: None,
+            view: None,
+            local: None,
+            shadow_rays: Vec::new(),
+            total_internal_reflection: false,
+            color: Vec3::ZERO,
+            children: Vec::new(),
+        });
+    }
+
+    fn end(&mut self, reason: EndReason) {
+        if let Some(node) = self.top() {
+            node.end = Some(reason);
+        }
+    }
+
+    fn hit(&mut self, hit: &SurfaceHit, view: Vec3) {
+        let scene = self.scene;
+        if let Some(node) = self.top() {
+            node.hit = Some(HitRecord {
+                t: hit.t,
+                point: hit.point,
+                normal: hit.normal,
+                object: scene.object(hit.object).name.clone(),
+                material: scene.material(hit.material).name.clone(),
+                front_face: hit.front_face,
+                barycentric: hit.barycentric,
+            });
+            node.view = Some(view);
+        }
+    }
+
+    fn shadow(&mut self, test: &ShadowTest) {
+        let scene = self.scene;
+        if let Some(node) = self.top() {
+            let lit = test.blocked_by.is_none() && test.terms.n_dot_l > 0.0;
+            node.shadow_rays.push(ShadowRecord {
+                light: scene.lights[test.light].name.clone(),
+                to_light: test.to_light,
+                distance: test.distance,
+                blocked_by: test.blocked_by.map(|o| scene.object(o).name.clone()),
+                facing_away: test.terms.n_dot_l.is_nan() || test.terms.n_dot_l <= 0.0,
+                n_dot_l: test.terms.n_dot_l,
+                n_dot_h: test.terms.n_dot_h,
+                r_dot_v: test.terms.r_dot_v,
+                diffuse: if lit { test.terms.diffuse } else { Vec3::ZERO },
+                specular: if lit { test.terms.specular } else { Vec3::ZERO },
+            });
+        }
+    }
+
+    fn local(&mut self, ambient: Vec3, diffuse: Vec3, specular: Vec3) {
+        if let Some(node) = self.top() {
+            node.local = Some(LocalRecord {
+                ambient,
+                diffuse,
+                specular,
+                total: ambient + diffuse + specular,
+            });
+        }
+    }
+
+    fn total_internal_reflection(&mut self) {
+        if let Some(node) = self.top() {
+            node.total_internal_reflection = true;
+        }
+    }
+
+    fn leave(&mut self, color: Vec3) {
+        if self.skipped > 0 {
+            self.skipped -= 1;
+            return;
+        }
+        let Some(mut node) = self.stack.pop() else {
+            return;
+        };
+        node.color = color;
+        match self.stack.last_mut() {
+            Some(parent) => parent.children.push(node),
+            None => self.root = Some(node),
+        }
+    }
+}
+
+/// Traces the centre sample of pixel (`x`, `y`) with a tree recorder. `None` when the pixel is
+/// outside the image.
+pub fn pixel_tree(tracer: &Tracer, x: u32, y: u32) -> Option<RayTree> {
+    let scene = &*tracer.scene;
+    let (w, h) = (scene.render.width, scene.render.height);
+    if x >= w || y >= h {
+        return None;
+    }
+    let frame = CameraFrame::new(&scene.camera, w, h);
+    let (u, v) = sample_offset(x, y, 0);
+    let ray = frame.ray(x as f32 + u, y as f32 + v);
+    let mut rec = TreeRecorder {
+        scene,
+        stack: Vec::new(),
+        skipped: 0,
+        nodes: 0,
+        truncated: false,
+        root: None,
+    };
+    let mut rays = RayCounts::default();
+    let mut info = SampleInfo::default();
+    let color = tracer.trace(
+        &ray,
+        RayKind::Primary,
+        0,
+        Vec3::ONE,
+        &mut rays,
+        &mut info,
+        &mut rec,
+    );
+    Some(RayTree {
+        pixel: [x, y],
+        color,
+        settings: TreeSettings {
+            max_depth: scene.render.max_depth,
+            shading: scene.render.shading,
+            trace: tracer.settings,
+        },
+        nodes: rec.nodes,
+        truncated: rec.truncated,
+        rays,
+        root: rec.root?,
+    })
+}
+
+fn fmt_v(v: Vec3) -> String {
+    format!("({:.4}, {:.4}, {:.4})", v.x, v.y, v.z)
+}
+
+/// The tree as indented, readable text (what `raytree tree` prints without `--json`).
+pub fn tree_text(tree: &RayTree) -> String {
+    let mut out = format!(
+        "pixel ({}, {}) colour {}  [{} nodes{}; max_depth {}, {:?}]\n",
+        tree.pixel[0],
+        tree.pixel[1],
+        fmt_v(tree.color),
+        tree.nodes,
+        if tree.truncated { ", truncated" } else { "" },
+        tree.settings.max_depth,
+        tree.settings.shading,
+    );
+    write_node(&mut out, &tree.root, 0);
+    out
+}
+
+fn write_node(out: &mut String, node: &Node, indent: usize) {
+    use std::fmt::Write;
+    let pad = "  ".repeat(indent);
+    let kind = match node.kind {
+        RayKind::Primary => "primary",
+        RayKind::Reflected => "R (reflected)",
+        RayKind::Refracted => "T (refracted)",
+        RayKind::Shadow => "shadow",
+    };
+    let _ = write!(
+        out,
+        "{pad}{kind} depth {} weight {} dir {}",
+        node.depth,
+        fmt_v(node.weight),
+        fmt_v(node.direction)
+    );
+    if let Some(end) = node.end {
+        let _ = writeln!(out, " -> {end:?} => colour {}", fmt_v(node.color));
+        return;
+    }
+    out.push('\n');
+    if let Some(hit) = &node.hit {
+        let _ = writeln!(
+            out,
+            "{pad}  hit {} ({}) at t = {:.5}, P = {}, N = {}{}{}",
+            hit.object,
+            hit.material,
+            hit.t,
+            fmt_v(hit.point),
+            fmt_v(hit.normal),
+            if hit.front_face { "" } else { ", inside" },
+            hit.barycentric
+                .map(|b| format!(", barycentric ({:.4}, {:.4}, {:.4})", b[0], b[1], b[2]))
+                .unwrap_or_default(),
+        );
+    }
+    for s in &node.shadow_rays {
+        let verdict = match (&s.blocked_by, s.facing_away) {
+            (_, true) => "facing away".to_string(),
+            (Some(b), _) => format!("blocked by {b}"),
+            (None, false) => "lit".to_string(),
+        };
+        let _ = writeln!(
+            out,
+            "{pad}  shadow ray to {}: {verdict}; L = {}, N·L = {:.4}, N·H = {:.4}, R·V = {:.4}, diffuse {}, specular {}",
+            s.light,
+            fmt_v(s.to_light),
+            s.n_dot_l,
+            s.n_dot_h,
+            s.r_dot_v,
+            fmt_v(s.diffuse),
+            fmt_v(s.specular)
+        );
+    }
+    if let Some(l) = &node.local {
+        let _ = writeln!(
+            out,
+            "{pad}  local = ambient {} + diffuse {} + specular {} = {}",
+            fmt_v(l.ambient),
+            fmt_v(l.diffuse),
+            fmt_v(l.specular),
+            fmt_v(l.total)
+        );
+    }
+    if node.total_internal_reflection {
+        let _ = writeln!(out, "{pad}  total internal reflection: kt goes to R");
+    }
+    for child in &node.children {
+        write_node(out, child, indent + 1);
+    }
+    let _ = writeln!(out, "{pad}  => colour {}", fmt_v(node.color));
+}
