@@ -1,0 +1,146 @@
+//! The `raytree` command as a user runs it: renders, trees, errors and exit codes.
+
+use assert_cmd::Command;
+
+fn raytree() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_raytree"))
+}
+
+fn png_text(path: &std::path::Path) -> Vec<(String, String)> {
+    let file = std::fs::File::open(path).expect("png exists");
+    let reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .expect("valid png");
+    reader
+        .info()
+        .uncompressed_latin1_text
+        .iter()
+        .map(|t| (t.keyword.clone(), t.text.clone()))
+        .collect()
+}
+
+#[test]
+fn renders_png_with_stats_and_stamps() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("quiz.png");
+    let output = raytree()
+        .args(["render", "quiz", "--width", "41", "--height", "31", "--samples", "2", "-o"])
+        .arg(&out)
+        .output()
+        .expect("runs");
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(stdout.contains("primary") && stdout.contains("shadow") && stdout.contains("Mrays/s"));
+    // 41 × 31 pixels × 2 samples primary rays.
+    assert!(stdout.contains(&format!("{} primary", 41 * 31 * 2)), "{stdout}");
+    let text = png_text(&out);
+    assert!(text.iter().any(|(k, v)| k == "raytree.samples" && v == "2/2"), "{text:?}");
+    assert!(text.iter().any(|(k, v)| k == "raytree.settings" && v.contains("max_depth")));
+}
+
+#[test]
+fn renders_exr() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("glass.exr");
+    raytree()
+        .args(["render", "glass", "--width", "32", "--height", "24", "-q", "-o"])
+        .arg(&out)
+        .assert()
+        .success();
+    let bytes = std::fs::read(&out).expect("exr written");
+    assert_eq!(&bytes[..4], &[0x76, 0x2f, 0x31, 0x01], "OpenEXR magic number");
+}
+
+#[test]
+fn bad_scene_is_one_sentence_and_no_file() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = dir.path().join("bad.toml");
+    std::fs::write(&scene, "[[sphere]]\ncenter = [0, 0, 0]\nradius = -1\n").expect("write");
+    let out = dir.path().join("never.png");
+    let output = raytree()
+        .args(["render"])
+        .arg(&scene)
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .expect("runs");
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("bad.toml:3:"), "{stderr}");
+    assert!(stderr.contains("radius"), "{stderr}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn unwritable_output_fails_cleanly() {
+    let output = raytree()
+        .args(["render", "quiz", "--width", "8", "--height", "8", "-q"])
+        .args(["-o", "/nonexistent-folder/x.png"])
+        .output()
+        .expect("runs");
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.starts_with("error: cannot write /nonexistent-folder/x.png"), "{stderr}");
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+    let output = raytree()
+        .args(["render", "quiz", "-o", "x.jpg"])
+        .output()
+        .expect("runs");
+    assert!(!output.status.success());
+    assert!(String::from_utf8_lossy(&output.stderr).contains(".png"));
+}
+
+#[test]
+fn out_of_range_options_are_refused() {
+    for args in [
+        ["--max-depth", "65"],
+        ["--width", "0"],
+        ["--samples", "0"],
+    ] {
+        raytree()
+            .args(["render", "quiz", "-o", "x.png"])
+            .args(args)
+            .assert()
+            .failure();
+    }
+}
+
+#[test]
+fn tree_prints_text_and_json() {
+    // The quiz scene's centre pixel hits the triangle at P = (0, 0, −1).
+    let output = raytree()
+        .args(["tree", "quiz", "--pixel", "100,100", "--json"])
+        .output()
+        .expect("runs");
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).expect("json");
+    let hit = &json["root"]["hit"];
+    let point: Vec<f64> = serde_json::from_value(hit["point"].clone()).expect("point");
+    assert!((point[2] + 1.0).abs() < 1e-6, "{point:?}");
+    let bary: Vec<f64> = serde_json::from_value(hit["barycentric"].clone()).expect("bary");
+    assert!((bary[2] - 0.5).abs() < 1e-6, "{bary:?}");
+    assert_eq!(json["root"]["kind"], "primary");
+    let text = raytree()
+        .args(["tree", "quiz", "--pixel", "100,100"])
+        .output()
+        .expect("runs");
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(text.contains("shadow ray to") && text.contains("barycentric"), "{text}");
+    raytree()
+        .args(["tree", "quiz", "--pixel", "5000,1"])
+        .assert()
+        .failure();
+}
+
+#[test]
+fn help_documents_the_options() {
+    let output = raytree().args(["render", "--help"]).output().expect("runs");
+    let help = String::from_utf8_lossy(&output.stdout);
+    for flag in [
+        "--width", "--height", "--samples", "--max-depth", "--threads", "--accel", "--sphere",
+        "--triangle", "--offset", "--shading", "--cutoff",
+    ] {
+        assert!(help.contains(flag), "render --help lacks {flag}");
+    }
+}

@@ -1,0 +1,314 @@
+//! The trace against answers derived by hand: the lecture's quiz, reflection and refraction,
+//! max_depth semantics, shadows, and pixels of small scenes (1e-5).
+
+use std::sync::Arc;
+
+use glam::{DVec3, Vec3};
+use raytree::accel::AccelKind;
+use raytree::geometry::{Ray, TriangleMethod, intersect_triangle, triangle_hit_point};
+use raytree::render::render;
+use raytree::scene::{
+    Camera, Light, Material, MaterialId, Object, ObjectId, ObjectSource, RenderParams, Scene,
+    Shading, Sphere, Triangle,
+};
+use raytree::shade::{halfway, light_terms};
+use raytree::trace::{TraceSettings, Tracer};
+
+const S: f32 = std::f32::consts::FRAC_1_SQRT_2;
+
+fn close(a: Vec3, b: Vec3, tol: f32) -> bool {
+    (a - b).abs().max_element() <= tol
+}
+
+/// A scene builder for hand-made test scenes.
+struct Build(Scene);
+
+impl Build {
+    fn new(camera: Camera, width: u32, height: u32) -> Self {
+        Build(Scene {
+            render: RenderParams {
+                width,
+                height,
+                max_depth: 5,
+                samples: 1,
+                background: Vec3::new(0.05, 0.1, 0.15),
+                ambient_light: Vec3::splat(0.5),
+                shading: Shading::BlinnPhong,
+            },
+            camera,
+            ..Scene::default()
+        })
+    }
+
+    fn material(mut self, m: Material) -> Self {
+        self.0.materials.push(m);
+        self
+    }
+
+    fn light(mut self, position: Vec3, color: Vec3) -> Self {
+        let name = format!("light {}", self.0.lights.len() + 1);
+        self.0.lights.push(Light {
+            name,
+            position,
+            color,
+            radius: 0.0,
+        });
+        self
+    }
+
+    fn sphere(mut self, name: &str, center: Vec3, radius: f32, material: u32) -> Self {
+        let object = ObjectId(self.0.objects.len() as u32);
+        self.0.objects.push(Object {
+            name: name.into(),
+            source: ObjectSource::Sphere,
+        });
+        self.0.spheres.push(Sphere {
+            center,
+            radius,
+            material: MaterialId(material),
+            object,
+        });
+        self
+    }
+
+    fn quad(mut self, name: &str, corners: [Vec3; 4], material: u32) -> Self {
+        let object = ObjectId(self.0.objects.len() as u32);
+        self.0.objects.push(Object {
+            name: name.into(),
+            source: ObjectSource::Triangle,
+        });
+        for vertices in [
+            [corners[0], corners[1], corners[2]],
+            [corners[0], corners[2], corners[3]],
+        ] {
+            self.0.triangles.push(Triangle {
+                vertices,
+                material: MaterialId(material),
+                object,
+            });
+        }
+        self
+    }
+
+    fn pixel(&self, x: u32, y: u32, accel: AccelKind) -> Vec3 {
+        let tracer = Tracer::new(
+            Arc::new(self.0.clone()),
+            TraceSettings {
+                accel,
+                ..TraceSettings::default()
+            },
+        );
+        let (image, _) = render(&tracer, 1, 1, &|_, _| {}).expect("render");
+        image.get(x, y)
+    }
+}
+
+fn looking(position: Vec3, look_at: Vec3, fov_y_deg: f32) -> Camera {
+    Camera {
+        position,
+        look_at,
+        up: Vec3::Y,
+        fov_y_deg,
+    }
+}
+
+fn mat(name: &str, ka: Vec3, kd: Vec3, ks: f32, n: f32, kr: f32) -> Material {
+    Material {
+        name: name.into(),
+        ambient: ka,
+        diffuse: kd,
+        specular: Vec3::splat(ks),
+        shininess: n,
+        reflectivity: Vec3::splat(kr),
+        transparency: Vec3::ZERO,
+        ior: 1.5,
+    }
+}
+
+#[test]
+fn lecture_quiz_numbers() {
+    let a = [
+        Vec3::new(-1.0, -1.0, -1.0),
+        Vec3::new(1.0, -1.0, -1.0),
+        Vec3::new(0.0, 1.0, -1.0),
+    ];
+    // Q1: N = normalize(A1A2 × A1A3) = (0, 0, 1).
+    let n = (a[1] - a[0]).cross(a[2] - a[0]).normalize();
+    assert_eq!(n, Vec3::Z);
+    let ray = Ray::new(Vec3::ZERO, Vec3::NEG_Z);
+    for method in [
+        TriangleMethod::Lecture,
+        TriangleMethod::MollerTrumbore,
+        TriangleMethod::Watertight,
+    ] {
+        // Q2: P = (0, 0, −1) at s = 1; Q3: barycentric (1/4, 1/4, 1/2).
+        let hit = intersect_triangle(method, &a, &ray, 0.0, f32::INFINITY)
+            .unwrap_or_else(|| panic!("{method:?} misses the quiz triangle"));
+        assert!((hit.t - 1.0).abs() < 1e-6, "{method:?} t = {}", hit.t);
+        let (p, _) = triangle_hit_point(&a, hit.b1, hit.b2);
+        assert!(close(p, Vec3::new(0.0, 0.0, -1.0), 1e-6), "{method:?} P = {p}");
+        let b = [1.0 - hit.b1 - hit.b2, hit.b1, hit.b2];
+        for (got, want) in b.iter().zip([0.25, 0.25, 0.5]) {
+            assert!((got - want).abs() < 1e-6, "{method:?} barycentric {b:?}");
+        }
+    }
+    // Q4: L towards K = (1, 0, 0) from P.
+    let p = Vec3::new(0.0, 0.0, -1.0);
+    let l = (Vec3::X - p).normalize();
+    assert!(close(l, Vec3::new(S, 0.0, S), 1e-7));
+    // Q5: H = normalize(L + V) with the quiz's V.
+    let v = Vec3::new(-S, S, 0.0);
+    let h = halfway(l, v);
+    assert!(close(h, Vec3::new(0.0, S, S), 1e-7), "H = {h}");
+    // Q6: I = (1/√2)(N·L) + (1/√2)(N·H) = 1: kd = ks = 1/√2, shininess 1, white light.
+    let m = mat("quiz", Vec3::ZERO, Vec3::splat(S), S, 1.0, 0.0);
+    let terms = light_terms(Shading::BlinnPhong, &m, Vec3::ONE, n, l, v);
+    let i = terms.diffuse + terms.specular;
+    assert!(close(i, Vec3::ONE, 1e-6), "I = {i}");
+}
+
+/// Pixel (2, 2) of a 5×5 image looks exactly along the camera's view direction.
+#[test]
+fn lit_mirror_sphere_pixel_by_hand() {
+    let ka = Vec3::new(0.1, 0.2, 0.3);
+    let kd = Vec3::new(0.5, 0.6, 0.7);
+    let light_color = Vec3::new(1.0, 0.9, 0.8);
+    let b = Build::new(looking(Vec3::ZERO, Vec3::NEG_Z, 90.0), 5, 5)
+        .material(mat("m", ka, kd, 0.25, 8.0, 0.5))
+        .light(Vec3::new(0.0, 2.0, 0.0), light_color)
+        .sphere("ball", Vec3::new(0.0, 0.0, -3.0), 1.0, 0);
+    // P = (0, 0, −2), N = V = (0, 0, 1), L = (0, 1, 1)/√2, H = normalize(L + V).
+    let n = DVec3::Z;
+    let l = DVec3::new(0.0, 1.0, 1.0).normalize();
+    let h = (l + DVec3::Z).normalize();
+    let ambient = ka.as_dvec3() * 0.5;
+    let lc = light_color.as_dvec3();
+    let local = ambient + lc * (kd.as_dvec3() * n.dot(l) + 0.25 * n.dot(h).powf(8.0));
+    // R = (0, 0, 1) leaves the scene: kr · background.
+    let expect = local + 0.5 * b.0.render.background.as_dvec3();
+    for accel in [AccelKind::None, AccelKind::Grid, AccelKind::Bvh] {
+        let got = b.pixel(2, 2, accel);
+        assert!(close(got, expect.as_vec3(), 1e-5), "{accel:?}: {got} vs {expect}");
+    }
+    // A corner pixel misses everything: the background exactly.
+    assert_eq!(b.pixel(0, 0, AccelKind::Bvh), b.0.render.background);
+}
+
+/// Facing mirror and wall: the reflected ray from the mirror hits the wall behind the camera.
+fn mirror_and_wall(max_depth: u32) -> Build {
+    let mut b = Build::new(looking(Vec3::ZERO, Vec3::NEG_Z, 60.0), 5, 5)
+        .material(mat(
+            "mirror",
+            Vec3::splat(0.1),
+            Vec3::splat(0.2),
+            0.3,
+            16.0,
+            0.6,
+        ))
+        .material(mat(
+            "wall",
+            Vec3::new(0.2, 0.1, 0.0),
+            Vec3::new(0.3, 0.5, 0.7),
+            0.1,
+            4.0,
+            0.0,
+        ))
+        .light(Vec3::ZERO, Vec3::ONE)
+        .quad(
+            "mirror",
+            [
+                Vec3::new(-5.0, -5.0, -2.0),
+                Vec3::new(5.0, -5.0, -2.0),
+                Vec3::new(5.0, 5.0, -2.0),
+                Vec3::new(-5.0, 5.0, -2.0),
+            ],
+            0,
+        )
+        .quad(
+            "wall",
+            [
+                Vec3::new(-5.0, -5.0, 2.0),
+                Vec3::new(-5.0, 5.0, 2.0),
+                Vec3::new(5.0, 5.0, 2.0),
+                Vec3::new(5.0, -5.0, 2.0),
+            ],
+            1,
+        );
+    b.0.render.max_depth = max_depth;
+    b
+}
+
+#[test]
+fn max_depth_zero_children_return_background() {
+    // Light at the eye: at both hits N·L = N·H = 1, so local = ka·A + kd + ks.
+    let mirror_local = Vec3::splat(0.1 * 0.5 + 0.2 + 0.3);
+    let wall_local = Vec3::new(0.2, 0.1, 0.0) * 0.5 + Vec3::new(0.3, 0.5, 0.7) + Vec3::splat(0.1);
+    let d0 = mirror_and_wall(0);
+    let bg = d0.0.render.background;
+    let got0 = d0.pixel(2, 2, AccelKind::None);
+    assert!(close(got0, mirror_local + 0.6 * bg, 1e-5), "depth 0: {got0}");
+    let got1 = mirror_and_wall(1).pixel(2, 2, AccelKind::None);
+    assert!(
+        close(got1, mirror_local + 0.6 * wall_local, 1e-5),
+        "depth 1: {got1}"
+    );
+    // The wall does not reflect, so deeper limits change nothing.
+    assert_eq!(mirror_and_wall(7).pixel(2, 2, AccelKind::Grid), got1);
+}
+
+#[test]
+fn shadowed_floor_point_is_ambient_only() {
+    let floor_ka = Vec3::new(0.3, 0.2, 0.1);
+    let b = Build::new(looking(Vec3::ZERO, Vec3::new(0.0, -1.0, -2.0), 40.0), 5, 5)
+        .material(mat("floor", floor_ka, Vec3::splat(0.8), 0.5, 10.0, 0.0))
+        .material(mat("blocker", Vec3::ONE, Vec3::ONE, 0.0, 1.0, 0.0))
+        .light(Vec3::new(0.0, 4.0, -2.0), Vec3::ONE)
+        .sphere("blocker", Vec3::new(0.0, 1.0, -2.0), 0.5, 1)
+        .quad(
+            "floor",
+            [
+                Vec3::new(-10.0, -1.0, 10.0),
+                Vec3::new(10.0, -1.0, 10.0),
+                Vec3::new(10.0, -1.0, -20.0),
+                Vec3::new(-10.0, -1.0, -20.0),
+            ],
+            0,
+        );
+    for accel in [AccelKind::None, AccelKind::Grid, AccelKind::Bvh] {
+        let got = b.pixel(2, 2, accel);
+        assert!(close(got, floor_ka * 0.5, 1e-6), "{accel:?}: {got}");
+    }
+    // Without the blocker the same point is lit: N = L = (0, 1, 0).
+    let mut lit = b;
+    lit.0.spheres.clear();
+    let v = DVec3::new(0.0, 1.0, 2.0).normalize();
+    let h = (DVec3::Y + v).normalize();
+    let expect = floor_ka.as_dvec3() * 0.5 + DVec3::splat(0.8) + 0.5 * h.y.powf(10.0);
+    let got = lit.pixel(2, 2, AccelKind::Bvh);
+    assert!(close(got, expect.as_vec3(), 1e-5), "{got} vs {expect}");
+}
+
+#[test]
+fn phong_uses_mirror_direction_of_the_light() {
+    // Camera looks down at a floor point straight under the light: N = L = (0, 1, 0), so
+    // R_l = 2(N·L)N − L = N and R·V = V·y, while Blinn-Phong's N·H is larger.
+    let ka = Vec3::new(0.3, 0.2, 0.1);
+    let mut b = Build::new(looking(Vec3::ZERO, Vec3::new(0.0, -1.0, -2.0), 40.0), 5, 5)
+        .material(mat("floor", ka, Vec3::splat(0.8), 0.5, 10.0, 0.0))
+        .light(Vec3::new(0.0, 4.0, -2.0), Vec3::ONE)
+        .quad(
+            "floor",
+            [
+                Vec3::new(-10.0, -1.0, 10.0),
+                Vec3::new(10.0, -1.0, 10.0),
+                Vec3::new(10.0, -1.0, -20.0),
+                Vec3::new(-10.0, -1.0, -20.0),
+            ],
+            0,
+        );
+    b.0.render.shading = Shading::Phong;
+    let v = DVec3::new(0.0, 1.0, 2.0).normalize();
+    let expect = ka.as_dvec3() * 0.5 + DVec3::splat(0.8) + 0.5 * v.y.powf(10.0);
+    let got = b.pixel(2, 2, AccelKind::None);
+    assert!(close(got, expect.as_vec3(), 1e-5), "{got} vs {expect}");
+}
