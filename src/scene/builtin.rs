@@ -11,10 +11,7 @@ use super::load::{SceneError, load_scene_str_with};
 pub const NAMES: &[&str] = &["default", "quiz", "glass", "box"];
 
 const SCENES: &[(&str, &str)] = &[
-    (
-        "default",
-        include_str!("../../assets/scenes/default.toml"),
-    ),
+    ("default", include_str!("../../assets/scenes/default.toml")),
     ("quiz", include_str!("../../assets/scenes/quiz.toml")),
     ("glass", include_str!("../../assets/scenes/glass.toml")),
     ("box", include_str!("../../assets/scenes/box.toml")),

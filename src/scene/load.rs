@@ -33,7 +33,7 @@ pub struct SceneError(pub String);
 
 /// Returns the text of a mesh or material library, given its path as written in the scene
 /// (relative to the scene file's folder), or the reason it cannot, as a short phrase.
-pub type ResolveFn = dyn Fn(&str) -> Result<String, String>;
+pub type ResolveFn<'a> = dyn Fn(&str) -> Result<String, String> + 'a;
 
 /// Loads a `.toml` scene or a bare `.obj` mesh (chosen by the extension, in any case). Meshes
 /// and material libraries are resolved relative to the file's folder. Sets [`Scene::source`].
@@ -79,7 +79,7 @@ pub fn load_scene_str(text: &str, name: &str) -> Result<Scene, SceneError> {
 pub fn load_scene_str_with(
     text: &str,
     name: &str,
-    resolve: &ResolveFn,
+    resolve: &ResolveFn<'_>,
 ) -> Result<Scene, SceneError> {
     let src = Src { file: name, text };
     let root = DeTable::parse(text).map_err(|e| syntax_error(&src, &e))?;
@@ -228,9 +228,8 @@ const ANY: Rule = |_| None;
 const NON_NEGATIVE: Rule = |x| (x < 0.0).then_some("must be at least 0");
 const POSITIVE: Rule = |x| (x <= 0.0).then_some("must be greater than 0");
 const NON_ZERO: Rule = |x| (x == 0.0).then_some("must not be 0");
-const FOV: Rule = |x| {
-    (x <= 0.0 || x >= 180.0).then_some("must be between 0 and 180 degrees (both excluded)")
-};
+const FOV: Rule =
+    |x| (x <= 0.0 || x >= 180.0).then_some("must be between 0 and 180 degrees (both excluded)");
 
 type Value<'i> = Spanned<DeValue<'i>>;
 
@@ -512,7 +511,7 @@ impl Kind {
 
 struct SceneBuilder<'a> {
     src: &'a Src<'a>,
-    resolve: &'a ResolveFn,
+    resolve: &'a ResolveFn<'a>,
     scene: Scene,
     /// The `[[material]]` entries by name (MTL materials are not referable by name).
     user_materials: HashMap<String, MaterialId>,
@@ -526,9 +525,15 @@ impl SceneBuilder<'_> {
             let span = key.span();
             let listed: Vec<String> = SECTIONS.iter().map(|s| section_syntax(s)).collect();
             if !SECTIONS.contains(&name) {
-                let hint = suggest(name, SECTIONS.iter().copied())
-                    .map(|s| format!(" (did you mean `{}`?)", section_syntax(s)))
-                    .unwrap_or_default();
+                let home = [("render", RENDER_KEYS), ("camera", CAMERA_KEYS)]
+                    .into_iter()
+                    .find(|(_, keys)| keys.contains(&name));
+                let hint = match home {
+                    Some((section, _)) => format!(" (it belongs under [{section}])"),
+                    None => suggest(name, SECTIONS.iter().copied())
+                        .map(|s| format!(" (did you mean `{}`?)", section_syntax(s)))
+                        .unwrap_or_default(),
+                };
                 let what = match value.get_ref() {
                     DeValue::Table(_) | DeValue::Array(_) => format!("unknown section `{name}`"),
                     _ => format!("unknown top-level key `{name}`"),
@@ -662,17 +667,6 @@ impl SceneBuilder<'_> {
             }
         }
 
-        if self.scene.lights.is_empty() {
-            self.scene.warnings.push(format!(
-                "{}: the scene has no lights, so only the ambient term lights it.",
-                src.file
-            ));
-        }
-        if self.scene.objects.is_empty() {
-            self.scene
-                .warnings
-                .push(format!("{}: the scene has no objects.", src.file));
-        }
         Ok(self.scene)
     }
 
@@ -713,7 +707,12 @@ impl SceneBuilder<'_> {
         ))
     }
 
-    fn add_sphere(&mut self, s: &Section, name: String, object: ObjectId) -> Result<(), SceneError> {
+    fn add_sphere(
+        &mut self,
+        s: &Section,
+        name: String,
+        object: ObjectId,
+    ) -> Result<(), SceneError> {
         let center = s.vec3("center", Vec3::ZERO, ANY)?;
         let radius = s.f32("radius", 1.0, POSITIVE)?;
         let material = self.material(s, "material")?;
@@ -790,13 +789,8 @@ impl SceneBuilder<'_> {
                 "a number or an array [x, y, z]",
             )?,
         };
-        let cannot = |problem: String| {
-            s.error(
-                &file_span,
-                "file",
-                format!("cannot be loaded: {problem}"),
-            )
-        };
+        let cannot =
+            |problem: String| s.error(&file_span, "file", format!("cannot be loaded: {problem}"));
         let text = (self.resolve)(&file).map_err(cannot)?;
         self.scene.objects.push(Object {
             name: name.clone(),
@@ -1021,7 +1015,10 @@ mod tests {
 
     #[test]
     fn suggestions_catch_typos_only() {
-        assert_eq!(suggest("radus", SPHERE_KEYS.iter().copied()), Some("radius"));
+        assert_eq!(
+            suggest("radus", SPHERE_KEYS.iter().copied()),
+            Some("radius")
+        );
         assert_eq!(suggest("colour", LIGHT_KEYS.iter().copied()), Some("color"));
         assert_eq!(suggest("zzz", SPHERE_KEYS.iter().copied()), None);
     }

@@ -13,9 +13,7 @@ use std::path::Path;
 use glam::{Mat3, Vec3};
 
 use super::load::{ResolveFn, SceneError, check_camera, default_material};
-use super::{
-    Camera, Light, Material, MaterialId, Object, ObjectId, ObjectSource, Scene, Triangle,
-};
+use super::{Camera, Light, Material, MaterialId, Object, ObjectId, ObjectSource, Scene, Triangle};
 
 /// Where a mesh goes: `scale` first, then the rotation (degrees about X, then Y, then Z), then
 /// `translate`.
@@ -107,7 +105,7 @@ pub(crate) struct MeshRequest<'a> {
     /// The path to give the resolver for the OBJ; MTL paths are relative to its folder.
     pub key: &'a str,
     pub text: &'a str,
-    pub resolve: &'a ResolveFn,
+    pub resolve: &'a ResolveFn<'a>,
     /// A scene material for every face instead of the MTL's.
     pub material_override: Option<MaterialId>,
     pub placement: &'a MeshPlacement,
@@ -142,10 +140,7 @@ fn error_line(text: &str) -> Option<usize> {
         .collect();
     let fails = |lines: usize| {
         let prefix = &text[..ends[lines - 1]];
-        !matches!(
-            load_obj(prefix, |_| Ok(Default::default())),
-            Ok(Ok(_))
-        )
+        !matches!(load_obj(prefix, |_| Ok(Default::default())), Ok(Ok(_)))
     };
     let (mut lo, mut hi) = (1, ends.len());
     if hi == 0 || !fails(hi) {
@@ -215,7 +210,8 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
                 .map_or(Vec3::NAN, |p| Vec3::new(p[0], p[1], p[2]))
         };
         for face in mesh.indices.chunks_exact(3) {
-            let mut v = [face[0], face[1], face[2]].map(|i| linear * corner(i) + req.placement.translate);
+            let mut v =
+                [face[0], face[1], face[2]].map(|i| linear * corner(i) + req.placement.translate);
             if mirrors {
                 v.swap(1, 2);
             }
@@ -224,13 +220,16 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
                 continue;
             }
             // Materials are added on first use, so a scene lists only what it shows.
-            let id = *material.get_or_insert_with(|| match (req.material_override, mesh.material_id) {
-                (Some(id), _) => id,
-                (None, Some(i)) if i < mtl_materials.len() => *mtl_ids[i].get_or_insert_with(|| {
-                    mtl_material(scene, req, &mtl_materials[i], &mut warnings)
-                }),
-                (None, _) => default_material(scene),
-            });
+            let id =
+                *material.get_or_insert_with(|| match (req.material_override, mesh.material_id) {
+                    (Some(id), _) => id,
+                    (None, Some(i)) if i < mtl_materials.len() => {
+                        *mtl_ids[i].get_or_insert_with(|| {
+                            mtl_material(scene, req, &mtl_materials[i], &mut warnings)
+                        })
+                    }
+                    (None, _) => default_material(scene),
+                });
             scene.triangles.push(Triangle {
                 vertices: v,
                 material: id,
@@ -337,7 +336,10 @@ pub fn material_from_mtl(
     let ior = scalar(m.optical_density, "Ni", |x| x > 0.0, d.ior).unwrap_or(d.ior);
     let in_unit = |x: f32| (0.0..=1.0).contains(&x);
     let dissolve = scalar(m.dissolve, "d", in_unit, 1.0).or_else(|| {
-        let tr = m.unknown_param.get("Tr").and_then(|t| t.trim().parse::<f32>().ok());
+        let tr = m
+            .unknown_param
+            .get("Tr")
+            .and_then(|t| t.trim().parse::<f32>().ok());
         scalar(tr, "Tr", in_unit, 0.0).map(|tr| 1.0 - tr)
     });
     let glass = matches!(m.illumination_model, Some(4 | 6 | 7));
@@ -366,7 +368,7 @@ pub(crate) fn load_obj_scene(
     text: &str,
     label: &str,
     key: &str,
-    resolve: &ResolveFn,
+    resolve: &ResolveFn<'_>,
 ) -> Result<Scene, SceneError> {
     let name = file_stem(key).unwrap_or_else(|| "mesh".into());
     let placement = MeshPlacement::default();
@@ -471,6 +473,10 @@ mod tests {
         assert!(is_visible_triangle(&ok));
         assert!(!is_visible_triangle(&[Vec3::ZERO, Vec3::X, Vec3::X * 2.0]));
         assert!(!is_visible_triangle(&[Vec3::ZERO, Vec3::X, Vec3::NAN]));
-        assert!(!is_visible_triangle(&[Vec3::ZERO, Vec3::X * 3e38, Vec3::Y * 3e38]));
+        assert!(!is_visible_triangle(&[
+            Vec3::ZERO,
+            Vec3::X * 3e38,
+            Vec3::Y * 3e38
+        ]));
     }
 }

@@ -171,7 +171,10 @@ mod tests {
         for x in [1.0f32, 0.1, 1e-7, 3.4e38, -0.0, 0.70710677, 123456.79] {
             // The loader parses float text straight to f32 (no double rounding through f64).
             let text = float(x);
-            assert!(text.contains(['.', 'e']), "{text} must not read as an integer");
+            assert!(
+                text.contains(['.', 'e']),
+                "{text} must not read as an integer"
+            );
             let back: f32 = text.parse().expect("a float");
             assert_eq!(back.to_bits(), x.to_bits(), "{text}");
         }
