@@ -151,7 +151,11 @@ impl Src<'_> {
 
 /// Makes one sentence of a message: one line, ending in a full stop.
 pub(crate) fn sentence(message: &str) -> String {
-    let mut s = message.split_whitespace().collect::<Vec<_>>().join(" ");
+    let mut s: String = message
+        .trim()
+        .chars()
+        .map(|c| if c.is_control() { ' ' } else { c })
+        .collect();
     if !s.ends_with(['.', '?', '!']) {
         s.push('.');
     }
@@ -170,7 +174,7 @@ fn syntax_error(src: &Src, e: &toml::de::Error) -> SceneError {
 /// "a string", "an array of 2 items", ...: what a value is, for type errors.
 fn describe(value: &DeValue) -> String {
     match value {
-        DeValue::String(s) => format!("the string \"{}\"", s.escape_debug()),
+        DeValue::String(s) => format!("the string \"{}\"", short(s).escape_debug()),
         DeValue::Integer(_) => "an integer".into(),
         DeValue::Float(_) => "a float".into(),
         DeValue::Boolean(b) => format!("the boolean {b}"),
@@ -181,6 +185,14 @@ fn describe(value: &DeValue) -> String {
             n => format!("an array of {n} items"),
         },
         DeValue::Table(_) => "a table".into(),
+    }
+}
+
+/// At most 40 characters of user text, so that a message stays a sentence.
+pub(crate) fn short(text: &str) -> String {
+    match text.char_indices().nth(40) {
+        Some((i, _)) => format!("{}…", &text[..i]),
+        None => text.to_string(),
     }
 }
 
@@ -285,11 +297,6 @@ impl<'s, 't, 'i> Section<'s, 't, 'i> {
             .iter()
             .find(|(k, _)| k.get_ref().as_ref() == key)
             .map(|(_, v)| v)
-    }
-
-    /// The span of `key`'s value, or of the section header when the key is absent.
-    fn span_of(&self, key: &str) -> Range<usize> {
-        self.get(key).map_or(self.span.clone(), |v| v.span())
     }
 
     fn error(&self, span: &Range<usize>, key: &str, phrase: impl AsRef<str>) -> SceneError {
@@ -517,65 +524,105 @@ struct SceneBuilder<'a> {
     user_materials: HashMap<String, MaterialId>,
 }
 
+/// Every top-level key must be a known section of the right shape (`[render]` a table,
+/// `[[sphere]]` an array of tables).
+fn check_sections(src: &Src, root: &DeTable) -> Result<(), SceneError> {
+    for (key, value) in root.iter() {
+        let name = key.get_ref().as_ref();
+        if !SECTIONS.contains(&name) {
+            let home = [("render", RENDER_KEYS), ("camera", CAMERA_KEYS)]
+                .into_iter()
+                .find(|(_, keys)| keys.contains(&name));
+            let hint = match home {
+                Some((section, _)) => format!(" (it belongs under [{section}])"),
+                None => suggest(name, SECTIONS.iter().copied())
+                    .map(|s| format!(" (did you mean `{}`?)", section_syntax(s)))
+                    .unwrap_or_default(),
+            };
+            let what = match value.get_ref() {
+                DeValue::Table(_) | DeValue::Array(_) => "unknown section",
+                _ => "unknown top-level key",
+            };
+            let listed: Vec<String> = SECTIONS.iter().map(|s| section_syntax(s)).collect();
+            return Err(src.error(
+                &key.span(),
+                format!(
+                    "{what} `{}`{hint}; the sections are {}",
+                    short(name),
+                    list_and(&listed)
+                ),
+            ));
+        }
+        let wants_table = matches!(name, "render" | "camera");
+        let shape_ok = match value.get_ref() {
+            DeValue::Table(_) => wants_table,
+            DeValue::Array(_) => !wants_table,
+            _ => false,
+        };
+        if !shape_ok {
+            let shape = if wants_table {
+                "a table"
+            } else {
+                "an array of tables"
+            };
+            return Err(src.error(
+                &value.span(),
+                format!(
+                    "`{name}` must be written as {} ({shape}), got {}",
+                    section_syntax(name),
+                    describe(value.get_ref())
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The names of `sections` (their `name` keys, unique), with `default(i)` for the others,
+/// stepping around the names given explicitly.
+fn unique_names(
+    sections: &[&Section],
+    kind: &str,
+    default: impl Fn(usize) -> Result<String, SceneError>,
+) -> Result<Vec<String>, SceneError> {
+    let mut names = Names::default();
+    let mut given = Vec::with_capacity(sections.len());
+    for s in sections {
+        let name = s.string("name")?;
+        if let Some((name, span)) = &name {
+            names.claim(s, name, span, kind)?;
+        }
+        given.push(name.map(|(name, _)| name));
+    }
+    given
+        .into_iter()
+        .enumerate()
+        .map(|(i, name)| match name {
+            Some(name) => Ok(name),
+            None => Ok(names.fresh(&default(i)?)),
+        })
+        .collect()
+}
+
 impl SceneBuilder<'_> {
     fn build(mut self, root: &DeTable) -> Result<Scene, SceneError> {
         let src = self.src;
-        for (key, value) in root.iter() {
-            let name = key.get_ref().as_ref();
-            let span = key.span();
-            let listed: Vec<String> = SECTIONS.iter().map(|s| section_syntax(s)).collect();
-            if !SECTIONS.contains(&name) {
-                let home = [("render", RENDER_KEYS), ("camera", CAMERA_KEYS)]
-                    .into_iter()
-                    .find(|(_, keys)| keys.contains(&name));
-                let hint = match home {
-                    Some((section, _)) => format!(" (it belongs under [{section}])"),
-                    None => suggest(name, SECTIONS.iter().copied())
-                        .map(|s| format!(" (did you mean `{}`?)", section_syntax(s)))
-                        .unwrap_or_default(),
-                };
-                let what = match value.get_ref() {
-                    DeValue::Table(_) | DeValue::Array(_) => format!("unknown section `{name}`"),
-                    _ => format!("unknown top-level key `{name}`"),
-                };
-                return Err(src.error(
-                    &span,
-                    format!("{what}{hint}; the sections are {}", list_and(&listed)),
-                ));
-            }
-            let wants_table = matches!(name, "render" | "camera");
-            let shape_ok = match value.get_ref() {
-                DeValue::Table(_) => wants_table,
-                DeValue::Array(_) => !wants_table,
-                _ => false,
-            };
-            if !shape_ok {
-                let shape = if wants_table {
-                    "a table"
-                } else {
-                    "an array of tables"
-                };
-                return Err(src.error(
-                    &value.span(),
-                    format!(
-                        "`{name}` must be written as {} ({shape}), got {}",
-                        section_syntax(name),
-                        describe(value.get_ref())
-                    ),
-                ));
-            }
-        }
-
+        check_sections(src, root)?;
         let get = |name: &str| {
             root.iter()
                 .find(|(k, _)| k.get_ref().as_ref() == name)
                 .map(|(_, v)| v)
         };
-        let elements = |name: &str| -> Vec<&Value> {
-            match get(name).map(|v| v.get_ref()) {
-                Some(DeValue::Array(items)) => items.iter().collect(),
-                _ => Vec::new(),
-            }
+        let sections = |name: &str, keys: &[&str]| -> Result<Vec<Section>, SceneError> {
+            let Some(DeValue::Array(items)) = get(name).map(|v| v.get_ref()) else {
+                return Ok(Vec::new());
+            };
+            let what = |i: usize| format!("{name} {}", i + 1);
+            items
+                .iter()
+                .enumerate()
+                .map(|(i, v)| Section::new(src, what(i), v, keys))
+                .collect()
         };
 
         if let Some(v) = get("render") {
@@ -587,78 +634,45 @@ impl SceneBuilder<'_> {
             self.scene.camera = parse_camera(&section)?;
         }
 
-        let mut light_names = Names::default();
-        let light_sections = elements("light")
-            .into_iter()
-            .enumerate()
-            .map(|(i, v)| Section::new(src, format!("light {}", i + 1), v, LIGHT_KEYS))
-            .collect::<Result<Vec<_>, _>>()?;
-        for s in &light_sections {
-            if let Some((name, span)) = s.string("name")? {
-                light_names.claim(&name, &s.what, &span, "name", s, "light")?;
-            }
-        }
-        for (i, s) in light_sections.iter().enumerate() {
-            let name = match s.string("name")? {
-                Some((name, _)) => name,
-                None => light_names.fresh(&format!("light {}", i + 1)),
-            };
+        let lights = sections("light", LIGHT_KEYS)?;
+        let refs: Vec<&Section> = lights.iter().collect();
+        let names = unique_names(&refs, "light", |i| Ok(format!("light {}", i + 1)))?;
+        for (s, name) in lights.iter().zip(names) {
             self.scene.lights.push(Light {
                 name,
+                // Without a position, a headlight: a light at the eye.
                 position: s.vec3("position", self.scene.camera.position, ANY)?,
                 color: s.color("color", Vec3::ONE, NON_NEGATIVE)?,
                 radius: s.f32("radius", 0.0, NON_NEGATIVE)?,
             });
         }
 
-        let mut first_with_name: HashMap<String, String> = HashMap::new();
-        for (i, v) in elements("material").into_iter().enumerate() {
-            let s = Section::new(src, format!("material {}", i + 1), v, MATERIAL_KEYS)?;
-            let material = parse_material(&s, i)?;
-            if let Some(first) = first_with_name.get(&material.name) {
-                return Err(s.error(
-                    &s.span_of("name"),
-                    "name",
-                    format!(
-                        "repeats \"{}\", the name of {first}; material names must be unique",
-                        material.name
-                    ),
-                ));
-            }
-            first_with_name.insert(material.name.clone(), s.what.clone());
+        let materials = sections("material", MATERIAL_KEYS)?;
+        let refs: Vec<&Section> = materials.iter().collect();
+        let names = unique_names(&refs, "material", |i| Ok(format!("material {}", i + 1)))?;
+        for (s, name) in materials.iter().zip(names) {
             let id = MaterialId(self.scene.materials.len() as u32);
-            self.user_materials.insert(material.name.clone(), id);
-            self.scene.materials.push(material);
+            self.user_materials.insert(name.clone(), id);
+            self.scene.materials.push(parse_material(s, name)?);
         }
 
         // Objects keep the order of the file, whatever their kind, so ids and names follow
         // what the author wrote.
-        let mut items: Vec<(Kind, Section)> = Vec::new();
-        for kind in [Kind::Sphere, Kind::Triangle, Kind::Mesh] {
-            let keys = match kind {
-                Kind::Sphere => SPHERE_KEYS,
-                Kind::Triangle => TRIANGLE_KEYS,
-                Kind::Mesh => MESH_KEYS,
-            };
-            for (i, v) in elements(kind.label()).into_iter().enumerate() {
-                let what = format!("{} {}", kind.label(), i + 1);
-                items.push((kind, Section::new(src, what, v, keys)?));
-            }
+        let mut objects: Vec<(Kind, Section)> = Vec::new();
+        for (kind, keys) in [
+            (Kind::Sphere, SPHERE_KEYS),
+            (Kind::Triangle, TRIANGLE_KEYS),
+            (Kind::Mesh, MESH_KEYS),
+        ] {
+            objects.extend(sections(kind.label(), keys)?.into_iter().map(|s| (kind, s)));
         }
-        items.sort_by_key(|(_, s)| s.span.start);
-
-        // Explicit names first, so that default names can step around them.
-        let mut object_names = Names::default();
-        for (_, s) in &items {
-            if let Some((name, span)) = s.string("name")? {
-                object_names.claim(&name, &s.what, &span, "name", s, "object")?;
-            }
-        }
-        for (kind, s) in &items {
-            let name = match s.string("name")? {
-                Some((name, _)) => name,
-                None => object_names.fresh(&default_object_name(*kind, s)?),
-            };
+        objects.sort_by_key(|(_, s)| s.span.start);
+        let refs: Vec<&Section> = objects.iter().map(|(_, s)| s).collect();
+        let names = unique_names(&refs, "object", |i| {
+            let (kind, s) = &objects[i];
+            default_object_name(*kind, s)
+        })?;
+        for ((kind, s), name) in objects.iter().zip(names) {
             let object = ObjectId(self.scene.objects.len() as u32);
             match kind {
                 Kind::Sphere => self.add_sphere(s, name, object)?,
@@ -666,7 +680,6 @@ impl SceneBuilder<'_> {
                 Kind::Mesh => self.add_mesh(s, name, object)?,
             }
         }
-
         Ok(self.scene)
     }
 
@@ -703,7 +716,10 @@ impl SceneBuilder<'_> {
         Err(s.error(
             &span,
             key,
-            format!("names an unknown material \"{name}\"{hint}; {listing}"),
+            format!(
+                "names an unknown material \"{}\"{hint}; {listing}",
+                short(&name).escape_debug()
+            ),
         ))
     }
 
@@ -853,24 +869,25 @@ struct Names {
 }
 
 impl Names {
-    /// An explicit name: an error if an earlier one is the same.
+    /// An explicit name (`name` of section `s`): an error if an earlier one is the same.
     fn claim(
         &mut self,
-        name: &str,
-        what: &str,
-        span: &Range<usize>,
-        key: &str,
         s: &Section,
+        name: &str,
+        span: &Range<usize>,
         kind: &str,
     ) -> Result<(), SceneError> {
         if let Some(first) = self.taken.get(name) {
             return Err(s.error(
                 span,
-                key,
-                format!("repeats \"{name}\", the name of {first}; {kind} names must be unique"),
+                "name",
+                format!(
+                    "repeats \"{}\", the name of {first}; {kind} names must be unique",
+                    short(name).escape_debug()
+                ),
             ));
         }
-        self.taken.insert(name.to_string(), what.to_string());
+        self.taken.insert(name.to_string(), s.what.clone());
         Ok(())
     }
 
@@ -980,12 +997,8 @@ pub(crate) fn check_camera(camera: &Camera) -> Result<(), CameraProblem> {
     Ok(())
 }
 
-fn parse_material(s: &Section, index: usize) -> Result<Material, SceneError> {
+fn parse_material(s: &Section, name: String) -> Result<Material, SceneError> {
     let d = Material::default();
-    let name = match s.string("name")? {
-        Some((name, _)) => name,
-        None => format!("material {}", index + 1),
-    };
     Ok(Material {
         name,
         ambient: s.color("ambient", d.ambient, NON_NEGATIVE)?,
@@ -1025,7 +1038,7 @@ mod tests {
 
     #[test]
     fn sentences_are_one_line_with_a_full_stop() {
-        assert_eq!(sentence("a\n  b"), "a b.");
+        assert_eq!(sentence("a\nb "), "a b.");
         assert_eq!(sentence("done."), "done.");
     }
 }
