@@ -15,13 +15,17 @@ struct Pcg(u64);
 
 impl Pcg {
     fn new(seed: u64) -> Self {
-        let mut p = Pcg(seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407));
+        let mut p = Pcg(seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407));
         p.next_u32();
         p
     }
     fn next_u32(&mut self) -> u32 {
         let old = self.0;
-        self.0 = old.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        self.0 = old
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
         let rot = (old >> 59) as u32;
         xorshifted.rotate_right(rot)
@@ -35,7 +39,11 @@ impl Pcg {
     }
     fn unit(&mut self) -> Vec3 {
         loop {
-            let v = Vec3::new(self.range(-1.0, 1.0), self.range(-1.0, 1.0), self.range(-1.0, 1.0));
+            let v = Vec3::new(
+                self.range(-1.0, 1.0),
+                self.range(-1.0, 1.0),
+                self.range(-1.0, 1.0),
+            );
             let l = v.length_squared();
             if l > 1e-4 && l <= 1.0 {
                 return v / l.sqrt();
@@ -83,18 +91,30 @@ fn quiz_triangle_all_methods() {
         assert!((hit.t - 1.0).abs() < 1e-6, "{m:?}: t = {}", hit.t);
         let b0 = 1.0 - hit.b1 - hit.b2;
         for (got, want) in [(b0, 0.25), (hit.b1, 0.25), (hit.b2, 0.5)] {
-            assert!((got - want).abs() < 1e-6, "{m:?}: barycentric {got} != {want}");
+            assert!(
+                (got - want).abs() < 1e-6,
+                "{m:?}: barycentric {got} != {want}"
+            );
         }
         let (p, err) = triangle_hit_point(&v, hit.b1, hit.b2);
-        assert!((p - Vec3::new(0.0, 0.0, -1.0)).abs().max_element() < 1e-6, "{m:?}: P = {p}");
+        assert!(
+            (p - Vec3::new(0.0, 0.0, -1.0)).abs().max_element() < 1e-6,
+            "{m:?}: P = {p}"
+        );
         assert!(err.max_element() < 1e-5);
         // Both faces: the same triangle seen from behind.
         let back = Ray::new(Vec3::new(0.0, 0.0, -2.0), Vec3::new(0.0, 0.0, 1.0));
         let hit = intersect_triangle(m, &v, &back, 0.0, f32::INFINITY).expect("back face");
         assert!((hit.t - 1.0).abs() < 1e-6);
         // The range is exclusive at both ends.
-        assert!(intersect_triangle(m, &v, &ray, 0.0, 1.0).is_none(), "{m:?}: t_max exclusive");
-        assert!(intersect_triangle(m, &v, &ray, 1.0, 2.0).is_none(), "{m:?}: t_min exclusive");
+        assert!(
+            intersect_triangle(m, &v, &ray, 0.0, 1.0).is_none(),
+            "{m:?}: t_max exclusive"
+        );
+        assert!(
+            intersect_triangle(m, &v, &ray, 1.0, 2.0).is_none(),
+            "{m:?}: t_min exclusive"
+        );
         // Parallel and degenerate: no hit, no panic.
         let parallel = Ray::new(Vec3::new(0.0, 0.0, -1.0), Vec3::X);
         let _ = intersect_triangle(m, &v, &parallel, 0.0, f32::INFINITY);
@@ -113,7 +133,11 @@ fn sphere_hits_outside_and_inside_match_f64() {
     let mut rng = Pcg::new(1);
     for method in [SphereMethod::Lecture, SphereMethod::Robust] {
         for _ in 0..2000 {
-            let center = Vec3::new(rng.range(-3.0, 3.0), rng.range(-3.0, 3.0), rng.range(-3.0, 3.0));
+            let center = Vec3::new(
+                rng.range(-3.0, 3.0),
+                rng.range(-3.0, 3.0),
+                rng.range(-3.0, 3.0),
+            );
             let r = rng.range(0.5, 2.0);
             // Outside, aimed within 0.9 r of the centre: the near root.
             let origin = center + rng.unit() * rng.range(1.5, 5.0) * r;
@@ -121,15 +145,22 @@ fn sphere_hits_outside_and_inside_match_f64() {
             let ray = Ray::new(origin, (target - origin).normalize());
             let (t0, _) = sphere_roots_f64(center, r, &ray).expect("oracle hit");
             let t = intersect_sphere(method, center, r, &ray, 0.0, f32::INFINITY).expect("hit");
-            assert!(((t as f64 - t0) / t0).abs() < 1e-5, "{method:?}: {t} vs {t0}");
+            assert!(
+                ((t as f64 - t0) / t0).abs() < 1e-5,
+                "{method:?}: {t} vs {t0}"
+            );
 
             // Inside (after refraction): the far root, never t <= 0.
             let origin = center + rng.unit() * rng.range(0.0, 0.9) * r;
             let ray = Ray::new(origin, rng.unit());
             let (n0, t1) = sphere_roots_f64(center, r, &ray).expect("oracle hit");
             assert!(n0 < 0.0 && t1 > 0.0);
-            let t = intersect_sphere(method, center, r, &ray, 0.0, f32::INFINITY).expect("far root");
-            assert!(t > 0.0 && ((t as f64 - t1) / t1).abs() < 1e-5, "{method:?}: {t} vs {t1}");
+            let t =
+                intersect_sphere(method, center, r, &ray, 0.0, f32::INFINITY).expect("far root");
+            assert!(
+                t > 0.0 && ((t as f64 - t1) / t1).abs() < 1e-5,
+                "{method:?}: {t} vs {t1}"
+            );
         }
     }
     // A sphere behind the ray and one beyond t_max are missed.
@@ -137,16 +168,27 @@ fn sphere_hits_outside_and_inside_match_f64() {
     for method in [SphereMethod::Lecture, SphereMethod::Robust] {
         assert!(intersect_sphere(method, -5.0 * Vec3::X, 1.0, &ray, 0.0, f32::INFINITY).is_none());
         assert!(intersect_sphere(method, 5.0 * Vec3::X, 1.0, &ray, 0.0, 3.9).is_none());
-        assert_eq!(intersect_sphere(method, 5.0 * Vec3::X, 1.0, &ray, 0.0, 4.1), Some(4.0));
+        assert_eq!(
+            intersect_sphere(method, 5.0 * Vec3::X, 1.0, &ray, 0.0, 4.1),
+            Some(4.0)
+        );
         // Near root at or below t_min: the far one.
-        assert_eq!(intersect_sphere(method, 5.0 * Vec3::X, 1.0, &ray, 4.0, 10.0), Some(6.0));
+        assert_eq!(
+            intersect_sphere(method, 5.0 * Vec3::X, 1.0, &ray, 4.0, 10.0),
+            Some(6.0)
+        );
     }
 }
 
 /// Rays from distance `D = d_over_r · r`: half passing within 0.95 r of the centre (hits),
 /// half at 1.05…1.5 r (misses). Returns (misses, false hits, max rel t error in EPSILONs,
 /// max |‖P − C‖ − r| in ulp(r) of the re-projected point) against the f64 oracle.
-fn sphere_sweep(method: SphereMethod, d_over_r: f32, n: usize, seed: u64) -> (usize, usize, f64, f64) {
+fn sphere_sweep(
+    method: SphereMethod,
+    d_over_r: f32,
+    n: usize,
+    seed: u64,
+) -> (usize, usize, f64, f64) {
     let mut rng = Pcg::new(seed);
     let (mut misses, mut false_hits) = (0, 0);
     let (mut max_t_err, mut max_p_err) = (0f64, 0f64);
@@ -187,8 +229,14 @@ fn s1_s2_robust_sphere_holds_far_away_and_lecture_fails() {
     for d_over_r in [3.0, 1e2, 1e3, 1e4, 1e5] {
         let (miss, false_hit, t_err, p_err) = sphere_sweep(SphereMethod::Robust, d_over_r, N, 7);
         assert_eq!((miss, false_hit), (0, 0), "robust at D/r = {d_over_r}");
-        assert!(t_err <= 4.0, "robust rel t error {t_err} EPSILON at D/r = {d_over_r}");
-        assert!(p_err <= 2.0, "re-projected point {p_err} ulp off at D/r = {d_over_r}");
+        assert!(
+            t_err <= 4.0,
+            "robust rel t error {t_err} EPSILON at D/r = {d_over_r}"
+        );
+        assert!(
+            p_err <= 2.0,
+            "re-projected point {p_err} ulp off at D/r = {d_over_r}"
+        );
     }
     // Lecture: fine nearby, broken from D/r = 1e4 on (STABILITY S1: >97% false hits there).
     let (miss, false_hit, _, _) = sphere_sweep(SphereMethod::Lecture, 3.0, N, 7);
@@ -196,7 +244,10 @@ fn s1_s2_robust_sphere_holds_far_away_and_lecture_fails() {
     for d_over_r in [1e4, 1e5] {
         let (miss, false_hit, _, _) = sphere_sweep(SphereMethod::Lecture, d_over_r, N, 7);
         let wrong = miss + false_hit;
-        assert!(wrong > N / 10, "lecture expected to fail at D/r = {d_over_r}, wrong = {wrong}");
+        assert!(
+            wrong > N / 10,
+            "lecture expected to fail at D/r = {d_over_r}, wrong = {wrong}"
+        );
     }
 }
 
@@ -211,12 +262,20 @@ fn s4_grazing_and_inside_origins() {
             let r = rng.range(0.5, 2.0);
             let n = rng.unit();
             let origin = center + n * (r * (1.0 - 10f32.powi(-k)));
-            let ray = Ray::new(origin, (-n + rng.range(0.0, 3.0) * perpendicular(&mut rng, n)).normalize());
-            let Some((n0, far)) = sphere_roots_f64(center, r, &ray) else { continue };
+            let ray = Ray::new(
+                origin,
+                (-n + rng.range(0.0, 3.0) * perpendicular(&mut rng, n)).normalize(),
+            );
+            let Some((n0, far)) = sphere_roots_f64(center, r, &ray) else {
+                continue;
+            };
             if n0 >= 0.0 {
                 continue; // rounded to the outside
             }
-            for (i, m) in [SphereMethod::Lecture, SphereMethod::Robust].into_iter().enumerate() {
+            for (i, m) in [SphereMethod::Lecture, SphereMethod::Robust]
+                .into_iter()
+                .enumerate()
+            {
                 let t = intersect_sphere(m, center, r, &ray, 0.0, f32::INFINITY);
                 let ok = t.is_some_and(|t| (t as f64 - far).abs() <= 1e-4 * far.max(r as f64));
                 wrong[i] += usize::from(!ok);
@@ -317,7 +376,13 @@ impl std::ops::Deref for AimedRay {
     }
 }
 
-fn mesh_edge_rays(rng: &mut Pcg, verts: &[Vec3], tris: &[[usize; 3]], scale: f32, center: Vec3) -> Vec<AimedRay> {
+fn mesh_edge_rays(
+    rng: &mut Pcg,
+    verts: &[Vec3],
+    tris: &[[usize; 3]],
+    scale: f32,
+    center: Vec3,
+) -> Vec<AimedRay> {
     let mut targets: Vec<Vec3> = verts.to_vec();
     let mut edges = std::collections::BTreeSet::new();
     for t in tris {
@@ -373,7 +438,10 @@ fn t1_watertight_never_leaks_through_shared_edges() {
                     })
                     .count();
                 if m == TriangleMethod::Watertight {
-                    assert_eq!(leaks, 0, "watertight leaks at scale {scale}, offset {offset}");
+                    assert_eq!(
+                        leaks, 0,
+                        "watertight leaks at scale {scale}, offset {offset}"
+                    );
                 } else {
                     naive_leaks[k] += leaks;
                 }
@@ -396,12 +464,12 @@ fn t3_tiny_triangles_mt_misses_watertight_hits() {
         let (mut mt_miss, mut wt_miss) = (0, 0);
         let n = 500;
         for _ in 0..n {
-            let base = Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
-            let v = [
-                base,
-                base + rng.unit() * edge,
-                base + rng.unit() * edge,
-            ];
+            let base = Vec3::new(
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+            );
+            let v = [base, base + rng.unit() * edge, base + rng.unit() * edge];
             let normal = (v[1] - v[0]).cross(v[2] - v[0]);
             if normal.length() < 0.2 * edge * edge {
                 continue; // too thin to aim at reliably
@@ -421,7 +489,10 @@ fn t3_tiny_triangles_mt_misses_watertight_hits() {
             mt_miss += usize::from(!hit(TriangleMethod::MollerTrumbore));
             wt_miss += usize::from(!hit(TriangleMethod::Watertight));
         }
-        assert_eq!(wt_miss, 0, "watertight misses tiny triangles at edge {edge}");
+        assert_eq!(
+            wt_miss, 0,
+            "watertight misses tiny triangles at edge {edge}"
+        );
         // |det| ~ edge² (for a unit direction) drops below MT_DET_EPSILON = 1e-8 at edge ~1e-4.
         if edge * edge < 0.1 * MT_DET_EPSILON {
             assert!(mt_miss > n / 2, "MT should miss at edge {edge}: {mt_miss}");
@@ -442,7 +513,10 @@ fn next_float_helpers() {
     assert!(next_float_up(0.0) > 0.0 && next_float_up(-0.0) > 0.0);
     assert!(next_float_down(0.0) < 0.0 && next_float_down(-0.0) < 0.0);
     assert_eq!(next_float_up(next_float_down(0.0)), -0.0);
-    assert_eq!(next_float_up(-f32::MIN_POSITIVE), -f32::MIN_POSITIVE + f32::from_bits(1));
+    assert_eq!(
+        next_float_up(-f32::MIN_POSITIVE),
+        -f32::MIN_POSITIVE + f32::from_bits(1)
+    );
     assert_eq!(next_float_up(f32::MAX), f32::INFINITY);
     assert_eq!(next_float_up(f32::INFINITY), f32::INFINITY);
     assert_eq!(next_float_down(f32::NEG_INFINITY), f32::NEG_INFINITY);
@@ -477,7 +551,12 @@ fn sphere_self_hits(method: OffsetMethod, s: f32, n: usize, rng: &mut Pcg) -> (f
         };
         let (p, err) = sphere_hit_point(sm, center, r, &ray, t);
         let nrm = (p - center).normalize();
-        let smp = Sample { p, err, n: nrm, incoming: ray.dir };
+        let smp = Sample {
+            p,
+            err,
+            n: nrm,
+            incoming: ray.dir,
+        };
         let hits = |dir: Vec3| {
             let o = offset_ray_origin(method, smp.p, smp.err, smp.n, dir);
             intersect_sphere(sm, center, r, &Ray::new(o, dir), 0.0, f32::INFINITY)
@@ -508,7 +587,11 @@ fn triangle_self_hits(method: OffsetMethod, s: f32, n: usize, rng: &mut Pcg) -> 
     for _ in 0..n {
         let side = if rng.f32() < 0.5 { geo_n } else { -geo_n };
         let (b1, b2) = (rng.f32(), rng.f32());
-        let (b1, b2) = if b1 + b2 > 1.0 { (1.0 - b1, 1.0 - b2) } else { (b1, b2) };
+        let (b1, b2) = if b1 + b2 > 1.0 {
+            (1.0 - b1, 1.0 - b2)
+        } else {
+            (b1, b2)
+        };
         let target = v[0] + b1 * (v[1] - v[0]) + b2 * (v[2] - v[0]);
         let origin = target + (side + 0.5 * rng.unit()).normalize() * (2.0 * s);
         let ray = Ray::new(origin, (target - origin).normalize());
@@ -517,7 +600,11 @@ fn triangle_self_hits(method: OffsetMethod, s: f32, n: usize, rng: &mut Pcg) -> 
         };
         count += 1;
         let (p, err) = triangle_hit_point(&v, hit.b1, hit.b2);
-        let facing = if ray.dir.dot(geo_n) < 0.0 { geo_n } else { -geo_n };
+        let facing = if ray.dir.dot(geo_n) < 0.0 {
+            geo_n
+        } else {
+            -geo_n
+        };
         let hits = |dir: Vec3| {
             let o = offset_ray_origin(method, p, err, geo_n, dir);
             intersect_triangle(tm, &v, &Ray::new(o, dir), 0.0, f32::INFINITY).is_some()
@@ -539,14 +626,26 @@ fn a1_a3_error_bound_offset_never_self_intersects() {
     for k in -3..=5 {
         let s = 10f32.powi(k);
         let (acne, refl, trans) = sphere_self_hits(OffsetMethod::ErrorBound, s, 3000, &mut rng);
-        assert_eq!((acne, refl, trans), (0.0, 0.0, 0.0), "sphere, ErrorBound, scale {s}");
+        assert_eq!(
+            (acne, refl, trans),
+            (0.0, 0.0, 0.0),
+            "sphere, ErrorBound, scale {s}"
+        );
         let (acne, other) = triangle_self_hits(OffsetMethod::ErrorBound, s, 3000, &mut rng);
         assert_eq!((acne, other), (0.0, 0.0), "triangle, ErrorBound, scale {s}");
         // The relative offset holds too, at every scale (its failure is leaking, below).
         let (acne, refl, trans) = sphere_self_hits(OffsetMethod::NormalScaled, s, 1000, &mut rng);
-        assert_eq!((acne, refl, trans), (0.0, 0.0, 0.0), "sphere, NormalScaled, scale {s}");
+        assert_eq!(
+            (acne, refl, trans),
+            (0.0, 0.0, 0.0),
+            "sphere, NormalScaled, scale {s}"
+        );
         let (acne, other) = triangle_self_hits(OffsetMethod::NormalScaled, s, 1000, &mut rng);
-        assert_eq!((acne, other), (0.0, 0.0), "triangle, NormalScaled, scale {s}");
+        assert_eq!(
+            (acne, other),
+            (0.0, 0.0),
+            "triangle, NormalScaled, scale {s}"
+        );
     }
     // The fixed 1e-4 is fine at scale 1 and shows acne from 1e3 on (STABILITY A1: 20% @1e3).
     let (acne, _, _) = sphere_self_hits(OffsetMethod::Fixed, 1.0, 2000, &mut rng);
@@ -554,7 +653,10 @@ fn a1_a3_error_bound_offset_never_self_intersects() {
     for s in [1e4f32, 1e5] {
         let (acne, _, _) = sphere_self_hits(OffsetMethod::Fixed, s, 2000, &mut rng);
         let (tri_acne, _) = triangle_self_hits(OffsetMethod::Fixed, s, 2000, &mut rng);
-        assert!(acne > 0.1 && tri_acne > 0.1, "fixed offset at scale {s}: acne {acne}, {tri_acne}");
+        assert!(
+            acne > 0.1 && tri_acne > 0.1,
+            "fixed offset at scale {s}: acne {acne}, {tri_acne}"
+        );
     }
 }
 
@@ -567,8 +669,17 @@ fn contact_leaks(method: OffsetMethod, s: f32, gap: f32, rng: &mut Pcg) -> bool 
         c + Vec3::new(s, 0.0, -s),
         c + Vec3::new(0.0, 0.0, s),
     ];
-    let ray = Ray::new(c + Vec3::new(0.1 * s, 2.0 * s, 0.05 * s), Vec3::new(-0.05, -1.0, -0.02).normalize());
-    let Some(hit) = intersect_triangle(TriangleMethod::Watertight, &ground, &ray, 0.0, f32::INFINITY) else {
+    let ray = Ray::new(
+        c + Vec3::new(0.1 * s, 2.0 * s, 0.05 * s),
+        Vec3::new(-0.05, -1.0, -0.02).normalize(),
+    );
+    let Some(hit) = intersect_triangle(
+        TriangleMethod::Watertight,
+        &ground,
+        &ray,
+        0.0,
+        f32::INFINITY,
+    ) else {
         return false;
     };
     let (p, err) = triangle_hit_point(&ground, hit.b1, hit.b2);
@@ -579,7 +690,14 @@ fn contact_leaks(method: OffsetMethod, s: f32, gap: f32, rng: &mut Pcg) -> bool 
         Vec3::new(p.x, h, p.z + 0.01 * s),
     ];
     let o = offset_ray_origin(method, p, err, Vec3::Y, Vec3::Y);
-    intersect_triangle(TriangleMethod::Watertight, &occluder, &Ray::new(o, Vec3::Y), 0.0, 10.0 * s).is_none()
+    intersect_triangle(
+        TriangleMethod::Watertight,
+        &occluder,
+        &Ray::new(o, Vec3::Y),
+        0.0,
+        10.0 * s,
+    )
+    .is_none()
 }
 
 #[test]
@@ -589,28 +707,52 @@ fn a1_contact_shadows_leak_only_with_large_offsets() {
         let s = 10f32.powi(k);
         let gap = 1e-3 * s;
         for _ in 0..50 {
-            assert!(!contact_leaks(OffsetMethod::ErrorBound, s, gap, &mut rng), "ErrorBound leaks at {s}");
+            assert!(
+                !contact_leaks(OffsetMethod::ErrorBound, s, gap, &mut rng),
+                "ErrorBound leaks at {s}"
+            );
         }
     }
     // Fixed 1e-4 jumps over a gap of 1e-6 at scale 1e-3 (STABILITY A1: 100% leak ≤ 1e-2).
     assert!(contact_leaks(OffsetMethod::Fixed, 1e-3, 1e-6, &mut rng));
-    assert!(contact_leaks(OffsetMethod::NormalScaled, 1e-3, 1e-6, &mut rng));
+    assert!(contact_leaks(
+        OffsetMethod::NormalScaled,
+        1e-3,
+        1e-6,
+        &mut rng
+    ));
 }
 
 #[test]
 fn offset_goes_to_the_side_of_the_outgoing_direction() {
     let p = Vec3::new(1.0, 2.0, 3.0);
     let err = Vec3::splat(1e-6);
-    for m in [OffsetMethod::Fixed, OffsetMethod::NormalScaled, OffsetMethod::ErrorBound] {
+    for m in [
+        OffsetMethod::Fixed,
+        OffsetMethod::NormalScaled,
+        OffsetMethod::ErrorBound,
+    ] {
         let up = offset_ray_origin(m, p, err, Vec3::Y, Vec3::new(0.3, 1.0, 0.0));
         let down = offset_ray_origin(m, p, err, Vec3::Y, Vec3::new(0.3, -1.0, 0.0));
         assert!(up.y > p.y && down.y < p.y, "{m:?}");
         assert_eq!((up.x, up.z), (p.x, p.z), "{m:?}: moves along n only");
     }
     // Fixed is exactly 1e-4 (rounded), NormalScaled grows with |p|.
-    let o = offset_ray_origin(OffsetMethod::Fixed, Vec3::ZERO, Vec3::ZERO, Vec3::Z, Vec3::Z);
+    let o = offset_ray_origin(
+        OffsetMethod::Fixed,
+        Vec3::ZERO,
+        Vec3::ZERO,
+        Vec3::Z,
+        Vec3::Z,
+    );
     assert_eq!(o, Vec3::new(0.0, 0.0, 1e-4));
     let far = Vec3::new(1e4, 0.0, 0.0);
-    let o = offset_ray_origin(OffsetMethod::NormalScaled, far, Vec3::ZERO, Vec3::Y, Vec3::Y);
+    let o = offset_ray_origin(
+        OffsetMethod::NormalScaled,
+        far,
+        Vec3::ZERO,
+        Vec3::Y,
+        Vec3::Y,
+    );
     assert!((o.y - 0.1).abs() < 1e-6);
 }

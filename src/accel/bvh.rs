@@ -36,10 +36,12 @@
 //!
 //! Our node test: child boxes are decoded to world space and padded by a few ulp of the node's
 //! magnitude ([`NODE_PAD_REL`], covering the 8-bit quantisation's rounding), slab `t` values
-//! use `1/d` with zeros mapped to `±f32::MAX` (no NaN), the far `t` is widened by `2γ(3)`
-//! (pbrt-v4), and the interval is clipped to the caller's `(t_min, best t]`, inclusive so equal
-//! `t` with a lower id is still found.
-use glam::{UVec2, Vec3A, uvec2, vec3a};
+//! use `1/d` clamped to `±2⁶⁰` (no NaN), both ends of the interval are widened by `2γ(3)` of
+//! their magnitude (pbrt-v4 widens the far end; the near end too so that a primitive whose
+//! computed `t` is an ulp before its box's computed entry is not culled), and the interval is
+//! clipped to the caller's `(t_min, best t]`, inclusive so equal `t` with a lower id is still
+//! found.
+use glam::{UVec2, Vec3, Vec3A, Vec4, uvec2, vec3a};
 use obvhs::{
     BvhBuildParams,
     aabb::Aabb,
@@ -50,7 +52,7 @@ use obvhs::{
     ploc::PlocBuilder,
 };
 
-use super::{Prim, Visitor, box_t_slack, safe_inv};
+use super::{Prim, Visitor, box_t_slack};
 use crate::geometry::Ray;
 
 /// Padding of decoded child boxes, relative to `|node origin| + node extent` (per axis): the
@@ -90,7 +92,11 @@ impl Bvh {
         let max_leaf = params.max_prims_per_leaf.clamp(1, 3);
         let mut cw = None;
         if max_stacked(&boxes) <= MAX_STACKED {
-            let jittered: Vec<Aabb> = boxes.iter().enumerate().map(|(i, b)| jitter(b, i)).collect();
+            let jittered: Vec<Aabb> = boxes
+                .iter()
+                .enumerate()
+                .map(|(i, b)| jitter(b, i))
+                .collect();
             let mut bvh2 = PlocBuilder::with_capacity(jittered.len()).build(
                 params.ploc_search_distance,
                 &jittered,
@@ -110,7 +116,11 @@ impl Bvh {
         let depth = tree_depth(&cw);
         // A balanced binary tree of 2³² leaves has depth 33, its BVH8 far less.
         debug_assert!(depth < STACK_SIZE);
-        let ordered = cw.primitive_indices.iter().map(|&i| prims[i as usize]).collect();
+        let ordered = cw
+            .primitive_indices
+            .iter()
+            .map(|&i| prims[i as usize])
+            .collect();
         Bvh {
             cw,
             prims: ordered,
@@ -135,7 +145,7 @@ impl Bvh {
         }
         let r = TravRay {
             origin: ray.origin.into(),
-            inv: safe_inv(ray.dir).into(),
+            inv: trav_inv(ray.dir),
             oct_inv4: octant_inv4(ray.dir.into()),
             t_min,
         };
@@ -165,7 +175,10 @@ impl Bvh {
                 let relative_index = (hits_imask & !(0xffff_ffffu32 << slot_index)).count_ones();
                 let node = &self.cw.nodes[(child_index_base + relative_index) as usize];
                 let hitmask = intersect_node(node, &r, v.limit());
-                current_group = uvec2(node.child_base_idx, (hitmask & 0xff00_0000) | node.imask as u32);
+                current_group = uvec2(
+                    node.child_base_idx,
+                    (hitmask & 0xff00_0000) | node.imask as u32,
+                );
                 primitive_group = uvec2(node.primitive_base_idx, hitmask & 0x00ff_ffff);
             } else {
                 current_group = UVec2::ZERO;
@@ -183,9 +196,28 @@ impl Bvh {
 
 struct TravRay {
     origin: Vec3A,
+    /// `1/d`, clamped to `±2⁶⁰` (zero components keep their sign): the node test multiplies it
+    /// by extents and box offsets, and the clamp keeps those products finite for any scene
+    /// below about `1e17` in size, so no `0·∞` NaN can appear. Treating `|d| < 2⁻⁶⁰` as `2⁻⁶⁰`
+    /// is harmless: child boxes are padded, so an origin on an unpadded face is strictly inside.
     inv: Vec3A,
     oct_inv4: u32,
     t_min: f32,
+}
+
+/// Bound of `|1/d|` in [`TravRay::inv`].
+const INV_DIR_CLAMP: f32 = (1u64 << 60) as f32;
+
+fn trav_inv(d: Vec3) -> Vec3A {
+    let f = |x: f32| {
+        let i = 1.0 / x;
+        if i.abs() < INV_DIR_CLAMP {
+            i
+        } else {
+            INV_DIR_CLAMP.copysign(x)
+        }
+    };
+    vec3a(f(d.x), f(d.y), f(d.z))
 }
 
 /// `obvhs`' private `ray_get_octant_inv4`: which child order to use for this direction.
@@ -196,39 +228,68 @@ fn octant_inv4(dir: Vec3A) -> u32 {
         | (if dir.z < 0.0 { 0 } else { 0x0101_0101 })
 }
 
-/// Conservative ray/child-box test of one CWBVH node; returns `obvhs`' hit mask layout
-/// (internal children in the top byte, leaf primitives in the low 24 bits).
+#[inline(always)]
+fn quad(q: &[u8; 8], half: usize) -> Vec4 {
+    let i = 4 * half;
+    Vec4::new(
+        q[i] as f32,
+        q[i + 1] as f32,
+        q[i + 2] as f32,
+        q[i + 3] as f32,
+    )
+}
+
+/// Conservative ray/child-box test of one CWBVH node, four children at a time (glam's `Vec4`
+/// is SSE on x86); returns `obvhs`' hit mask layout (internal children in the top byte, leaf
+/// primitives in the low 24 bits).
+///
+/// Per axis the slab `t` of a child face `p ± pad + e·q` is `q·(e/d) + (p ± pad − o)/d`; the
+/// rounding of this form is a few ulp of `|p − o| + 255·e` (in distance), covered by the pad
+/// (`|p| + 256·e` part) and the `2γ(3)` widening of both ends of the interval (the `|o|`
+/// part, and the relative error of the primitives' own `t`).
 #[inline(always)]
 fn intersect_node(node: &CwBvhNode, r: &TravRay, t_max: f32) -> u32 {
     let e = node.compute_extent();
     let p = Vec3A::from(node.p);
-    let pad = (p.abs() + e * 256.0) * NODE_PAD_REL;
-    let p_lo = p - pad;
-    let p_hi = p + pad;
+    // Isotropic: a primitive's computed hit point is off by a few ulp of its largest
+    // coordinate in *every* axis, even along an axis where the box is flat (a plane at z = 0).
+    let pad = Vec3A::splat((p.abs() + e * 256.0).max_element() * NODE_PAD_REL);
+    let scale = e * r.inv;
+    let base_lo = (p - pad - r.origin) * r.inv;
+    let base_hi = (p + pad - r.origin) * r.inv;
     let slack = box_t_slack();
     let (child_bits8, bit_index8) = node.get_child_and_index_bits(r.oct_inv4);
     let mut hit_mask = 0;
-    for child in 0..8 {
-        if node.child_meta[child] == 0 {
-            continue;
+    for half in 0..2 {
+        let mut t_near = Vec4::splat(f32::NEG_INFINITY);
+        let mut t_far = Vec4::splat(f32::INFINITY);
+        let axes = [
+            (&node.child_min_x, &node.child_max_x),
+            (&node.child_min_y, &node.child_max_y),
+            (&node.child_min_z, &node.child_max_z),
+        ];
+        for (axis, (q_min, q_max)) in axes.into_iter().enumerate() {
+            let lo = quad(q_min, half) * scale[axis] + Vec4::splat(base_lo[axis]);
+            let hi = quad(q_max, half) * scale[axis] + Vec4::splat(base_hi[axis]);
+            // For a negative direction the max face is entered first.
+            let (near, far) = if r.inv[axis] >= 0.0 {
+                (lo, hi)
+            } else {
+                (hi, lo)
+            };
+            t_near = t_near.max(near);
+            t_far = t_far.min(far);
         }
-        let q_lo = vec3a(
-            node.child_min_x[child] as f32,
-            node.child_min_y[child] as f32,
-            node.child_min_z[child] as f32,
-        );
-        let q_hi = vec3a(
-            node.child_max_x[child] as f32,
-            node.child_max_y[child] as f32,
-            node.child_max_z[child] as f32,
-        );
-        let ta = (p_lo + e * q_lo - r.origin) * r.inv;
-        let tb = (p_hi + e * q_hi - r.origin) * r.inv;
-        let t_near = ta.min(tb).max_element().max(r.t_min);
-        let t_far = ta.max(tb).min_element();
-        let t_far = (t_far + t_far.abs() * slack).min(t_max);
-        if t_near <= t_far {
-            hit_mask |= extract_byte64(child_bits8, child) << extract_byte64(bit_index8, child);
+        // Widen both ends by the rounding of the slab arithmetic *and* of the primitives' own
+        // t: a tie (equal t, lower id) in a flat box must not be culled by an ulp.
+        let t_near = (t_near - t_near.abs() * slack).max(Vec4::splat(r.t_min));
+        let t_far = (t_far + t_far.abs() * slack).min(Vec4::splat(t_max));
+        let mask = t_near.cmple(t_far).bitmask();
+        for j in 0..4 {
+            if mask & (1 << j) != 0 {
+                let child = 4 * half + j;
+                hit_mask |= extract_byte64(child_bits8, child) << extract_byte64(bit_index8, child);
+            }
         }
     }
     hit_mask
@@ -285,7 +346,11 @@ fn max_stacked(boxes: &[Aabb]) -> usize {
     let mut best = 0;
     let mut run = 0;
     for i in 0..keys.len() {
-        run = if i > 0 && keys[i] == keys[i - 1] { run + 1 } else { 1 };
+        run = if i > 0 && keys[i] == keys[i - 1] {
+            run + 1
+        } else {
+            1
+        };
         best = best.max(run);
     }
     best

@@ -26,9 +26,14 @@ pub const GRID_DENSITY: f32 = 4.0;
 /// Cells per axis at most (so at most `128³ ≈ 2.1e6` cells).
 pub const GRID_MAX_RES: i32 = 128;
 
-/// Cap on the total number of cell references (primitive-in-cell entries); the resolution is
-/// halved until the scene fits, so a few huge primitives cannot blow up memory.
-pub const GRID_MAX_REFS: usize = 1 << 26;
+/// Cap on the total number of cell references (primitive-in-cell entries):
+/// `GRID_MAX_REFS_PER_PRIM · N + GRID_MAX_REFS_EXTRA`. The resolution is halved until the scene
+/// fits, so huge or stacked primitives (each in every cell) cannot blow up memory; a typical
+/// scene needs 2–5 references per primitive.
+pub const GRID_MAX_REFS_PER_PRIM: usize = 16;
+
+/// See [`GRID_MAX_REFS_PER_PRIM`]: room for a few primitives that cover the whole grid.
+pub const GRID_MAX_REFS_EXTRA: usize = 1 << 20;
 
 /// Padding of each primitive's box when it is inserted, as a fraction of the cell size.
 pub const GRID_PRIM_PAD: f32 = 1e-3;
@@ -71,10 +76,11 @@ impl Grid {
         let extent = hi - lo;
 
         let mut res = resolution(extent, prims.len());
+        let max_refs = GRID_MAX_REFS_PER_PRIM * prims.len() + GRID_MAX_REFS_EXTRA;
         loop {
             let grid = Self::with_res(lo, extent, res);
             let refs = grid.count_refs(&boxes, magnitude);
-            if refs <= GRID_MAX_REFS || res == IVec3::ONE {
+            if refs <= max_refs || res == IVec3::ONE {
                 return grid.fill(prims, &boxes, magnitude, refs);
             }
             res = (res / 2).max(IVec3::ONE);
@@ -103,7 +109,8 @@ impl Grid {
     /// [`Grid::plane`] (cell `i` is `[plane(i), plane(i + 1)]`).
     fn cell_range(&self, axis: usize, a: f32, b: f32) -> (i32, i32) {
         let n = self.res[axis];
-        let index = |x: f32| (((x - self.lo[axis]) * self.inv_cell[axis]).floor() as i32).clamp(0, n - 1);
+        let index =
+            |x: f32| (((x - self.lo[axis]) * self.inv_cell[axis]).floor() as i32).clamp(0, n - 1);
         let mut i0 = index(a);
         while i0 > 0 && self.plane(axis, i0) >= a {
             i0 -= 1;
@@ -148,10 +155,17 @@ impl Grid {
         (x + self.res.x * (y + self.res.y * z)) as usize
     }
 
-    fn fill(mut self, prims: Vec<Prim>, boxes: &[(Vec3, Vec3)], magnitude: f32, refs: usize) -> Grid {
+    fn fill(
+        mut self,
+        prims: Vec<Prim>,
+        boxes: &[(Vec3, Vec3)],
+        magnitude: f32,
+        refs: usize,
+    ) -> Grid {
         let cells = (self.res.x * self.res.y * self.res.z) as usize;
         let mut counts = vec![0u32; cells + 1];
-        let ranges: Vec<[(i32, i32); 3]> = boxes.iter().map(|b| self.ranges(b, magnitude)).collect();
+        let ranges: Vec<[(i32, i32); 3]> =
+            boxes.iter().map(|b| self.ranges(b, magnitude)).collect();
         let for_each_cell = |r: &[(i32, i32); 3], f: &mut dyn FnMut(usize)| {
             for z in r[2].0..=r[2].1 {
                 for y in r[1].0..=r[1].1 {
@@ -189,7 +203,13 @@ impl Grid {
 
     /// 3D-DDA over the cells the ray crosses in `(t_min, t_max)`, visiting their primitives in
     /// order along the ray; stops when the visitor asks or its limit lies within the cell.
-    pub(super) fn walk<V: Visitor>(&self, ray: &crate::geometry::Ray, t_min: f32, t_max: f32, v: &mut V) {
+    pub(super) fn walk<V: Visitor>(
+        &self,
+        ray: &crate::geometry::Ray,
+        t_min: f32,
+        t_max: f32,
+        v: &mut V,
+    ) {
         let o = ray.origin;
         let d = ray.dir;
         let inv = safe_inv(d);
@@ -207,7 +227,7 @@ impl Grid {
         let slack = box_t_slack();
         let t0 = (t_enter - t_enter.abs() * slack).max(t_min);
         let t1 = (t_exit + t_exit.abs() * slack).min(t_max);
-        if !(t0 <= t1) {
+        if t0.is_nan() || t1.is_nan() || t0 > t1 {
             return;
         }
 
@@ -217,8 +237,13 @@ impl Grid {
         let mut t_next = [0f32; 3];
         for axis in 0..3 {
             let n = self.res[axis];
-            let x = if t0.is_finite() { o[axis] + t0 * d[axis] } else { o[axis] };
-            let mut i = (((x - self.lo[axis]) * self.inv_cell[axis]).floor() as i32).clamp(0, n - 1);
+            let x = if t0.is_finite() {
+                o[axis] + t0 * d[axis]
+            } else {
+                o[axis]
+            };
+            let mut i =
+                (((x - self.lo[axis]) * self.inv_cell[axis]).floor() as i32).clamp(0, n - 1);
             if inv[axis] > 0.0 {
                 // Cell i spans t in [t_plane(i), t_plane(i + 1)].
                 while i + 1 < n && t_plane(axis, i + 1) <= t0 {
@@ -307,4 +332,64 @@ fn resolution(extent: Vec3, n: usize) -> IVec3 {
         }
     }
     res
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::{Closest, Shape};
+    use crate::geometry::{Methods, Ray};
+
+    /// Rays that start exactly on cell boundaries (and run along them) must see what brute
+    /// force sees: this is where the starting cell's rounding matters.
+    #[test]
+    fn rays_starting_on_cell_planes_match_brute_force() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut rnd = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut prims = Vec::new();
+        for id in 0..400u32 {
+            let c = Vec3::new(rnd(), rnd(), rnd()) * 4.0 - 2.0;
+            let shape = if id % 3 == 0 {
+                Shape::Sphere {
+                    center: c,
+                    radius: 0.05 + 0.2 * rnd(),
+                }
+            } else {
+                let e =
+                    |r: &mut dyn FnMut() -> f32| Vec3::new(r() - 0.5, r() - 0.5, r() - 0.5) * 0.6;
+                Shape::Triangle([c, c + e(&mut rnd), c + e(&mut rnd)])
+            };
+            prims.push(Prim { shape, id });
+        }
+        let grid = Grid::build(prims.clone());
+        let m = Methods::default();
+        let mut checked = 0;
+        for k in 0..6000 {
+            let axis = k % 3;
+            let i = (rnd() * (grid.res[axis] + 1) as f32) as i32;
+            let mut o = Vec3::new(rnd(), rnd(), rnd()) * 5.0 - 2.5;
+            o[axis] = grid.plane(axis, i.min(grid.res[axis]));
+            let mut d = Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5);
+            match k % 4 {
+                0 => d[axis] = 0.0,           // along the plane
+                1 => d[(axis + 1) % 3] = 0.0, // axis-parallel component
+                _ => {}
+            }
+            let ray = Ray::new(o, d.normalize());
+            let mut brute = Closest::new(&m, &ray, 0.0, f32::INFINITY);
+            prims.iter().for_each(|p| {
+                brute.visit(p);
+            });
+            let mut walked = Closest::new(&m, &ray, 0.0, f32::INFINITY);
+            grid.walk(&ray, 0.0, f32::INFINITY, &mut walked);
+            assert_eq!(walked.hit(), brute.hit(), "ray {k}: {ray:?}");
+            checked += usize::from(brute.hit().is_some());
+        }
+        assert!(checked > 1000, "{checked}");
+    }
 }

@@ -85,7 +85,8 @@ impl Prim {
     fn intersect(&self, m: &Methods, ray: &Ray, t_min: f32, t_max: f32) -> Option<(f32, f32, f32)> {
         match &self.shape {
             Shape::Sphere { center, radius } => {
-                intersect_sphere(m.sphere, *center, *radius, ray, t_min, t_max).map(|t| (t, 0.0, 0.0))
+                intersect_sphere(m.sphere, *center, *radius, ray, t_min, t_max)
+                    .map(|t| (t, 0.0, 0.0))
             }
             Shape::Triangle(v) => {
                 intersect_triangle(m.triangle, v, ray, t_min, t_max).map(|h| (h.t, h.b1, h.b2))
@@ -192,7 +193,9 @@ impl Visitor for AnyHit<'_> {
 
     #[inline(always)]
     fn visit(&mut self, prim: &Prim) -> bool {
-        self.hit = prim.intersect(self.m, self.ray, self.t_min, self.t_max).is_some();
+        self.hit = prim
+            .intersect(self.m, self.ray, self.t_min, self.t_max)
+            .is_some();
         self.hit
     }
 }
@@ -363,7 +366,11 @@ fn ray_is_usable(ray: &Ray, t_min: f32, t_max: f32) -> bool {
 fn safe_inv(d: Vec3) -> Vec3 {
     let f = |x: f32| {
         let i = 1.0 / x;
-        if i.is_finite() { i } else { f32::MAX.copysign(x) }
+        if i.is_finite() {
+            i
+        } else {
+            f32::MAX.copysign(x)
+        }
     };
     Vec3::new(f(d.x), f(d.y), f(d.z))
 }

@@ -53,8 +53,7 @@ fn lecture_roots(center: Vec3, radius: f32, ray: &Ray) -> Option<(f32, f32)> {
     let dp = center - ray.origin;
     let b = ray.dir.dot(dp);
     let disc = b * b - dp.dot(dp) + radius * radius;
-    // `!(disc >= 0)` also rejects NaN.
-    if !(disc >= 0.0) {
+    if disc.is_nan() || disc < 0.0 {
         return None;
     }
     let s = disc.sqrt();
@@ -76,7 +75,7 @@ fn robust_roots(center: Vec3, radius: f32, ray: &Ray) -> Option<(f32, f32)> {
     // Hearn–Baker: the vector from the centre to the point of the ray closest to it.
     let l = f + (b_prime / a) * u;
     let disc = r2 - l.dot(l);
-    if !(disc >= 0.0) {
+    if disc.is_nan() || disc < 0.0 {
         return None;
     }
     let c = f.dot(f) - r2;
@@ -170,7 +169,7 @@ pub fn sphere_roots_f64(center: Vec3, radius: f32, ray: &Ray) -> Option<(f64, f6
     let b = -f.dot(u);
     let l = f + (b / a) * u;
     let disc = r * r - l.dot(l);
-    if !(disc >= 0.0) {
+    if disc.is_nan() || disc < 0.0 {
         return None;
     }
     let c = f.dot(f) - r * r;

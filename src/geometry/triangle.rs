@@ -103,7 +103,7 @@ fn moller_trumbore(v: &[Vec3; 3], ray: &Ray, t_min: f32, t_max: f32) -> Option<T
     let e2 = v[2] - v[0];
     let p = ray.dir.cross(e2);
     let det = e1.dot(p);
-    if !(det.abs() >= MT_DET_EPSILON) {
+    if det.is_nan() || det.abs() < MT_DET_EPSILON {
         return None;
     }
     let inv_det = 1.0 / det;
@@ -190,7 +190,7 @@ fn watertight(v: &[Vec3; 3], ray: &Ray, t_min: f32, t_max: f32) -> Option<TriHit
         return None;
     }
     let t_scaled = e0 * (sz * p0z) + e1 * (sz * p1z) + e2 * (sz * p2z);
-    if (det < 0.0 && !(t_scaled < 0.0)) || (det > 0.0 && !(t_scaled > 0.0)) {
+    if t_scaled.is_nan() || (det < 0.0 && t_scaled >= 0.0) || (det > 0.0 && t_scaled <= 0.0) {
         return None;
     }
     let inv_det = 1.0 / det;
