@@ -559,9 +559,17 @@ fn auto_resolves_by_size() {
 fn closed_mesh_has_no_leaks_through_any_accelerator() {
     let mut rng = Pcg::new(8);
     let m = default_methods();
-    for scale in [1e-3f32, 1.0, 1e3] {
-        // An icosahedron-like closed mesh: an octahedron subdivided twice onto a sphere.
+    for (scale, offset) in [
+        (1e-3f32, 0.0f32),
+        (1.0, 0.0),
+        (1e3, 0.0),
+        (1.0, 1e2),
+        (1e-2, 1e4),
+    ] {
+        // A closed mesh: an octahedron subdivided twice onto a sphere, moved off the origin.
+        let center = Vec3::new(0.3, -0.7, 0.2) * (offset * scale);
         let (verts, idx) = octasphere(2, scale);
+        let verts: Vec<Vec3> = verts.iter().map(|v| *v + center).collect();
         let scene = PrimSet {
             spheres: vec![],
             triangles: idx.iter().map(|t| t.map(|i| verts[i])).collect(),
@@ -575,7 +583,7 @@ fn closed_mesh_has_no_leaks_through_any_accelerator() {
         }
         for p in targets {
             for _ in 0..4 {
-                let out = (p.normalize() + 0.05 * rng.unit()).normalize();
+                let out = ((p - center).normalize() + 0.05 * rng.unit()).normalize();
                 let origin = p + out * (scale * rng.range(0.5, 4.0));
                 let ray = Ray::new(origin, (p - origin).normalize());
                 let t_target = (p - origin).length();
@@ -583,7 +591,7 @@ fn closed_mesh_has_no_leaks_through_any_accelerator() {
                     let hit = a.closest_hit(&m, &ray, 0.0, f32::INFINITY);
                     assert!(
                         hit.is_some_and(|h| h.t < t_target + 0.1 * scale),
-                        "{k:?} leaks at scale {scale}: {ray:?}"
+                        "{k:?} leaks at scale {scale}, offset {offset}: {ray:?}"
                     );
                 }
             }
