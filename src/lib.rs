@@ -10,8 +10,8 @@
 pub mod accel;
 pub mod export;
 pub mod geometry;
+pub mod ray_tree;
 pub mod render;
 pub mod scene;
 pub mod shade;
-pub mod ray_tree;
 pub mod trace;
