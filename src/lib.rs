@@ -3,8 +3,8 @@
 //!
 //! Data flow: a scene file or OBJ → [`scene::Scene`] (or a [`scene::SceneError`]; callers keep
 //! their old scene) → an accelerator ([`accel::Accel`]) over the scene's spheres and triangles →
-//! [`trace::trace`] per sample in worker threads ([`render`]) → a linear `f32` film → [`export`]
-//! (PNG, EXR). A clicked pixel runs the same [`trace::trace`] with a tree recorder instead of the
+//! [`trace::Tracer::trace`] per sample in worker threads ([`render`]) → a linear `f32` film → [`export`]
+//! (PNG, EXR). A clicked pixel runs the same [`trace::Tracer::trace`] with a tree recorder instead of the
 //! no-op one.
 
 pub mod accel;
