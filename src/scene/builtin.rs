@@ -1,5 +1,115 @@
-//! todo
-pub const NAMES: &[&str] = &[];
-pub fn load_builtin(_name: &str) -> Result<super::Scene, super::SceneError> {
-    todo!()
+//! Scenes compiled into the binary: the files of `assets/scenes` and the models they use from
+//! `assets/models`, loaded through the same TOML loader with a resolver that reads the
+//! embedded text instead of the disk. `default` is Whitted's classic picture (mirror and glass
+//! spheres over a checkerboard), `quiz` is the lecture's closing quiz, `glass` shows refraction
+//! and total internal reflection, `box` is a closed room with a mirror wall.
+
+use super::Scene;
+use super::load::{SceneError, load_scene_str_with};
+
+/// The built-in scenes, in the order a menu should show them.
+pub const NAMES: &[&str] = &["default", "quiz", "glass", "box"];
+
+const SCENES: &[(&str, &str)] = &[
+    ("default", include_str!("../../assets/scenes/default.toml")),
+    ("quiz", include_str!("../../assets/scenes/quiz.toml")),
+    ("glass", include_str!("../../assets/scenes/glass.toml")),
+    ("box", include_str!("../../assets/scenes/box.toml")),
+];
+
+/// Embedded model files by their path from the crate root.
+const MODELS: &[(&str, &str)] = &[
+    (
+        "assets/models/checker_floor.obj",
+        include_str!("../../assets/models/checker_floor.obj"),
+    ),
+    (
+        "assets/models/checker_floor.mtl",
+        include_str!("../../assets/models/checker_floor.mtl"),
+    ),
+    (
+        "assets/models/torus.obj",
+        include_str!("../../assets/models/torus.obj"),
+    ),
+    (
+        "assets/models/torus.mtl",
+        include_str!("../../assets/models/torus.mtl"),
+    ),
+    (
+        "assets/models/prism.obj",
+        include_str!("../../assets/models/prism.obj"),
+    ),
+    (
+        "assets/models/room.obj",
+        include_str!("../../assets/models/room.obj"),
+    ),
+    (
+        "assets/models/room.mtl",
+        include_str!("../../assets/models/room.mtl"),
+    ),
+];
+
+/// The TOML text of a built-in scene, e.g. to show it or save it as a starting point.
+pub fn scene_text(name: &str) -> Option<&'static str> {
+    SCENES.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)
+}
+
+/// Loads a built-in scene by name ([`NAMES`]); [`Scene::source`] stays `None`.
+pub fn load_builtin(name: &str) -> Result<Scene, SceneError> {
+    let text = scene_text(name).ok_or_else(|| {
+        let names: Vec<String> = NAMES.iter().map(|n| format!("\"{n}\"")).collect();
+        SceneError(format!(
+            "there is no built-in scene \"{name}\"; the built-in scenes are {}.",
+            super::load::list_and(&names)
+        ))
+    })?;
+    load_scene_str_with(text, &format!("builtin/{name}.toml"), &resolve)
+}
+
+/// The resolver of built-in scenes: `path` is relative to `assets/scenes`, as in the scene
+/// files on disk, and must name an embedded model.
+pub fn resolve(path: &str) -> Result<String, String> {
+    let wanted = normalize(&format!("assets/scenes/{path}"));
+    MODELS
+        .iter()
+        .find(|(p, _)| Some(*p) == wanted.as_deref())
+        .map(|(_, text)| (*text).to_string())
+        .ok_or_else(|| format!("{path}: not among the models built into raytree"))
+}
+
+/// Resolves `.` and `..` in a `/`-separated relative path; `None` if it climbs out of the root.
+fn normalize(path: &str) -> Option<String> {
+    let mut parts: Vec<&str> = Vec::new();
+    for part in path.split(['/', '\\']) {
+        match part {
+            "" | "." => {}
+            ".." => {
+                parts.pop()?;
+            }
+            p => parts.push(p),
+        }
+    }
+    Some(parts.join("/"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paths_are_normalized() {
+        assert_eq!(
+            normalize("assets/scenes/../models/./a.obj").as_deref(),
+            Some("assets/models/a.obj")
+        );
+        assert_eq!(normalize("../../x"), None);
+    }
+
+    #[test]
+    fn every_name_has_a_scene() {
+        assert_eq!(NAMES.len(), SCENES.len());
+        for name in NAMES {
+            assert!(scene_text(name).is_some(), "{name}");
+        }
+    }
 }

@@ -6,13 +6,18 @@
 pub mod builtin;
 pub mod load;
 pub mod obj;
+pub mod save;
 
 use std::path::PathBuf;
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-pub use load::{SceneError, load_scene_file, load_scene_str};
+pub use builtin::load_builtin;
+pub use load::{
+    ResolveFn, SceneError, fs_resolver, load_scene_file, load_scene_str, load_scene_str_with,
+};
+pub use save::scene_to_toml;
 
 /// Index into [`Scene::materials`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]

@@ -1,0 +1,678 @@
+//! Scene loading as the rest of raytree sees it (SPEC §3): defaults, the value forms, the
+//! errors and their places, meshes and their MTL materials, bare OBJ files, the built-in
+//! scenes and the TOML round trip.
+
+use std::path::Path;
+
+use glam::Vec3;
+use raytree::scene::{
+    Camera, Material, MaterialId, ObjectId, ObjectSource, RenderParams, Scene, Shading, builtin,
+    load_builtin, load_scene_file, load_scene_str, load_scene_str_with, scene_to_toml,
+};
+
+/// A resolver over in-memory files, for meshes written inside a test.
+fn files(list: &[(&'static str, &'static str)]) -> impl Fn(&str) -> Result<String, String> + use<> {
+    let list = list.to_vec();
+    move |path: &str| {
+        list.iter()
+            .find(|(p, _)| *p == path)
+            .map(|(_, text)| (*text).to_string())
+            .ok_or_else(|| format!("{path}: no such test file"))
+    }
+}
+
+fn load(text: &str) -> Scene {
+    load_scene_str(text, "t.toml").unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn load_err(text: &str) -> String {
+    match load_scene_str(text, "t.toml") {
+        Ok(_) => panic!("expected an error for:\n{text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+fn assert_scene_eq(a: &Scene, b: &Scene, what: &str) {
+    assert_eq!(a.render, b.render, "{what}: render");
+    assert_eq!(a.camera, b.camera, "{what}: camera");
+    assert_eq!(a.lights, b.lights, "{what}: lights");
+    assert_eq!(a.materials, b.materials, "{what}: materials");
+    assert_eq!(a.objects, b.objects, "{what}: objects");
+    assert_eq!(a.spheres, b.spheres, "{what}: spheres");
+    assert_eq!(a.triangles, b.triangles, "{what}: triangles");
+    assert_eq!(a.warnings, b.warnings, "{what}: warnings");
+}
+
+fn material<'s>(scene: &'s Scene, name: &str) -> &'s Material {
+    scene
+        .materials
+        .iter()
+        .find(|m| m.name == name)
+        .unwrap_or_else(|| panic!("no material {name} in {:?}", names(scene)))
+}
+
+fn names(scene: &Scene) -> Vec<&str> {
+    scene.materials.iter().map(|m| m.name.as_str()).collect()
+}
+
+#[test]
+fn defaults_apply_to_everything_left_out() {
+    let scene = load("[[sphere]]\n[[light]]\n");
+    assert_eq!(scene.render, RenderParams::default());
+    assert_eq!(scene.camera, Camera::default());
+    // The sphere names no material: the shared "default" one is added, once.
+    assert_eq!(scene.materials, vec![Material::default()]);
+    assert_eq!(scene.spheres.len(), 1);
+    let s = scene.spheres[0];
+    assert_eq!((s.center, s.radius), (Vec3::ZERO, 1.0));
+    assert_eq!((s.material, s.object), (MaterialId(0), ObjectId(0)));
+    assert_eq!(scene.objects[0].name, "sphere 1");
+    assert_eq!(scene.objects[0].source, ObjectSource::Sphere);
+    let light = &scene.lights[0];
+    assert_eq!(light.name, "light 1");
+    assert_eq!(light.position, Camera::default().position, "a headlight");
+    assert_eq!((light.color, light.radius), (Vec3::ONE, 0.0));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert_eq!(scene.source, None);
+}
+
+#[test]
+fn empty_scene_loads() {
+    let scene = load("# nothing\n");
+    assert!(scene.objects.is_empty() && scene.materials.is_empty() && scene.lights.is_empty());
+    assert!(scene.warnings.is_empty());
+}
+
+#[test]
+fn coefficients_are_scalars_or_rgb_and_integers_are_numbers() {
+    let scene = load(
+        r#"
+        [render]
+        background = [0.1, 0.2, 0.3]
+        ambient_light = 0.5
+        shading = "phong"
+        [camera]
+        fov_y = 45
+        [[material]]
+        name = "m"
+        ambient = 0
+        diffuse = [0.25, 0.5, 1]
+        specular = 1
+        shininess = 10
+        [[sphere]]
+        material = "m"
+        "#,
+    );
+    assert_eq!(scene.render.background, Vec3::new(0.1, 0.2, 0.3));
+    assert_eq!(scene.render.ambient_light, Vec3::splat(0.5));
+    assert_eq!(scene.render.shading, Shading::Phong);
+    assert_eq!(scene.camera.fov_y_deg, 45.0);
+    let m = material(&scene, "m");
+    assert_eq!(m.ambient, Vec3::ZERO);
+    assert_eq!(m.diffuse, Vec3::new(0.25, 0.5, 1.0));
+    assert_eq!(m.specular, Vec3::ONE);
+    assert_eq!(m.shininess, 10.0);
+    // Unset fields keep Material::default()'s values.
+    assert_eq!(m.ior, Material::default().ior);
+    assert_eq!(m.reflectivity, Material::default().reflectivity);
+    // "default" is not added: nothing needs it.
+    assert_eq!(names(&scene), ["m"]);
+}
+
+#[test]
+fn errors_give_line_and_column_of_the_value_or_key() {
+    // Columns count characters from 1; the value, not the key, is what is wrong.
+    assert_eq!(
+        load_err("[[sphere]]\ncenter = [0, 0, 0]\nradius = 1\n\n[[sphere]]\n\nradius = -1\n"),
+        "t.toml:7:10: sphere 2 field `radius` must be greater than 0, got -1."
+    );
+    // Inside an array, the offending item.
+    assert_eq!(
+        load_err("[camera]\n  position = [1, 2, -inf]\n"),
+        "t.toml:2:21: camera field `position` must be finite, got -inf."
+    );
+    // An unknown key: the key itself.
+    assert_eq!(
+        load_err("[render]\nwidth = 10\n  heigth = 10\n"),
+        "t.toml:3:3: render has an unknown field `heigth` (did you mean `height`?); its fields \
+         are `width`, `height`, `max_depth`, `samples`, `background`, `ambient_light` and \
+         `shading`."
+    );
+    // A syntax error: where the parser stopped.
+    let e = load_err("[render]\nwidth = 1.2.3\n");
+    assert!(e.starts_with("t.toml:2:"), "{e}");
+    assert!(e.contains("TOML syntax error"), "{e}");
+    // Unicode before the error does not shift the column.
+    assert_eq!(
+        load_err("sphere = [{ name = \"ü\", radius = -2 }]\n")
+            .split(": ")
+            .next(),
+        Some("t.toml:1:34")
+    );
+}
+
+#[test]
+fn validation_covers_every_rule() {
+    let cases: &[(&str, &str)] = &[
+        (
+            "[render]\nheight = 16385",
+            "render field `height` must be between 1 and 16384",
+        ),
+        (
+            "[render]\nsamples = 0",
+            "render field `samples` must be between 1 and 65536",
+        ),
+        (
+            "[render]\nmax_depth = 65",
+            "render field `max_depth` must be at most 64, got 65",
+        ),
+        (
+            "[render]\nmax_depth = -1",
+            "render field `max_depth` must be between 0 and 64",
+        ),
+        (
+            "[render]\nwidth = 64.0",
+            "render field `width` must be a whole number, got a float",
+        ),
+        (
+            "[render]\nbackground = -1",
+            "render field `background` must be at least 0",
+        ),
+        (
+            "[camera]\nfov_y = 180",
+            "camera field `fov_y` must be between 0 and 180 degrees",
+        ),
+        (
+            "[camera]\nlook_at = [0, 0, 5]",
+            "camera field `look_at` must be a point apart",
+        ),
+        (
+            "[camera]\nup = [0, 0, 0]",
+            "camera field `up` must not be the zero vector",
+        ),
+        (
+            "[camera]\nup = [0, 0, 2]",
+            "camera field `up` must not be parallel",
+        ),
+        (
+            "[[light]]\nradius = -0.1",
+            "light 1 field `radius` must be at least 0",
+        ),
+        (
+            "[[light]]\ncolor = [1, -1, 1]",
+            "light 1 field `color` must be at least 0",
+        ),
+        (
+            "[[light]]\nname = \"a\"\n[[light]]\nname = \"a\"",
+            "light 2 field `name` repeats",
+        ),
+        (
+            "[[material]]\nior = 0",
+            "material 1 field `ior` must be greater than 0",
+        ),
+        (
+            "[[material]]\nshininess = -1",
+            "material 1 field `shininess` must be at least 0",
+        ),
+        (
+            "[[material]]\ndiffuse = [1, 2]",
+            "must be a number or an array [r, g, b], got an",
+        ),
+        (
+            "[[material]]\nname = \"\"",
+            "material 1 field `name` must not be empty",
+        ),
+        (
+            "[[sphere]]\nradius = 0",
+            "sphere 1 field `radius` must be greater than 0, got 0",
+        ),
+        (
+            "[[sphere]]\nmaterial = \"x\"",
+            "names an unknown material \"x\"; no [[material]]",
+        ),
+        (
+            "[[sphere]]\nname = \"s\"\n[[triangle]]\nname = \"s\"",
+            "object names must be unique",
+        ),
+        (
+            "[[triangle]]\nvertices = [[0, 0, 0], [1, 0, 0]]",
+            "must be an array of 3 corners",
+        ),
+        (
+            "[[triangle]]\nvertices = [[0,0,0], [1,0,0], [0,nan,0]]",
+            "must be finite, got nan",
+        ),
+        (
+            "[[mesh]]\nmaterial = \"default\"",
+            "mesh 1 is missing the field `file`",
+        ),
+        (
+            "[[mesh]]\nfile = \"x.obj\"\nscale = [1, 0, 1]",
+            "field `scale` must not be 0",
+        ),
+        (
+            "[sphere]\nradius = 1",
+            "`sphere` must be written as [[sphere]]",
+        ),
+        (
+            "render = 3",
+            "`render` must be written as [render] (a table), got an integer",
+        ),
+        ("[[light]]\ncolour = 1", "(did you mean `color`?)"),
+        (
+            "[[sphere]]\ncenter = [0, 0, 1e39]",
+            "must be finite, got 1e39",
+        ),
+    ];
+    for (text, wanted) in cases {
+        let e = load_err(text);
+        assert!(e.contains(wanted), "{text:?}\n gave {e}\n not {wanted}");
+        assert!(e.starts_with("t.toml:"), "{e}");
+        assert_eq!(e.matches('\n').count(), 0, "one line: {e}");
+        assert!(e.ends_with('.'), "{e}");
+    }
+}
+
+#[test]
+fn default_material_and_names_resolve() {
+    let scene = load(
+        r#"
+        [[material]]
+        name = "red"
+        [[sphere]]
+        material = "red"
+        [[sphere]]
+        material = "default"
+        [[triangle]]
+        vertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]
+        [[sphere]]
+        name = "sphere 1"
+        "#,
+    );
+    assert_eq!(names(&scene), ["red", "default"]);
+    let ids: Vec<u32> = scene.spheres.iter().map(|s| s.material.0).collect();
+    assert_eq!(ids, [0, 1, 1]);
+    assert_eq!(scene.triangles[0].material, MaterialId(1));
+    // Objects keep file order across kinds; a default name steps around an explicit one.
+    let object_names: Vec<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(
+        object_names,
+        ["sphere 1 2", "sphere 2", "triangle 1", "sphere 1"]
+    );
+    assert_eq!(scene.triangles[0].object, ObjectId(2));
+}
+
+const ONE_TRIANGLE: &str = "v 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\n";
+
+#[test]
+fn mesh_placement_scales_rotates_and_translates() {
+    let resolve = files(&[("tri.obj", ONE_TRIANGLE)]);
+    let text = r#"
+        [[mesh]]
+        file = "tri.obj"
+        scale = 2
+        rotate = [0, 0, 90]
+        translate = [1, 2, 3]
+    "#;
+    let scene = load_scene_str_with(text, "t.toml", &resolve).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.triangles.len(), 1);
+    // (1,0,0) ·2 → (2,0,0), 90° about z → (0,2,0), + (1,2,3) → (1,4,3).
+    let v = scene.triangles[0].vertices[0];
+    assert!(v.abs_diff_eq(Vec3::new(1.0, 4.0, 3.0), 1e-5), "{v}");
+    assert_eq!(scene.objects[0].name, "tri");
+    assert_eq!(
+        scene.objects[0].source,
+        ObjectSource::Mesh {
+            file: "tri.obj".into(),
+            material: None,
+            translate: Vec3::new(1.0, 2.0, 3.0),
+            rotate_deg: Vec3::new(0.0, 0.0, 90.0),
+            scale: Vec3::splat(2.0),
+        }
+    );
+    assert_eq!(names(&scene), ["default"]);
+}
+
+#[test]
+fn mirroring_scale_keeps_the_front_outside() {
+    let resolve = files(&[("tri.obj", ONE_TRIANGLE)]);
+    let normal = |scale: &str| {
+        let text = format!("[[mesh]]\nfile = \"tri.obj\"\nscale = {scale}\n");
+        let scene =
+            load_scene_str_with(&text, "t.toml", &resolve).unwrap_or_else(|e| panic!("{e}"));
+        let [a, b, c] = scene.triangles[0].vertices;
+        (b - a).cross(c - a)
+    };
+    // The triangle faces (1,1,1) outward; mirrored in x it must face (-1,1,1).
+    assert!(normal("1").dot(Vec3::ONE) > 0.0);
+    assert!(normal("[-1, 1, 1]").dot(Vec3::new(-1.0, 1.0, 1.0)) > 0.0);
+}
+
+#[test]
+fn degenerate_mesh_triangles_are_dropped_and_counted() {
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nv nan 0 0\n\
+               f 1 2 3\nf 1 2 4\nf 1 1 3\nf 1 2 5\nf 3 2 1\n";
+    let resolve = files(&[("models/x.obj", obj)]);
+    let scene = load_scene_str_with("[[mesh]]\nfile = \"models/x.obj\"\n", "t.toml", &resolve)
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.triangles.len(), 2);
+    assert_eq!(
+        scene.warnings,
+        ["models/x.obj: dropped 3 degenerate triangles (zero area or non-finite vertices)."]
+    );
+}
+
+#[test]
+fn mtl_maps_to_phong_materials() {
+    let scene = load_scene_file(Path::new("tests/fixtures/models/materials.obj"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let d = Material::default();
+
+    let plain = material(&scene, "materials/plain");
+    assert_eq!(plain.ambient, Vec3::new(0.1, 0.2, 0.3));
+    assert_eq!(plain.diffuse, Vec3::new(0.4, 0.5, 0.6));
+    assert_eq!(plain.specular, Vec3::new(0.7, 0.8, 0.9));
+    assert_eq!(plain.shininess, 12.0);
+    assert_eq!(plain.ior, 1.25);
+    assert_eq!(plain.transparency, Vec3::splat(0.25), "1 - d");
+    assert_eq!(plain.reflectivity, Vec3::ZERO, "illum 2 does not reflect");
+
+    let mirror = material(&scene, "materials/mirror");
+    assert_eq!(
+        mirror.reflectivity,
+        Vec3::splat(0.8),
+        "illum 3: reflectivity = Ks"
+    );
+    assert_eq!(mirror.transparency, Vec3::ZERO);
+    assert_eq!((mirror.ambient, mirror.shininess), (d.ambient, d.shininess));
+
+    let glass = material(&scene, "materials/glass");
+    assert_eq!(
+        glass.reflectivity,
+        Vec3::splat(0.2),
+        "illum 7: reflectivity = Ks"
+    );
+    assert_eq!(glass.transparency, Vec3::splat(0.9), "illum 7 without d");
+    assert_eq!(glass.ior, 1.5);
+
+    let tr = material(&scene, "materials/tr");
+    assert!(tr.transparency.abs_diff_eq(Vec3::splat(0.4), 1e-6), "Tr");
+
+    let partial = material(&scene, "materials/partial");
+    assert_eq!(
+        *partial,
+        Material {
+            name: "materials/partial".into(),
+            diffuse: Vec3::X,
+            ..Material::default()
+        }
+    );
+
+    // The face with an undefined `usemtl` uses the default material, with a warning.
+    assert_eq!(
+        names(&scene),
+        [
+            "materials/plain",
+            "materials/mirror",
+            "materials/glass",
+            "materials/tr",
+            "materials/partial",
+            "default"
+        ]
+    );
+    assert_eq!(scene.triangles[5].material, MaterialId(5));
+    assert_eq!(
+        scene.warnings,
+        [
+            "tests/fixtures/models/materials.obj: `usemtl` names materials that no material \
+             library defines (`nowhere`); their faces use the default material."
+        ]
+    );
+}
+
+#[test]
+fn material_override_ignores_the_mtl_and_missing_mtl_warns() {
+    let obj = "mtllib gone.mtl\nusemtl shiny\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    let resolve = files(&[("m/a.obj", obj)]);
+    let text = "[[material]]\nname = \"red\"\n[[mesh]]\nfile = \"m/a.obj\"\nmaterial = \"red\"\n";
+    let scene = load_scene_str_with(text, "t.toml", &resolve).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(names(&scene), ["red"]);
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+
+    let scene = load_scene_str_with("[[mesh]]\nfile = \"m/a.obj\"\n", "t.toml", &resolve)
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(names(&scene), ["default"]);
+    assert_eq!(
+        scene.warnings,
+        [
+            "m/a.obj: cannot read the material library `gone.mtl` (m/gone.mtl: no such test \
+             file); its faces use the default material."
+        ]
+    );
+}
+
+#[test]
+fn scene_materials_override_mtl_materials_of_the_same_name() {
+    let scene = load_scene_file(Path::new("tests/fixtures/models/materials.obj"))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let text = "[[material]]\nname = \"gem/plain\"\ndiffuse = [0, 1, 0]\n\
+                [[mesh]]\nname = \"gem\"\nfile = \"materials.obj\"\n";
+    let resolve = raytree::scene::fs_resolver("tests/fixtures/models".into());
+    let edited = load_scene_str_with(text, "t.toml", &resolve).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(material(&edited, "gem/plain").diffuse, Vec3::Y);
+    assert_eq!(edited.materials.len(), scene.materials.len());
+    assert_eq!(edited.triangles[0].material, MaterialId(0));
+}
+
+#[test]
+fn bare_obj_is_framed_and_lit() {
+    let path = Path::new("tests/fixtures/models/materials.obj");
+    let scene = load_scene_file(path).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.source.as_deref(), Some(path));
+    assert_eq!(scene.render, RenderParams::default());
+    assert_eq!(scene.objects.len(), 1);
+    assert_eq!(scene.objects[0].name, "materials");
+    assert_eq!(scene.triangles.len(), 6);
+
+    let (lo, hi) = scene.bounds().expect("bounds");
+    assert_eq!(
+        (lo, hi),
+        (Vec3::new(0.0, 0.0, -1.0), Vec3::new(7.0, 1.0, 1.0))
+    );
+    let c = &scene.camera;
+    assert_eq!(c.look_at, 0.5 * (lo + hi));
+    assert_eq!(c.fov_y_deg, 45.0);
+    assert_eq!(c.up, Vec3::Y);
+    let from_center = c.position - c.look_at;
+    assert!(
+        from_center.z > 0.0 && from_center.y > 0.0,
+        "+z side, above: {from_center}"
+    );
+    // The bounding sphere fits the vertical field of view.
+    let radius = 0.5 * (hi - lo).length();
+    let half_fov = (0.5 * c.fov_y_deg).to_radians();
+    assert!(from_center.length() * half_fov.sin() >= radius);
+    assert!(
+        from_center.length() * half_fov.sin() < 1.5 * radius,
+        "not absurdly far"
+    );
+
+    assert_eq!(scene.lights.len(), 1);
+    let key = &scene.lights[0];
+    assert_eq!(
+        (key.name.as_str(), key.color, key.radius),
+        ("key", Vec3::ONE, 0.0)
+    );
+    assert!(key.position.y > c.position.y, "above the camera");
+}
+
+#[test]
+fn builtin_scenes_load_cleanly() {
+    // (name, objects, spheres, triangles, lights, materials)
+    let expected = [
+        ("default", 4, 2, 128 + 576, 2, 5),
+        ("quiz", 1, 0, 1, 1, 1),
+        ("glass", 4, 1, 128 + 128 + 8, 2, 5),
+        ("box", 3, 2, 12, 1, 6),
+    ];
+    assert_eq!(builtin::NAMES, expected.map(|e| e.0));
+    for (name, objects, spheres, triangles, lights, materials) in expected {
+        let scene = load_builtin(name).unwrap_or_else(|e| panic!("{e}"));
+        assert!(scene.warnings.is_empty(), "{name}: {:?}", scene.warnings);
+        assert_eq!(scene.objects.len(), objects, "{name} objects");
+        assert_eq!(scene.spheres.len(), spheres, "{name} spheres");
+        assert_eq!(scene.triangles.len(), triangles, "{name} triangles");
+        assert_eq!(scene.lights.len(), lights, "{name} lights");
+        assert_eq!(
+            scene.materials.len(),
+            materials,
+            "{name} materials: {:?}",
+            names(&scene)
+        );
+        assert_eq!(scene.source, None);
+        let r = &scene.render;
+        assert!(
+            r.width <= 640 && r.height <= 480 && r.samples == 1,
+            "{name} renders fast"
+        );
+
+        // The same file from disk gives the same scene.
+        let path = format!("assets/scenes/{name}.toml");
+        let from_disk = load_scene_file(Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
+        assert_scene_eq(&scene, &from_disk, &path);
+        assert_eq!(from_disk.source.as_deref(), Some(Path::new(&path)));
+    }
+    let e = load_builtin("cornell").expect_err("unknown").to_string();
+    assert_eq!(
+        e,
+        "there is no built-in scene \"cornell\"; the built-in scenes are \"default\", \"quiz\", \
+         \"glass\" and \"box\"."
+    );
+}
+
+#[test]
+fn quiz_scene_is_the_lecture_quiz() {
+    let scene = load_builtin("quiz").unwrap_or_else(|e| panic!("{e}"));
+    let r = &scene.render;
+    assert!(
+        r.width % 2 == 1 && r.height % 2 == 1,
+        "a centre pixel exists"
+    );
+    assert_eq!((r.ambient_light, r.background), (Vec3::ZERO, Vec3::ZERO));
+    assert_eq!(r.shading, Shading::BlinnPhong);
+    assert_eq!(scene.camera.position, Vec3::ZERO);
+    assert_eq!(scene.camera.look_at, Vec3::new(0.0, 0.0, -1.0));
+    assert!(
+        (0.5 * scene.camera.fov_y_deg).to_radians().tan() > 1.0,
+        "whole triangle in view"
+    );
+    let t = scene.triangles[0];
+    let [a1, a2, a3] = t.vertices;
+    assert_eq!(a1, Vec3::new(-1.0, -1.0, -1.0));
+    assert_eq!(a2, Vec3::new(1.0, -1.0, -1.0));
+    assert_eq!(a3, Vec3::new(0.0, 1.0, -1.0));
+    assert!(
+        (a2 - a1)
+            .cross(a3 - a1)
+            .normalize()
+            .abs_diff_eq(Vec3::Z, 1e-6)
+    );
+    let m = scene.material(t.material);
+    assert_eq!(m.ambient, Vec3::ZERO);
+    assert_eq!(m.diffuse, Vec3::splat(std::f32::consts::FRAC_1_SQRT_2));
+    assert_eq!(m.specular, Vec3::splat(std::f32::consts::FRAC_1_SQRT_2));
+    assert_eq!(m.shininess, 1.0);
+    assert_eq!((m.reflectivity, m.transparency), (Vec3::ZERO, Vec3::ZERO));
+    let l = &scene.lights[0];
+    assert_eq!((l.position, l.color, l.radius), (Vec3::X, Vec3::ONE, 0.0));
+}
+
+#[test]
+fn scene_to_toml_round_trips_every_builtin_scene() {
+    for name in builtin::NAMES {
+        let scene = load_builtin(name).unwrap_or_else(|e| panic!("{e}"));
+        let text = scene_to_toml(&scene);
+        let back = load_scene_str_with(&text, name, &builtin::resolve)
+            .unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
+        assert_scene_eq(&scene, &back, name);
+        // Meshes are written as meshes, not as their triangles.
+        let meshes = scene
+            .objects
+            .iter()
+            .filter(|o| matches!(o.source, ObjectSource::Mesh { .. }))
+            .count();
+        assert_eq!(text.matches("[[mesh]]").count(), meshes, "{name}");
+        // And writing again gives the same text.
+        assert_eq!(scene_to_toml(&back), text, "{name}");
+    }
+}
+
+#[test]
+fn scene_to_toml_round_trips_odd_values() {
+    let text = r#"
+        [render]
+        background = [0.1, 0.2, 0.30000001]
+        [camera]
+        fov_y = 33.333333
+        [[light]]
+        name = "quote \" and \\ and ü"
+        [[material]]
+        name = "tiny"
+        diffuse = 1e-30
+        shininess = 3.4e38
+        [[triangle]]
+        vertices = [[0, 0, 0], [1e-3, 0, 0], [0, 123456.79, 0]]
+        material = "tiny"
+        [[sphere]]
+        center = [-0.0, 1, 2]
+    "#;
+    let scene = load(text);
+    let back = load(&scene_to_toml(&scene));
+    assert_scene_eq(&scene, &back, "odd values");
+}
+
+#[test]
+fn file_kinds_and_missing_files() {
+    let e = load_scene_file(Path::new("tests/fixtures/bad/not_a_scene.txt"))
+        .expect_err("txt")
+        .to_string();
+    assert_eq!(
+        e,
+        "tests/fixtures/bad/not_a_scene.txt: cannot open this kind of file; a scene is a \
+         `.toml` file or a bare `.obj` mesh."
+    );
+    // The extension is matched in any case.
+    let e = load_scene_file(Path::new("tests/fixtures/NOPE.TOML"))
+        .expect_err("missing")
+        .to_string();
+    assert_eq!(
+        e,
+        "tests/fixtures/NOPE.TOML: cannot read the scene file: No such file or directory."
+    );
+}
+
+/// Every file in `tests/fixtures/bad` fails with one clear sentence; the snapshot is the list.
+#[test]
+fn bad_scenes_give_one_sentence_each() {
+    let mut paths: Vec<_> = std::fs::read_dir("tests/fixtures/bad")
+        .expect("fixtures")
+        .map(|e| e.expect("entry").path())
+        .collect();
+    paths.sort();
+    paths.push("tests/fixtures/bad/does_not_exist.toml".into());
+    let mut report = String::new();
+    for path in &paths {
+        let name = path.file_name().expect("name").to_string_lossy();
+        let message = match load_scene_file(path) {
+            Ok(_) => panic!("{} loaded", path.display()),
+            Err(e) => e.to_string(),
+        };
+        assert!(!message.contains('\n'), "{message}");
+        assert!(
+            message.starts_with(&format!("{}:", path.display())),
+            "names the file: {message}"
+        );
+        report += &format!("{name} => {message}\n");
+    }
+    insta::assert_snapshot!(report);
+}
