@@ -237,16 +237,16 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
         .default_open(true)
         .show(ui, |ui| {
             let r = &mut app.edit.render;
-            ui.horizontal(|ui| {
-                ui.label("max depth");
-                restart |= ui.add(egui::Slider::new(&mut r.max_depth, 0..=64)).changed();
-            });
-            ui.horizontal(|ui| {
-                ui.label("samples");
-                restart |= ui
-                    .add(egui::Slider::new(&mut r.samples, 1..=1024).logarithmic(true))
-                    .changed();
-            });
+            restart |= ui
+                .add(egui::Slider::new(&mut r.max_depth, 0..=64).text("max depth"))
+                .changed();
+            restart |= ui
+                .add(
+                    egui::Slider::new(&mut r.samples, 1..=1024)
+                        .logarithmic(true)
+                        .text("samples"),
+                )
+                .changed();
             ui.horizontal(|ui| {
                 ui.label("size");
                 restart |= ui.add(DragValue::new(&mut r.width).range(1..=8192)).changed();

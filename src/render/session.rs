@@ -129,6 +129,8 @@ pub struct Session {
     pool: Arc<rayon::ThreadPool>,
     threads: usize,
     stats: Arc<LiveStats>,
+    /// Events of older generations dropped on receipt.
+    stale_dropped: std::cell::Cell<u64>,
 }
 
 impl Session {
@@ -142,6 +144,7 @@ impl Session {
             pool: Arc::new(build_pool(threads)?),
             threads,
             stats: Arc::new(LiveStats::default()),
+            stale_dropped: std::cell::Cell::new(0),
         })
     }
 
@@ -196,12 +199,17 @@ impl Session {
             .unwrap_or(generation)
     }
 
+    /// Events of older generations that arrived after a restart and were dropped.
+    pub fn stale_dropped(&self) -> u64 {
+        self.stale_dropped.get()
+    }
+
     /// The next event, if one is waiting; stale generations are dropped here too.
     pub fn try_next(&self) -> Option<SessionEvent> {
         loop {
             match self.receiver.try_recv() {
                 Ok(ev) if ev.generation() == self.generation() => return Some(ev),
-                Ok(_) => continue,
+                Ok(_) => self.stale_dropped.set(self.stale_dropped.get() + 1),
                 Err(TryRecvError::Empty | TryRecvError::Disconnected) => return None,
             }
         }
