@@ -2,11 +2,31 @@
 //! 3D-DDA traversal (the lecture's "spatial subdivision") and a BVH built with `obvhs`
 //! (the lecture's "BVH"). All answer the same two queries, closest hit and occlusion, and give
 //! the identical answer: the nearest `t`, ties broken by the lower primitive id.
+//!
+//! How "identical" is achieved: every accelerator calls the same `f32` intersection function on
+//! the same primitive data (a compact copy taken at build time), and each function's `t` does
+//! not depend on the `t_max` it is given (only the final range check does). The traversals are
+//! conservative (padded boxes and cells, slab tests widened by their rounding error), so every
+//! primitive whose reported hit point lies in its own bounding box is tested. Ties: a candidate
+//! replaces the best hit when its `t` is smaller, or equal with a lower id.
+//!
+//! Caveat, by design: a method that reports hits far outside the primitive (the lecture's
+//! sphere formula at `D/r ≥ 1e3`, whose "hits" are rounding noise) can be found by `None` and
+//! not by the others. With the robust methods (the defaults) they agree exactly.
+//!
+//! Bad input: spheres with a non-finite centre or a radius that is not finite and positive, and
+//! triangles with a non-finite vertex or an exactly zero (or non-finite) cross product, are
+//! dropped at build time for every kind and counted ([`Accel::skipped_prims`]). Rays with a
+//! non-finite origin or direction, a zero direction or an empty `(t_min, t_max)` hit nothing.
+//! No traversal allocates, locks or returns `Result`.
+
+mod bvh;
+mod grid;
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::{Methods, Ray};
+use crate::geometry::{Methods, Ray, intersect_sphere, intersect_triangle, next_float_up};
 
 /// Which accelerator to build. `Auto` picks from the scene's size.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
@@ -38,23 +58,326 @@ pub struct PrimHit {
     pub b2: f32,
 }
 
+/// `Auto` uses no accelerator below this many (valid) primitives and the BVH from here on.
+///
+/// A first guess: with a handful of primitives, testing them all is cheaper than any
+/// traversal. Issue 5 measures the real crossover points (none / grid / BVH against scene size
+/// and distribution) and replaces this rule with the measured one.
+pub const AUTO_MIN_BVH_PRIMS: usize = 8;
+
+/// The shape of one primitive, as the accelerators store it.
+#[derive(Clone, Copy, Debug)]
+enum Shape {
+    Sphere { center: Vec3, radius: f32 },
+    Triangle([Vec3; 3]),
+}
+
+/// One primitive of the compact copy, with its original id.
+#[derive(Clone, Copy, Debug)]
+struct Prim {
+    shape: Shape,
+    id: u32,
+}
+
+impl Prim {
+    /// The shared intersection call: `(t, b1, b2)` (barycentrics are 0 for spheres).
+    #[inline(always)]
+    fn intersect(&self, m: &Methods, ray: &Ray, t_min: f32, t_max: f32) -> Option<(f32, f32, f32)> {
+        match &self.shape {
+            Shape::Sphere { center, radius } => {
+                intersect_sphere(m.sphere, *center, *radius, ray, t_min, t_max)
+                    .map(|t| (t, 0.0, 0.0))
+            }
+            Shape::Triangle(v) => {
+                intersect_triangle(m.triangle, v, ray, t_min, t_max).map(|h| (h.t, h.b1, h.b2))
+            }
+        }
+    }
+
+    /// A bounding box that contains the primitive despite the rounding of `c ± r`.
+    fn bounds(&self) -> (Vec3, Vec3) {
+        match &self.shape {
+            Shape::Sphere { center, radius } => {
+                let r = Vec3::splat(*radius);
+                let pad = (center.abs() + r) * (2.0 * f32::EPSILON);
+                (*center - r - pad, *center + r + pad)
+            }
+            Shape::Triangle([a, b, c]) => (a.min(*b).min(*c), a.max(*b).max(*c)),
+        }
+    }
+}
+
+/// What a traversal does with each primitive it reaches; generic so the loops monomorphise.
+trait Visitor {
+    /// The farthest `t` still of interest (boxes and cells entered beyond it are skipped).
+    fn limit(&self) -> f32;
+    /// Test one primitive; `true` stops the traversal.
+    fn visit(&mut self, prim: &Prim) -> bool;
+}
+
+/// Closest hit with the id tie-break.
+struct Closest<'a> {
+    m: &'a Methods,
+    ray: &'a Ray,
+    t_min: f32,
+    t: f32,
+    prim: u32,
+    b1: f32,
+    b2: f32,
+}
+
+impl<'a> Closest<'a> {
+    fn new(m: &'a Methods, ray: &'a Ray, t_min: f32, t_max: f32) -> Self {
+        Self {
+            m,
+            ray,
+            t_min,
+            t: t_max,
+            prim: u32::MAX,
+            b1: 0.0,
+            b2: 0.0,
+        }
+    }
+
+    fn hit(&self) -> Option<PrimHit> {
+        (self.prim != u32::MAX).then_some(PrimHit {
+            t: self.t,
+            prim: self.prim,
+            b1: self.b1,
+            b2: self.b2,
+        })
+    }
+}
+
+impl Visitor for Closest<'_> {
+    #[inline(always)]
+    fn limit(&self) -> f32 {
+        self.t
+    }
+
+    #[inline(always)]
+    fn visit(&mut self, prim: &Prim) -> bool {
+        // Once we have a hit, ask for hits up to and *including* its t (the functions' t_max
+        // is exclusive), so an equal t with a lower id can still win.
+        let limit = if self.prim == u32::MAX {
+            self.t
+        } else {
+            next_float_up(self.t)
+        };
+        if let Some((t, b1, b2)) = prim.intersect(self.m, self.ray, self.t_min, limit)
+            && (t < self.t || (t == self.t && prim.id < self.prim))
+        {
+            self.t = t;
+            self.prim = prim.id;
+            self.b1 = b1;
+            self.b2 = b2;
+        }
+        false
+    }
+}
+
+/// Any hit in `(t_min, t_max)`: stops at the first.
+struct AnyHit<'a> {
+    m: &'a Methods,
+    ray: &'a Ray,
+    t_min: f32,
+    t_max: f32,
+    hit: bool,
+}
+
+impl Visitor for AnyHit<'_> {
+    #[inline(always)]
+    fn limit(&self) -> f32 {
+        self.t_max
+    }
+
+    #[inline(always)]
+    fn visit(&mut self, prim: &Prim) -> bool {
+        self.hit = prim
+            .intersect(self.m, self.ray, self.t_min, self.t_max)
+            .is_some();
+        self.hit
+    }
+}
+
+enum Imp {
+    /// Every primitive in id order (also used for empty sets of every kind).
+    None(Vec<Prim>),
+    Grid(grid::Grid),
+    Bvh(bvh::Bvh),
+}
+
+/// An acceleration structure over a compact copy of a [`PrimSet`]. Immutable after
+/// [`Accel::build`]; shared by reference between worker threads.
 pub struct Accel {
-    _todo: (),
+    kind: AccelKind,
+    imp: Imp,
+    prim_count: usize,
+    skipped: usize,
+}
+
+impl std::fmt::Debug for Accel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Accel")
+            .field("kind", &self.kind)
+            .field("prims", &self.prim_count)
+            .field("skipped", &self.skipped)
+            .field("memory_bytes", &self.memory_bytes())
+            .finish()
+    }
 }
 
 impl Accel {
-    pub fn build(_kind: AccelKind, _prims: &PrimSet) -> Accel {
-        todo!()
+    /// Build the accelerator `kind` over `prims` (copied; invalid primitives dropped and
+    /// counted). `Auto` resolves to a concrete kind, see [`AUTO_MIN_BVH_PRIMS`].
+    pub fn build(kind: AccelKind, prims: &PrimSet) -> Accel {
+        let mut list = Vec::with_capacity(prims.spheres.len() + prims.triangles.len());
+        let mut skipped = 0;
+        let mut id = 0u32;
+        for &(center, radius) in &prims.spheres {
+            if center.is_finite() && radius.is_finite() && radius > 0.0 {
+                list.push(Prim {
+                    shape: Shape::Sphere { center, radius },
+                    id,
+                });
+            } else {
+                skipped += 1;
+            }
+            id += 1;
+        }
+        for v in &prims.triangles {
+            let cross = (v[1] - v[0]).cross(v[2] - v[0]);
+            let finite = v.iter().all(|p| p.is_finite()) && cross.is_finite();
+            if finite && cross != Vec3::ZERO {
+                list.push(Prim {
+                    shape: Shape::Triangle(*v),
+                    id,
+                });
+            } else {
+                skipped += 1;
+            }
+            id += 1;
+        }
+        let kind = match kind {
+            AccelKind::Auto if list.len() < AUTO_MIN_BVH_PRIMS => AccelKind::None,
+            AccelKind::Auto => AccelKind::Bvh,
+            k => k,
+        };
+        let prim_count = list.len();
+        let imp = if list.is_empty() {
+            Imp::None(list)
+        } else {
+            match kind {
+                AccelKind::Grid => Imp::Grid(grid::Grid::build(list)),
+                AccelKind::Bvh => Imp::Bvh(bvh::Bvh::build(list)),
+                _ => Imp::None(list),
+            }
+        };
+        Accel {
+            kind,
+            imp,
+            prim_count,
+            skipped,
+        }
     }
-    pub fn closest_hit(&self, _m: &Methods, _ray: &Ray, _t_min: f32, _t_max: f32) -> Option<PrimHit> {
-        todo!()
+
+    /// The kind actually built (`Auto` resolved).
+    pub fn kind(&self) -> AccelKind {
+        self.kind
     }
-    pub fn occluded(&self, _m: &Methods, _ray: &Ray, _t_min: f32, _t_max: f32) -> bool {
-        todo!()
+
+    /// Valid primitives in the structure.
+    pub fn prim_count(&self) -> usize {
+        self.prim_count
+    }
+
+    /// Primitives dropped at build time (non-finite, zero-area, non-positive radius).
+    pub fn skipped_prims(&self) -> usize {
+        self.skipped
+    }
+
+    /// Depth of the BVH (root = 1), `None` for the other kinds (STABILITY B2 reports it).
+    pub fn bvh_depth(&self) -> Option<usize> {
+        match &self.imp {
+            Imp::Bvh(b) => Some(b.depth()),
+            _ => None,
+        }
+    }
+
+    /// Approximate heap memory of the structure, in bytes.
+    pub fn memory_bytes(&self) -> usize {
+        match &self.imp {
+            Imp::None(p) => p.capacity() * size_of::<Prim>(),
+            Imp::Grid(g) => g.memory_bytes(),
+            Imp::Bvh(b) => b.memory_bytes(),
+        }
+    }
+
+    /// The nearest hit in `(t_min, t_max)`, ties broken by the lower primitive id.
+    pub fn closest_hit(&self, m: &Methods, ray: &Ray, t_min: f32, t_max: f32) -> Option<PrimHit> {
+        if !ray_is_usable(ray, t_min, t_max) {
+            return None;
+        }
+        let mut v = Closest::new(m, ray, t_min, t_max);
+        self.walk(ray, t_min, t_max, &mut v);
+        v.hit()
+    }
+
+    /// Whether anything is hit in `(t_min, t_max)` (stops at the first hit found).
+    pub fn occluded(&self, m: &Methods, ray: &Ray, t_min: f32, t_max: f32) -> bool {
+        if !ray_is_usable(ray, t_min, t_max) {
+            return false;
+        }
+        let mut v = AnyHit {
+            m,
+            ray,
+            t_min,
+            t_max,
+            hit: false,
+        };
+        self.walk(ray, t_min, t_max, &mut v);
+        v.hit
+    }
+
+    #[inline]
+    fn walk<V: Visitor>(&self, ray: &Ray, t_min: f32, t_max: f32, v: &mut V) {
+        match &self.imp {
+            Imp::None(prims) => {
+                for p in prims {
+                    if v.visit(p) {
+                        return;
+                    }
+                }
+            }
+            Imp::Grid(g) => g.walk(ray, t_min, t_max, v),
+            Imp::Bvh(b) => b.walk(ray, t_min, v),
+        }
     }
 }
-impl Accel {
-    pub fn kind(&self) -> AccelKind {
-        todo!()
-    }
+
+#[inline]
+fn ray_is_usable(ray: &Ray, t_min: f32, t_max: f32) -> bool {
+    ray.origin.is_finite() && ray.dir.is_finite() && ray.dir != Vec3::ZERO && t_min < t_max
+}
+
+/// `1/d` per axis with zero (or subnormal) components mapped to `±f32::MAX` (sign of the zero):
+/// the slab products `(plane − o)·inv` are then `±∞`, `0` or finite, never NaN.
+#[inline]
+fn safe_inv(d: Vec3) -> Vec3 {
+    let f = |x: f32| {
+        let i = 1.0 / x;
+        if i.is_finite() {
+            i
+        } else {
+            f32::MAX.copysign(x)
+        }
+    };
+    Vec3::new(f(d.x), f(d.y), f(d.z))
+}
+
+/// Relative widening of a slab test's far `t` (pbrt-v4: `tFar *= 1 + 2γ(3)`), covering the
+/// rounding of `(plane − o)·(1/d)`.
+#[inline]
+fn box_t_slack() -> f32 {
+    2.0 * crate::geometry::gamma(3)
 }

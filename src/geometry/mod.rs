@@ -45,3 +45,28 @@ pub fn gamma(n: u32) -> f32 {
     let nu = n as f32 * u;
     nu / (1.0 - nu)
 }
+
+/// The next representable `f32` above `v` (pbrt-v4 `NextFloatUp`): `+∞` and NaN stay put, `−0`
+/// counts as `+0`, so the result is always strictly greater for finite input.
+pub fn next_float_up(v: f32) -> f32 {
+    if v.is_nan() || v == f32::INFINITY {
+        return v;
+    }
+    // −0 and +0 both step to the smallest positive subnormal.
+    let v = if v == 0.0 { 0.0 } else { v };
+    let bits = v.to_bits();
+    let bits = if v >= 0.0 { bits + 1 } else { bits - 1 };
+    f32::from_bits(bits)
+}
+
+/// The next representable `f32` below `v` (pbrt-v4 `NextFloatDown`): `−∞` and NaN stay put,
+/// `+0` counts as `−0`, so the result is always strictly smaller for finite input.
+pub fn next_float_down(v: f32) -> f32 {
+    if v.is_nan() || v == f32::NEG_INFINITY {
+        return v;
+    }
+    let v = if v == 0.0 { -0.0 } else { v };
+    let bits = v.to_bits();
+    let bits = if v > 0.0 { bits - 1 } else { bits + 1 };
+    f32::from_bits(bits)
+}

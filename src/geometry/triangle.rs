@@ -1,9 +1,23 @@
-//! Ray/triangle intersection: the lecture's plane-then-barycentric method, Möller–Trumbore and
-//! the watertight test of Woop, Benthin and Wald (2013).
-use glam::Vec3;
+//! Ray/triangle intersection: the lecture's plane-then-barycentric method (section
+//! "Ray/Triangle Intersection"), Möller–Trumbore (1997) and the watertight test of Woop,
+//! Benthin and Wald (2013, "Watertight Ray/Triangle Intersection", JCGT 2(1)).
+//!
+//! All three test both faces and report the barycentric weights `b1`, `b2` of vertices 1 and 2
+//! (vertex 0 has `1 − b1 − b2`). Each returns a `t` that does not depend on `t_min`/`t_max`
+//! except through the final range check, so accelerators that shrink `t_max` see the same hit.
+//!
+//! Where they fail (STABILITY T1, T3): the lecture's method and Möller–Trumbore decide "inside"
+//! per triangle with independently rounded quantities, so a ray through a shared edge or
+//! vertex can be outside both neighbours (a leak, a crack in the image). Möller–Trumbore also
+//! rejects `|det| <` [`MT_DET_EPSILON`], which is an absolute threshold on a quantity that scales
+//! with the square of the triangle's size: triangles with edges below about `1e-4` are missed
+//! altogether. The watertight test shears the triangle into a ray-aligned space where the three
+//! edge functions of a shared edge are computed from the same numbers in both triangles, so
+//! their signs agree exactly and no ray slips between; it rejects only `det == 0`.
+use glam::{DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
-use super::Ray;
+use super::{Ray, gamma};
 
 /// How rays meet triangles.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
@@ -26,19 +40,200 @@ pub struct TriHit {
     pub b2: f32,
 }
 
+/// Möller–Trumbore's "parallel ray" threshold on `|det| = |(d × e2)·e1|`, as in the common
+/// implementations (the 1997 paper uses `1e-6`; `1e-8` is the usual `f32` choice).
+///
+/// `det` has units of length² (for a unit direction), so this absolute threshold silently drops
+/// every triangle whose edges are shorter than about `1e-4` (STABILITY T3), and needle triangles
+/// seen edge-on. Kept on purpose: it is the method as taught and the sweeps show its failure.
+pub const MT_DET_EPSILON: f32 = 1e-8;
+
 /// Nearest hit in `(t_min, t_max)` of the ray with triangle `v` (both faces), if any.
+#[inline]
 pub fn intersect_triangle(
-    _method: TriangleMethod,
-    _v: &[Vec3; 3],
-    _ray: &Ray,
-    _t_min: f32,
-    _t_max: f32,
+    method: TriangleMethod,
+    v: &[Vec3; 3],
+    ray: &Ray,
+    t_min: f32,
+    t_max: f32,
 ) -> Option<TriHit> {
-    todo!()
+    match method {
+        TriangleMethod::Lecture => lecture(v, ray, t_min, t_max),
+        TriangleMethod::MollerTrumbore => moller_trumbore(v, ray, t_min, t_max),
+        TriangleMethod::Watertight => watertight(v, ray, t_min, t_max),
+    }
+}
+
+/// The lecture: unit normal `n = normalize((A2 − A1) × (A3 − A1))`, plane `n·p = d` with
+/// `d = n·A1`, `s = (d − n·P0)/(n·u)`, then the barycentric coordinates of `P = P0 + s·u` as
+/// ratios of signed sub-triangle areas (`n·((Aj − P) × (Ak − P))` over the whole area), inside
+/// when all three are ≥ 0. Naive on purpose; it only refuses to divide by `n·u == 0`.
+fn lecture(v: &[Vec3; 3], ray: &Ray, t_min: f32, t_max: f32) -> Option<TriHit> {
+    let [a1, a2, a3] = *v;
+    let cross = (a2 - a1).cross(a3 - a1);
+    let n = cross.normalize();
+    let d = n.dot(a1);
+    let n_dot_u = n.dot(ray.dir);
+    // Also rejects NaN (a degenerate triangle has no normal).
+    if n_dot_u == 0.0 || n_dot_u.is_nan() {
+        return None;
+    }
+    let s = (d - n.dot(ray.origin)) / n_dot_u;
+    if !(s > t_min && s < t_max) {
+        return None;
+    }
+    let p = ray.at(s);
+    let area = n.dot(cross);
+    let w1 = n.dot((a2 - p).cross(a3 - p)) / area;
+    let w2 = n.dot((a3 - p).cross(a1 - p)) / area;
+    let w3 = n.dot((a1 - p).cross(a2 - p)) / area;
+    if !(w1 >= 0.0 && w2 >= 0.0 && w3 >= 0.0) {
+        return None;
+    }
+    Some(TriHit {
+        t: s,
+        b1: w2,
+        b2: w3,
+    })
+}
+
+/// Möller & Trumbore (1997), "Fast, Minimum Storage Ray/Triangle Intersection", both faces.
+fn moller_trumbore(v: &[Vec3; 3], ray: &Ray, t_min: f32, t_max: f32) -> Option<TriHit> {
+    let e1 = v[1] - v[0];
+    let e2 = v[2] - v[0];
+    let p = ray.dir.cross(e2);
+    let det = e1.dot(p);
+    if det.is_nan() || det.abs() < MT_DET_EPSILON {
+        return None;
+    }
+    let inv_det = 1.0 / det;
+    let s = ray.origin - v[0];
+    let b1 = s.dot(p) * inv_det;
+    if !(0.0..=1.0).contains(&b1) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let b2 = ray.dir.dot(q) * inv_det;
+    if !(b2 >= 0.0 && b1 + b2 <= 1.0) {
+        return None;
+    }
+    let t = e2.dot(q) * inv_det;
+    if !(t > t_min && t < t_max) {
+        return None;
+    }
+    Some(TriHit { t, b1, b2 })
+}
+
+/// Index of the largest component (pbrt-v4 `MaxComponentIndex`: ties go to the later axis).
+#[inline]
+fn max_component_index(a: Vec3) -> usize {
+    if a.x > a.y {
+        if a.x > a.z { 0 } else { 2 }
+    } else if a.y > a.z {
+        1
+    } else {
+        2
+    }
+}
+
+/// Woop, Benthin & Wald (2013), as in the paper and pbrt-v4:
+/// 1. translate the vertices by `−origin`;
+/// 2. permute axes so `z` is the direction's largest `|component|`;
+/// 3. shear so the ray is the `+z` axis (`Sx = −dx/dz`, `Sy = −dy/dz`, `Sz = 1/dz`);
+/// 4. edge functions `U, V, W` of the sheared 2D triangle in plain `f32` products (no FMA, so a
+///    shared edge gives exactly negated values in its two triangles), recomputed in `f64` when
+///    any is exactly 0 (the ray passes through an edge or vertex);
+/// 5. reject mixed signs (outside) and `det = U + V + W == 0` only;
+/// 6. the scaled distance `T = U·z0 + V·z1 + W·z2` must have the sign of `det` (hit in front).
+///
+/// The range check `t_min < t < t_max` is made on the divided `t = T/det` (not on `T` against
+/// `t_max·det`) so the answer is a pure function of the triangle and the ray: the accelerators
+/// rely on that to agree bit for bit.
+fn watertight(v: &[Vec3; 3], ray: &Ray, t_min: f32, t_max: f32) -> Option<TriHit> {
+    let d = ray.dir;
+    let kz = max_component_index(d.abs());
+    let kx = if kz == 2 { 0 } else { kz + 1 };
+    let ky = if kx == 2 { 0 } else { kx + 1 };
+    let dz = d[kz];
+    if dz == 0.0 || dz.is_nan() {
+        return None;
+    }
+    let sx = -d[kx] / dz;
+    let sy = -d[ky] / dz;
+    let sz = 1.0 / dz;
+
+    let p0 = v[0] - ray.origin;
+    let p1 = v[1] - ray.origin;
+    let p2 = v[2] - ray.origin;
+    // Permute and shear x, y.
+    let (p0x, p0y, p0z) = (p0[kx] + sx * p0[kz], p0[ky] + sy * p0[kz], p0[kz]);
+    let (p1x, p1y, p1z) = (p1[kx] + sx * p1[kz], p1[ky] + sy * p1[kz], p1[kz]);
+    let (p2x, p2y, p2z) = (p2[kx] + sx * p2[kz], p2[ky] + sy * p2[kz], p2[kz]);
+
+    let mut e0 = p1x * p2y - p1y * p2x;
+    let mut e1 = p2x * p0y - p2y * p0x;
+    let mut e2 = p0x * p1y - p0y * p1x;
+    if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
+        // The products of two f32 are exact in f64; only the difference rounds, once.
+        let f = |ax: f32, by: f32, ay: f32, bx: f32| {
+            (f64::from(ax) * f64::from(by) - f64::from(ay) * f64::from(bx)) as f32
+        };
+        e0 = f(p1x, p2y, p1y, p2x);
+        e1 = f(p2x, p0y, p2y, p0x);
+        e2 = f(p0x, p1y, p0y, p1x);
+    }
+    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+        return None;
+    }
+    let det = e0 + e1 + e2;
+    if det == 0.0 || det.is_nan() {
+        return None;
+    }
+    let t_scaled = e0 * (sz * p0z) + e1 * (sz * p1z) + e2 * (sz * p2z);
+    if t_scaled.is_nan() || (det < 0.0 && t_scaled >= 0.0) || (det > 0.0 && t_scaled <= 0.0) {
+        return None;
+    }
+    let inv_det = 1.0 / det;
+    let t = t_scaled * inv_det;
+    if !(t > t_min && t < t_max) {
+        return None;
+    }
+    Some(TriHit {
+        t,
+        b1: e1 * inv_det,
+        b2: e2 * inv_det,
+    })
 }
 
 /// The point with barycentric weights `(1 − b1 − b2, b1, b2)` and a per-axis bound on its
-/// absolute error.
-pub fn triangle_hit_point(_v: &[Vec3; 3], _b1: f32, _b2: f32) -> (Vec3, Vec3) {
-    todo!()
+/// absolute error (pbrt-v4: `γ(7)·(|b0·v0| + |b1·v1| + |b2·v2|)`). Interpolating the vertices
+/// keeps the point on the triangle's plane whatever the error of `t`.
+pub fn triangle_hit_point(v: &[Vec3; 3], b1: f32, b2: f32) -> (Vec3, Vec3) {
+    let b0 = 1.0 - b1 - b2;
+    let (w0, w1, w2) = (b0 * v[0], b1 * v[1], b2 * v[2]);
+    let p = w0 + w1 + w2;
+    let err = gamma(7) * (w0.abs() + w1.abs() + w2.abs());
+    (p, err)
+}
+
+/// `f64` replay of the ray/triangle test on the same `f32` inputs (barycentrics by Cramer's
+/// rule in double precision), used by the stability tests as the oracle: `(t, b0, b1, b2)` of
+/// the ray's line with the triangle's plane, or `None` when parallel or degenerate. The caller
+/// decides what "inside" means (all `b ≥ 0`) and what margin to allow.
+pub fn triangle_hit_f64(v: &[Vec3; 3], ray: &Ray) -> Option<(f64, f64, f64, f64)> {
+    let v0 = DVec3::from(v[0]);
+    let e1 = DVec3::from(v[1]) - v0;
+    let e2 = DVec3::from(v[2]) - v0;
+    let d = DVec3::from(ray.dir);
+    let p = d.cross(e2);
+    let det = e1.dot(p);
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let s = DVec3::from(ray.origin) - v0;
+    let b1 = s.dot(p) / det;
+    let q = s.cross(e1);
+    let b2 = d.dot(q) / det;
+    let t = e2.dot(q) / det;
+    Some((t, 1.0 - b1 - b2, b1, b2))
 }

@@ -1,0 +1,637 @@
+//! `Accel`: none, grid and BVH must give the identical closest hit (same t, same primitive, same
+//! barycentrics; ties to the lower id) and the identical occlusion verdict for every ray, over
+//! random and degenerate scenes (STABILITY B1, B2, T1 "including through the BVH", T4).
+
+use glam::{DVec3, Vec3};
+use raytree::accel::{AUTO_MIN_BVH_PRIMS, Accel, AccelKind, PrimHit, PrimSet};
+use raytree::geometry::{Methods, Ray, SphereMethod, TriangleMethod};
+
+/// PCG32 (O'Neill), enough for seeded test inputs.
+struct Pcg(u64);
+
+impl Pcg {
+    fn new(seed: u64) -> Self {
+        let mut p = Pcg(seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407));
+        p.next_u32();
+        p
+    }
+    fn next_u32(&mut self) -> u32 {
+        let old = self.0;
+        self.0 = old
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
+        let rot = (old >> 59) as u32;
+        xorshifted.rotate_right(rot)
+    }
+    fn f32(&mut self) -> f32 {
+        (self.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0)
+    }
+    fn range(&mut self, a: f32, b: f32) -> f32 {
+        a + (b - a) * self.f32()
+    }
+    fn below(&mut self, n: usize) -> usize {
+        (self.next_u32() as usize) % n
+    }
+    fn unit(&mut self) -> Vec3 {
+        loop {
+            let v = Vec3::new(
+                self.range(-1.0, 1.0),
+                self.range(-1.0, 1.0),
+                self.range(-1.0, 1.0),
+            );
+            let l = v.length_squared();
+            if l > 1e-4 && l <= 1.0 {
+                return v / l.sqrt();
+            }
+        }
+    }
+    fn in_box(&mut self, lo: Vec3, hi: Vec3) -> Vec3 {
+        Vec3::new(
+            self.range(lo.x, hi.x),
+            self.range(lo.y, hi.y),
+            self.range(lo.z, hi.z),
+        )
+    }
+}
+
+const KINDS: [AccelKind; 3] = [AccelKind::None, AccelKind::Grid, AccelKind::Bvh];
+
+fn bounds(p: &PrimSet) -> (Vec3, Vec3) {
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    for &(c, r) in &p.spheres {
+        if c.is_finite() && r.is_finite() {
+            lo = lo.min(c - r);
+            hi = hi.max(c + r);
+        }
+    }
+    for t in &p.triangles {
+        for v in t {
+            if v.is_finite() {
+                lo = lo.min(*v);
+                hi = hi.max(*v);
+            }
+        }
+    }
+    if lo.x > hi.x {
+        (Vec3::splat(-1.0), Vec3::ONE)
+    } else {
+        (lo, hi)
+    }
+}
+
+/// A mix of ray kinds over the scene's bounds: random (camera-like, from outside and inside),
+/// short segments (shadow rays), rays exactly parallel to an axis, rays aimed at primitives.
+fn rays_for(p: &PrimSet, rng: &mut Pcg, n: usize) -> Vec<(Ray, f32, f32)> {
+    let (lo, hi) = bounds(p);
+    let c = (lo + hi) * 0.5;
+    let ext = (hi - lo).max(Vec3::splat((hi - lo).max_element() * 0.1));
+    let (olo, ohi) = (c - ext, c + ext);
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        let origin = rng.in_box(olo, ohi);
+        let (ray, t_min, t_max) = match i % 5 {
+            0 => (Ray::new(origin, rng.unit()), 0.0, f32::INFINITY),
+            1 => {
+                // Segment to a random point: a shadow ray.
+                let target = rng.in_box(olo, ohi);
+                let d = target - origin;
+                (Ray::new(origin, d.normalize()), 0.0, d.length())
+            }
+            2 => {
+                // Exactly axis-parallel, both signs.
+                let axis = rng.below(3);
+                let mut d = Vec3::ZERO;
+                d[axis] = if rng.f32() < 0.5 { 1.0 } else { -1.0 };
+                (Ray::new(origin, d), 0.0, f32::INFINITY)
+            }
+            3 => {
+                // Aimed at a primitive (many hits), with a random t_min.
+                let target = aim_point(p, rng).unwrap_or(c);
+                let d = (target - origin).normalize();
+                let t_min = if rng.f32() < 0.3 {
+                    rng.range(0.0, ext.max_element())
+                } else {
+                    0.0
+                };
+                (Ray::new(origin, d), t_min, f32::INFINITY)
+            }
+            _ => {
+                // From outside the bounds towards the middle.
+                let o = c + rng.unit() * (3.0 * ext.max_element());
+                let target = aim_point(p, rng).unwrap_or(c);
+                (Ray::new(o, (target - o).normalize()), 0.0, f32::INFINITY)
+            }
+        };
+        if ray.dir.is_finite() {
+            out.push((ray, t_min, t_max));
+        }
+    }
+    out
+}
+
+fn aim_point(p: &PrimSet, rng: &mut Pcg) -> Option<Vec3> {
+    let n = p.spheres.len() + p.triangles.len();
+    if n == 0 {
+        return None;
+    }
+    let i = rng.below(n);
+    Some(if i < p.spheres.len() {
+        let (c, r) = p.spheres[i];
+        c + rng.unit() * (r * rng.range(0.0, 1.2))
+    } else {
+        let [a, b, c] = p.triangles[i - p.spheres.len()];
+        let (u, v) = (rng.range(-0.1, 1.0), rng.range(-0.1, 1.0));
+        a + u * (b - a) + v * (c - a) * (1.0 - u).max(0.0)
+    })
+}
+
+/// Compare all kinds on `rays`; returns the number of closest hits (so callers can check the
+/// scene was exercised).
+fn assert_kinds_agree(
+    name: &str,
+    prims: &PrimSet,
+    methods: &Methods,
+    rays: &[(Ray, f32, f32)],
+) -> usize {
+    let accels: Vec<Accel> = KINDS.iter().map(|&k| Accel::build(k, prims)).collect();
+    for (a, k) in accels.iter().zip(KINDS) {
+        assert_eq!(a.kind(), k);
+    }
+    let mut hits = 0;
+    for (i, (ray, t_min, t_max)) in rays.iter().enumerate() {
+        let reference: Option<PrimHit> = accels[0].closest_hit(methods, ray, *t_min, *t_max);
+        let occluded = accels[0].occluded(methods, ray, *t_min, *t_max);
+        assert_eq!(
+            occluded,
+            reference.is_some(),
+            "{name}: none's occlusion vs closest, ray {i}"
+        );
+        hits += usize::from(reference.is_some());
+        for (a, k) in accels.iter().zip(KINDS).skip(1) {
+            let got = a.closest_hit(methods, ray, *t_min, *t_max);
+            assert_eq!(
+                got, reference,
+                "{name}: {k:?} closest hit differs, ray {i}: {ray:?} ({t_min}, {t_max})"
+            );
+            let occ = a.occluded(methods, ray, *t_min, *t_max);
+            assert_eq!(
+                occ, occluded,
+                "{name}: {k:?} occlusion differs, ray {i}: {ray:?} ({t_min}, {t_max})"
+            );
+        }
+    }
+    hits
+}
+
+fn random_triangle(rng: &mut Pcg, lo: Vec3, hi: Vec3, size: f32) -> [Vec3; 3] {
+    let c = rng.in_box(lo, hi);
+    [
+        c + rng.unit() * size,
+        c + rng.unit() * size,
+        c + rng.unit() * size,
+    ]
+}
+
+fn random_scene(
+    rng: &mut Pcg,
+    spheres: usize,
+    triangles: usize,
+    extent: f32,
+    size: f32,
+) -> PrimSet {
+    let (lo, hi) = (Vec3::splat(-extent), Vec3::splat(extent));
+    PrimSet {
+        spheres: (0..spheres)
+            .map(|_| (rng.in_box(lo, hi), size * rng.range(0.05, 1.0)))
+            .collect(),
+        triangles: (0..triangles)
+            .map(|_| {
+                let s = size * rng.range(0.1, 1.0);
+                random_triangle(rng, lo, hi, s)
+            })
+            .collect(),
+    }
+}
+
+/// A ground plane of `n × n` quads (two triangles each) at height `y`, side `size`.
+fn plane(n: usize, size: f32, y: f32) -> Vec<[Vec3; 3]> {
+    let step = size / n as f32;
+    let at = |i: usize, j: usize| {
+        Vec3::new(
+            -size / 2.0 + i as f32 * step,
+            y,
+            -size / 2.0 + j as f32 * step,
+        )
+    };
+    let mut tris = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            tris.push([a, b, c]);
+            tris.push([a, c, d]);
+        }
+    }
+    tris
+}
+
+fn default_methods() -> Methods {
+    Methods::default()
+}
+
+#[test]
+fn empty_and_single_primitive_scenes() {
+    let m = default_methods();
+    let mut rng = Pcg::new(1);
+    let empty = PrimSet::default();
+    for k in KINDS {
+        let a = Accel::build(k, &empty);
+        let ray = Ray::new(Vec3::ZERO, Vec3::X);
+        assert!(a.closest_hit(&m, &ray, 0.0, f32::INFINITY).is_none());
+        assert!(!a.occluded(&m, &ray, 0.0, f32::INFINITY));
+    }
+    let one_sphere = PrimSet {
+        spheres: vec![(Vec3::new(0.5, -0.25, 2.0), 0.75)],
+        triangles: vec![],
+    };
+    let rays = rays_for(&one_sphere, &mut rng, 1000);
+    assert!(assert_kinds_agree("one sphere", &one_sphere, &m, &rays) > 100);
+    let one_tri = PrimSet {
+        spheres: vec![],
+        triangles: vec![[
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 1.5),
+        ]],
+    };
+    let rays = rays_for(&one_tri, &mut rng, 1000);
+    assert!(assert_kinds_agree("one triangle", &one_tri, &m, &rays) > 50);
+}
+
+#[test]
+fn random_mixed_scenes_agree() {
+    let mut rng = Pcg::new(2);
+    let mut total_hits = 0;
+    for (spheres, triangles, size) in [
+        (5, 5, 0.5),
+        (50, 200, 0.3),
+        (300, 1500, 0.15),
+        (0, 800, 0.2),
+        (400, 0, 0.1),
+    ] {
+        let scene = random_scene(&mut rng, spheres, triangles, 2.0, size);
+        let rays = rays_for(&scene, &mut rng, 2000);
+        total_hits += assert_kinds_agree("random", &scene, &default_methods(), &rays);
+    }
+    assert!(total_hits > 3000, "too few hits to be a test: {total_hits}");
+    // The other methods agree across kinds too (well-conditioned scene).
+    let scene = random_scene(&mut rng, 40, 300, 2.0, 0.3);
+    let rays = rays_for(&scene, &mut rng, 1500);
+    for (sphere, triangle) in [
+        (SphereMethod::Lecture, TriangleMethod::Lecture),
+        (SphereMethod::Robust, TriangleMethod::MollerTrumbore),
+    ] {
+        let m = Methods {
+            sphere,
+            triangle,
+            ..Methods::default()
+        };
+        assert_kinds_agree("random, other methods", &scene, &m, &rays);
+    }
+}
+
+#[test]
+fn identical_triangles_tie_to_the_lowest_id() {
+    let mut rng = Pcg::new(3);
+    let tri = [
+        Vec3::new(-1.0, -1.0, 0.0),
+        Vec3::new(1.0, -1.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+    ];
+    let mut scene = PrimSet {
+        spheres: vec![(Vec3::new(0.0, 0.0, 3.0), 0.5)],
+        triangles: vec![tri; 3000],
+    };
+    // A second stack of identical copies elsewhere, and concentric spheres (nested boxes).
+    scene
+        .triangles
+        .extend(vec![tri.map(|v| v + Vec3::new(3.0, 0.0, 1.0)); 500]);
+    scene
+        .spheres
+        .extend((0..300).map(|i| (Vec3::new(-3.0, 0.0, 0.0), 0.1 + 0.01 * i as f32)));
+    let rays = rays_for(&scene, &mut rng, 1500);
+    assert!(assert_kinds_agree("identical", &scene, &default_methods(), &rays) > 300);
+    let bvh = Accel::build(AccelKind::Bvh, &scene);
+    assert!(
+        bvh.bvh_depth().is_some_and(|d| d < 32),
+        "BVH depth {:?}",
+        bvh.bvh_depth()
+    );
+    // Straight through the stack: the first copy (lowest id) wins in every kind.
+    let ray = Ray::new(Vec3::new(0.1, -0.2, -5.0), Vec3::Z);
+    for k in KINDS {
+        let hit = Accel::build(k, &scene)
+            .closest_hit(&default_methods(), &ray, 0.0, f32::INFINITY)
+            .expect("hit");
+        assert_eq!(
+            hit.prim,
+            300 + 1,
+            "{k:?}: first triangle id is spheres.len() = 301"
+        );
+    }
+}
+
+/// Dense near-ties across cells: a large slanted plane with a dust of small triangles and
+/// spheres just in front of it, and a few more layers a hair apart, so the nearest hit is often
+/// in the next cell, just past a hit found in the current one (catches a grid walk that stops
+/// too early or starts in the wrong cell).
+#[test]
+fn dust_in_front_of_layers() {
+    let mut rng = Pcg::new(9);
+    let mut scene = PrimSet::default();
+    for k in 0..5 {
+        let z = k as f32 * 2e-3;
+        scene.triangles.push([
+            Vec3::new(-2.5, -2.5, z),
+            Vec3::new(5.0, -2.5, z),
+            Vec3::new(-2.5, 5.0, z),
+        ]);
+    }
+    for _ in 0..3000 {
+        let c = rng.in_box(Vec3::new(-2.0, -2.0, -2e-3), Vec3::new(2.0, 2.0, -1e-4));
+        let (a, b) = (rng.unit() * 0.06, rng.unit() * 0.06);
+        let flat = Vec3::new(1.0, 1.0, 0.02);
+        scene.triangles.push([c, c + a * flat, c + b * flat]);
+    }
+    for _ in 0..200 {
+        let c = rng.in_box(Vec3::new(-2.0, -2.0, -0.3), Vec3::new(2.0, 2.0, 0.4));
+        scene.spheres.push((c, rng.range(0.005, 0.05)));
+    }
+    let mut rays = Vec::new();
+    for i in 0..4000 {
+        let o = rng.in_box(Vec3::new(-3.0, -3.0, -3.0), Vec3::new(3.0, 3.0, -0.5));
+        let target = rng.in_box(Vec3::new(-2.0, -2.0, 0.0), Vec3::new(2.0, 2.0, 0.0));
+        let d = (target - o).normalize();
+        let t_max = if i % 3 == 0 {
+            (target - o).length()
+        } else {
+            f32::INFINITY
+        };
+        rays.push((Ray::new(o, d), 0.0, t_max));
+    }
+    let hits = assert_kinds_agree("dust", &scene, &default_methods(), &rays);
+    assert!(hits > 3000, "hits {hits}");
+}
+
+/// STABILITY B2: 1e5 identical triangles build quickly into shallow structures of bounded size.
+#[test]
+fn hundred_thousand_identical_triangles() {
+    let tri = [
+        Vec3::new(-1.0, -1.0, 0.0),
+        Vec3::new(1.0, -1.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+    ];
+    let scene = PrimSet {
+        spheres: vec![],
+        triangles: vec![tri; 100_000],
+    };
+    let accels: Vec<Accel> = KINDS.iter().map(|&k| Accel::build(k, &scene)).collect();
+    assert!(
+        accels[2].bvh_depth().is_some_and(|d| d <= 12),
+        "{:?}",
+        accels[2].bvh_depth()
+    );
+    assert!(
+        accels[1].memory_bytes() < 64 << 20,
+        "grid uses {} bytes",
+        accels[1].memory_bytes()
+    );
+    let m = default_methods();
+    let mut rng = Pcg::new(10);
+    for _ in 0..20 {
+        let o = rng.unit() * 3.0;
+        let ray = Ray::new(o, (rng.unit() * 0.5 - o).normalize());
+        let expect = accels[0].closest_hit(&m, &ray, 0.0, f32::INFINITY);
+        assert!(expect.is_none_or(|h| h.prim == 0));
+        for a in &accels[1..] {
+            assert_eq!(
+                a.closest_hit(&m, &ray, 0.0, f32::INFINITY),
+                expect,
+                "{:?}",
+                a.kind()
+            );
+            assert_eq!(a.occluded(&m, &ray, 0.0, f32::INFINITY), expect.is_some());
+        }
+    }
+}
+
+#[test]
+fn accel_is_shareable_between_threads() {
+    fn assert_send_sync<T: Send + Sync>() {}
+    assert_send_sync::<Accel>();
+}
+
+#[test]
+fn flat_plane_and_axis_parallel_rays() {
+    let mut rng = Pcg::new(4);
+    let mut scene = PrimSet {
+        spheres: vec![
+            (Vec3::new(0.0, 1.0, 0.0), 1.0),
+            (Vec3::new(2.0, 0.5, -1.0), 0.5),
+        ],
+        triangles: plane(20, 10.0, 0.0),
+    };
+    let rays = rays_for(&scene, &mut rng, 2000);
+    assert!(assert_kinds_agree("plane + spheres", &scene, &default_methods(), &rays) > 500);
+    // The plane alone is perfectly flat: zero thickness on y.
+    scene.spheres.clear();
+    let mut rays = rays_for(&scene, &mut rng, 1000);
+    // Rays lying exactly in the plane and along grid lines.
+    for i in 0..200 {
+        let x = -5.0 + 0.5 * (i % 21) as f32;
+        let d = if i % 2 == 0 { Vec3::Z } else { Vec3::X };
+        rays.push((Ray::new(Vec3::new(x, 0.0, x), d), 0.0, f32::INFINITY));
+        rays.push((
+            Ray::new(
+                Vec3::new(x, 1.0, -6.0),
+                Vec3::new(0.0, -1.0, 1.0).normalize(),
+            ),
+            0.0,
+            f32::INFINITY,
+        ));
+    }
+    assert!(assert_kinds_agree("flat plane", &scene, &default_methods(), &rays) > 300);
+}
+
+#[test]
+fn huge_tiny_and_far_scales_agree() {
+    let mut rng = Pcg::new(5);
+    // A huge sphere under tiny triangles and spheres.
+    let mut scene = random_scene(&mut rng, 100, 400, 1.0, 1e-3);
+    scene.spheres.push((Vec3::new(0.0, -1e4 - 1.0, 0.0), 1e4));
+    scene.triangles.extend(plane(4, 1e4, -0.5));
+    let rays = rays_for(&scene, &mut rng, 2500);
+    assert_kinds_agree("huge + tiny", &scene, &default_methods(), &rays);
+    // Everything at scale 1e-3 (obvhs' own box test culls boxes closer than 1e-4).
+    let scene = random_scene(&mut rng, 50, 300, 1e-3, 2e-4);
+    let rays = rays_for(&scene, &mut rng, 2500);
+    assert!(assert_kinds_agree("scale 1e-3", &scene, &default_methods(), &rays) > 300);
+    // Far from the origin.
+    let mut scene = random_scene(&mut rng, 50, 300, 2.0, 0.3);
+    let off = Vec3::new(1e4, -3e3, 5e3);
+    scene.spheres.iter_mut().for_each(|(c, _)| *c += off);
+    scene
+        .triangles
+        .iter_mut()
+        .for_each(|t| t.iter_mut().for_each(|v| *v += off));
+    let rays = rays_for(&scene, &mut rng, 2500);
+    assert!(assert_kinds_agree("far", &scene, &default_methods(), &rays) > 300);
+}
+
+#[test]
+fn bad_primitives_are_skipped_and_counted() {
+    let mut rng = Pcg::new(6);
+    let mut scene = random_scene(&mut rng, 20, 200, 2.0, 0.3);
+    let bad_tris = [
+        [Vec3::NAN, Vec3::X, Vec3::Y],
+        [Vec3::ZERO, Vec3::X, 2.0 * Vec3::X],
+        [Vec3::ONE; 3],
+        [Vec3::splat(f32::INFINITY), Vec3::X, Vec3::Y],
+    ];
+    for (i, t) in bad_tris.iter().enumerate() {
+        scene.triangles.insert(3 + 40 * i, *t);
+    }
+    scene.spheres.insert(5, (Vec3::ZERO, -1.0));
+    scene.spheres.insert(7, (Vec3::NAN, 1.0));
+    scene.spheres.insert(9, (Vec3::ZERO, f32::INFINITY));
+    for k in KINDS {
+        let a = Accel::build(k, &scene);
+        assert_eq!(a.skipped_prims(), 7, "{k:?}");
+        assert_eq!(a.prim_count(), 220, "{k:?}");
+    }
+    let rays = rays_for(&scene, &mut rng, 2000);
+    assert!(assert_kinds_agree("bad prims", &scene, &default_methods(), &rays) > 300);
+    // Unusable rays hit nothing and never panic.
+    let a = Accel::build(AccelKind::Bvh, &scene);
+    let m = default_methods();
+    for ray in [
+        Ray::new(Vec3::NAN, Vec3::X),
+        Ray::new(Vec3::ZERO, Vec3::ZERO),
+        Ray::new(Vec3::ZERO, Vec3::new(f32::INFINITY, 0.0, 0.0)),
+    ] {
+        assert!(a.closest_hit(&m, &ray, 0.0, f32::INFINITY).is_none());
+        assert!(!a.occluded(&m, &ray, 0.0, f32::INFINITY));
+    }
+    assert!(
+        a.closest_hit(&m, &Ray::new(Vec3::ZERO, Vec3::X), 1.0, 1.0)
+            .is_none()
+    );
+    assert!(
+        a.closest_hit(&m, &Ray::new(Vec3::ZERO, Vec3::X), f32::NAN, 1.0)
+            .is_none()
+    );
+}
+
+#[test]
+fn auto_resolves_by_size() {
+    let mut rng = Pcg::new(7);
+    let small = random_scene(&mut rng, 3, AUTO_MIN_BVH_PRIMS - 4, 1.0, 0.2);
+    assert_eq!(
+        Accel::build(AccelKind::Auto, &small).kind(),
+        AccelKind::None
+    );
+    let big = random_scene(&mut rng, 3, AUTO_MIN_BVH_PRIMS, 1.0, 0.2);
+    let a = Accel::build(AccelKind::Auto, &big);
+    assert_eq!(a.kind(), AccelKind::Bvh);
+    assert!(a.memory_bytes() > 0);
+    assert_eq!(
+        Accel::build(AccelKind::Auto, &PrimSet::default()).kind(),
+        AccelKind::None
+    );
+}
+
+/// Rays from outside at the vertices and edges of a closed mesh never pass through it, through
+/// any accelerator (STABILITY T1: "0 leaks, including through the BVH").
+#[test]
+fn closed_mesh_has_no_leaks_through_any_accelerator() {
+    let mut rng = Pcg::new(8);
+    let m = default_methods();
+    for (scale, offset) in [
+        (1e-3f32, 0.0f32),
+        (1.0, 0.0),
+        (1e3, 0.0),
+        (1.0, 1e2),
+        (1e-2, 1e4),
+    ] {
+        // A closed mesh: an octahedron subdivided twice onto a sphere, moved off the origin.
+        let center = Vec3::new(0.3, -0.7, 0.2) * (offset * scale);
+        let (verts, idx) = octasphere(2, scale);
+        let verts: Vec<Vec3> = verts.iter().map(|v| *v + center).collect();
+        let scene = PrimSet {
+            spheres: vec![],
+            triangles: idx.iter().map(|t| t.map(|i| verts[i])).collect(),
+        };
+        let accels: Vec<Accel> = KINDS.iter().map(|&k| Accel::build(k, &scene)).collect();
+        let mut targets = verts.clone();
+        for t in &idx {
+            for k in 0..3 {
+                targets.push((verts[t[k]] + verts[t[(k + 1) % 3]]) * 0.5);
+            }
+        }
+        for p in targets {
+            for _ in 0..4 {
+                let out = ((p - center).normalize() + 0.05 * rng.unit()).normalize();
+                let origin = p + out * (scale * rng.range(0.5, 4.0));
+                let ray = Ray::new(origin, (p - origin).normalize());
+                let t_target = (p - origin).length();
+                for (a, k) in accels.iter().zip(KINDS) {
+                    let hit = a.closest_hit(&m, &ray, 0.0, f32::INFINITY);
+                    assert!(
+                        hit.is_some_and(|h| h.t < t_target + 0.1 * scale),
+                        "{k:?} leaks at scale {scale}, offset {offset}: {ray:?}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+fn octasphere(levels: u32, scale: f32) -> (Vec<Vec3>, Vec<[usize; 3]>) {
+    let mut verts: Vec<DVec3> = vec![
+        DVec3::X,
+        DVec3::NEG_X,
+        DVec3::Y,
+        DVec3::NEG_Y,
+        DVec3::Z,
+        DVec3::NEG_Z,
+    ];
+    let mut tris: Vec<[usize; 3]> = vec![
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    for _ in 0..levels {
+        let mut mid = std::collections::HashMap::new();
+        let mut next = Vec::new();
+        for [a, b, c] in tris {
+            let mut m = |x: usize, y: usize| {
+                *mid.entry((x.min(y), x.max(y))).or_insert_with(|| {
+                    verts.push(((verts[x] + verts[y]) * 0.5).normalize());
+                    verts.len() - 1
+                })
+            };
+            let (ab, bc, ca) = (m(a, b), m(b, c), m(c, a));
+            next.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
+        }
+        tris = next;
+    }
+    (verts.iter().map(|v| v.as_vec3() * scale).collect(), tris)
+}
