@@ -64,6 +64,14 @@ pub fn write_atomically(
         write(&mut out).map_err(|e| export_error(path, e))?;
         out.flush().map_err(|e| export_error(path, e))?;
     }
+    // Temporary files are private (0600); the result is an ordinary file like any other.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        tmp.as_file()
+            .set_permissions(std::fs::Permissions::from_mode(0o644))
+            .map_err(|e| export_error(path, e))?;
+    }
     tmp.as_file()
         .sync_all()
         .map_err(|e| export_error(path, e))?;
@@ -145,8 +153,10 @@ mod tests {
         assert_eq!(to_srgb8(Vec3::ZERO), [0, 0, 0]);
         assert_eq!(to_srgb8(Vec3::ONE), [255, 255, 255]);
         assert_eq!(to_srgb8(Vec3::splat(2.0)), [255, 255, 255]);
-        // Linear 0.214041 is sRGB 0.5 → 128.
-        assert_eq!(to_srgb8(Vec3::splat(0.214_041)), [128, 128, 128]);
+        // Linear 0.22 is sRGB 1.055·0.22^(1/2.4) − 0.055 = 0.50640 → 129.13 → 129.
+        assert_eq!(to_srgb8(Vec3::splat(0.22)), [129, 129, 129]);
+        // Below the linear segment's end: 12.92 · 0.002 = 0.02584 → 6.59 → 7.
+        assert_eq!(to_srgb8(Vec3::splat(0.002)), [7, 7, 7]);
         assert_eq!(to_srgb8(Vec3::splat(f32::NAN)), [0, 0, 0]);
     }
 

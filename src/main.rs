@@ -210,7 +210,8 @@ fn run_render(args: &RenderArgs) -> Result<()> {
     })?;
     bar.finish_and_clear();
 
-    let text = vec![
+    let text =
+        vec![
         ("Software".to_string(), format!("raytree {}", env!("CARGO_PKG_VERSION"))),
         ("raytree.scene".to_string(), args.scene.clone()),
         ("raytree.samples".to_string(), format!("{samples}/{samples}")),
@@ -268,7 +269,10 @@ fn run_tree(args: &TreeArgs) -> Result<()> {
     let (w, h) = (scene.render.width, scene.render.height);
     let (x, y) = args.pixel;
     if x >= w || y >= h {
-        bail!("pixel {x},{y} is outside the {w}x{h} image of {}", args.scene);
+        bail!(
+            "pixel {x},{y} is outside the {w}x{h} image of {}",
+            args.scene
+        );
     }
     let tracer = Tracer::new(Arc::new(scene), trace);
     let tree = ray_tree::pixel_tree(&tracer, x, y).context("the pixel has no tree")?;

@@ -239,6 +239,8 @@ impl Tracer {
 
     /// Traces one ray of `kind` at `depth` (the primary ray has depth 0) whose contribution to
     /// the pixel is scaled by `weight`; returns its colour.
+    // The hot path takes its tallies as plain arguments rather than a context struct.
+    #[allow(clippy::too_many_arguments)]
     pub fn trace<R: Recorder>(
         &self,
         ray: &Ray,
@@ -367,11 +369,14 @@ impl Tracer {
                 counts.count(RayKind::Shadow);
                 info.rays += 1;
                 let blocked = if R::ENABLED {
-                    let blocker = self.accel.closest_hit(self.methods(), &shadow_ray, 0.0, length);
+                    let blocker = self
+                        .accel
+                        .closest_hit(self.methods(), &shadow_ray, 0.0, length);
                     blocked_by = blocker.map(|b| self.object_of(b.prim));
                     blocker.is_some()
                 } else {
-                    self.accel.occluded(self.methods(), &shadow_ray, 0.0, length)
+                    self.accel
+                        .occluded(self.methods(), &shadow_ray, 0.0, length)
                 };
                 if !blocked {
                     diffuse += terms.diffuse;

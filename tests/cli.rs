@@ -24,18 +24,42 @@ fn renders_png_with_stats_and_stamps() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("quiz.png");
     let output = raytree()
-        .args(["render", "quiz", "--width", "41", "--height", "31", "--samples", "2", "-o"])
+        .args([
+            "render",
+            "quiz",
+            "--width",
+            "41",
+            "--height",
+            "31",
+            "--samples",
+            "2",
+            "-o",
+        ])
         .arg(&out)
         .output()
         .expect("runs");
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(stdout.contains("primary") && stdout.contains("shadow") && stdout.contains("Mrays/s"));
     // 41 × 31 pixels × 2 samples primary rays.
-    assert!(stdout.contains(&format!("{} primary", 41 * 31 * 2)), "{stdout}");
+    assert!(
+        stdout.contains(&format!("{} primary", 41 * 31 * 2)),
+        "{stdout}"
+    );
     let text = png_text(&out);
-    assert!(text.iter().any(|(k, v)| k == "raytree.samples" && v == "2/2"), "{text:?}");
-    assert!(text.iter().any(|(k, v)| k == "raytree.settings" && v.contains("max_depth")));
+    assert!(
+        text.iter()
+            .any(|(k, v)| k == "raytree.samples" && v == "2/2"),
+        "{text:?}"
+    );
+    assert!(
+        text.iter()
+            .any(|(k, v)| k == "raytree.settings" && v.contains("max_depth"))
+    );
 }
 
 #[test]
@@ -43,12 +67,18 @@ fn renders_exr() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("glass.exr");
     raytree()
-        .args(["render", "glass", "--width", "32", "--height", "24", "-q", "-o"])
+        .args([
+            "render", "glass", "--width", "32", "--height", "24", "-q", "-o",
+        ])
         .arg(&out)
         .assert()
         .success();
     let bytes = std::fs::read(&out).expect("exr written");
-    assert_eq!(&bytes[..4], &[0x76, 0x2f, 0x31, 0x01], "OpenEXR magic number");
+    assert_eq!(
+        &bytes[..4],
+        &[0x76, 0x2f, 0x31, 0x01],
+        "OpenEXR magic number"
+    );
 }
 
 #[test]
@@ -81,7 +111,10 @@ fn unwritable_output_fails_cleanly() {
         .expect("runs");
     assert!(!output.status.success());
     let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(stderr.starts_with("error: cannot write /nonexistent-folder/x.png"), "{stderr}");
+    assert!(
+        stderr.starts_with("error: cannot write /nonexistent-folder/x.png"),
+        "{stderr}"
+    );
     assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
     let output = raytree()
         .args(["render", "quiz", "-o", "x.jpg"])
@@ -93,11 +126,7 @@ fn unwritable_output_fails_cleanly() {
 
 #[test]
 fn out_of_range_options_are_refused() {
-    for args in [
-        ["--max-depth", "65"],
-        ["--width", "0"],
-        ["--samples", "0"],
-    ] {
+    for args in [["--max-depth", "65"], ["--width", "0"], ["--samples", "0"]] {
         raytree()
             .args(["render", "quiz", "-o", "x.png"])
             .args(args)
@@ -113,7 +142,11 @@ fn tree_prints_text_and_json() {
         .args(["tree", "quiz", "--pixel", "100,100", "--json"])
         .output()
         .expect("runs");
-    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
     let json: serde_json::Value = serde_json::from_slice(&output.stdout).expect("json");
     let hit = &json["root"]["hit"];
     let point: Vec<f64> = serde_json::from_value(hit["point"].clone()).expect("point");
@@ -126,7 +159,10 @@ fn tree_prints_text_and_json() {
         .output()
         .expect("runs");
     let text = String::from_utf8_lossy(&text.stdout);
-    assert!(text.contains("shadow ray to") && text.contains("barycentric"), "{text}");
+    assert!(
+        text.contains("shadow ray to") && text.contains("barycentric"),
+        "{text}"
+    );
     raytree()
         .args(["tree", "quiz", "--pixel", "5000,1"])
         .assert()
@@ -138,8 +174,17 @@ fn help_documents_the_options() {
     let output = raytree().args(["render", "--help"]).output().expect("runs");
     let help = String::from_utf8_lossy(&output.stdout);
     for flag in [
-        "--width", "--height", "--samples", "--max-depth", "--threads", "--accel", "--sphere",
-        "--triangle", "--offset", "--shading", "--cutoff",
+        "--width",
+        "--height",
+        "--samples",
+        "--max-depth",
+        "--threads",
+        "--accel",
+        "--sphere",
+        "--triangle",
+        "--offset",
+        "--shading",
+        "--cutoff",
     ] {
         assert!(help.contains(flag), "render --help lacks {flag}");
     }

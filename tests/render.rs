@@ -131,7 +131,11 @@ fn golden_images() {
                 .map(|(x, y)| x.abs_diff(*y))
                 .max()
                 .unwrap_or(0);
-            total_diff += a.iter().zip(b).map(|(x, y)| x.abs_diff(*y) as u64).sum::<u64>();
+            total_diff += a
+                .iter()
+                .zip(b)
+                .map(|(x, y)| x.abs_diff(*y) as u64)
+                .sum::<u64>();
             if d > 2 {
                 off_pixels += 1;
             }

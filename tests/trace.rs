@@ -146,7 +146,10 @@ fn lecture_quiz_numbers() {
             .unwrap_or_else(|| panic!("{method:?} misses the quiz triangle"));
         assert!((hit.t - 1.0).abs() < 1e-6, "{method:?} t = {}", hit.t);
         let (p, _) = triangle_hit_point(&a, hit.b1, hit.b2);
-        assert!(close(p, Vec3::new(0.0, 0.0, -1.0), 1e-6), "{method:?} P = {p}");
+        assert!(
+            close(p, Vec3::new(0.0, 0.0, -1.0), 1e-6),
+            "{method:?} P = {p}"
+        );
         let b = [1.0 - hit.b1 - hit.b2, hit.b1, hit.b2];
         for (got, want) in b.iter().zip([0.25, 0.25, 0.5]) {
             assert!((got - want).abs() < 1e-6, "{method:?} barycentric {b:?}");
@@ -188,7 +191,10 @@ fn lit_mirror_sphere_pixel_by_hand() {
     let expect = local + 0.5 * b.0.render.background.as_dvec3();
     for accel in [AccelKind::None, AccelKind::Grid, AccelKind::Bvh] {
         let got = b.pixel(2, 2, accel);
-        assert!(close(got, expect.as_vec3(), 1e-5), "{accel:?}: {got} vs {expect}");
+        assert!(
+            close(got, expect.as_vec3(), 1e-5),
+            "{accel:?}: {got} vs {expect}"
+        );
     }
     // A corner pixel misses everything: the background exactly.
     assert_eq!(b.pixel(0, 0, AccelKind::Bvh), b.0.render.background);
@@ -246,7 +252,10 @@ fn max_depth_zero_children_return_background() {
     let d0 = mirror_and_wall(0);
     let bg = d0.0.render.background;
     let got0 = d0.pixel(2, 2, AccelKind::None);
-    assert!(close(got0, mirror_local + 0.6 * bg, 1e-5), "depth 0: {got0}");
+    assert!(
+        close(got0, mirror_local + 0.6 * bg, 1e-5),
+        "depth 0: {got0}"
+    );
     let got1 = mirror_and_wall(1).pixel(2, 2, AccelKind::None);
     assert!(
         close(got1, mirror_local + 0.6 * wall_local, 1e-5),

@@ -198,6 +198,23 @@ fn watertight(v: &[Vec3; 3], ray: &Ray, t_min: f32, t_max: f32) -> Option<TriHit
     if !(t > t_min && t < t_max) {
         return None;
     }
+    // pbrt-v4: accept only a t conservatively greater than zero. A ray that starts on the
+    // triangle's plane (an offset origin of a flat, axis-aligned floor has a zero error bound
+    // along the normal) can otherwise compute a tiny positive t and shadow itself.
+    let (z0, z1, z2) = ((sz * p0z).abs(), (sz * p1z).abs(), (sz * p2z).abs());
+    let max_z = z0.max(z1).max(z2);
+    let max_x = p0x.abs().max(p1x.abs()).max(p2x.abs());
+    let max_y = p0y.abs().max(p1y.abs()).max(p2y.abs());
+    let delta_z = gamma(3) * max_z;
+    let delta_x = gamma(5) * (max_x + max_z);
+    let delta_y = gamma(5) * (max_y + max_z);
+    let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+    let max_e = e0.abs().max(e1.abs()).max(e2.abs());
+    let delta_t =
+        3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs();
+    if t <= delta_t {
+        return None;
+    }
     Some(TriHit {
         t,
         b1: e1 * inv_det,

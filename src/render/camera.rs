@@ -83,7 +83,9 @@ mod tests {
         let c = frame.ray(0.0, 0.0).dir;
         let expect = Vec3::new(-t * 101.0 / 51.0, t, -1.0).normalize();
         assert!((c - expect).length() < 1e-6, "{c} vs {expect}");
-        let (x, y) = frame.project(Vec3::new(1.0, 2.0, 3.0) + 5.0 * c).expect("in front");
+        let (x, y) = frame
+            .project(Vec3::new(1.0, 2.0, 3.0) + 5.0 * c)
+            .expect("in front");
         assert!(x.abs() < 1e-3 && y.abs() < 1e-3, "{x} {y}");
     }
 }

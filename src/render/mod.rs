@@ -24,20 +24,11 @@ pub use sampling::sample_offset;
 pub const TILE_SIZE: u32 = 32;
 
 /// How to render, beyond the scene's own `[render]` section.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct RenderSettings {
     pub trace: TraceSettings,
     /// Worker threads; 0 uses every core.
     pub threads: usize,
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        Self {
-            trace: TraceSettings::default(),
-            threads: 0,
-        }
-    }
 }
 
 /// A linear RGB image, row-major, y = 0 at the top.
@@ -90,7 +81,11 @@ pub fn tiles(width: u32, height: u32, size: u32) -> Vec<Rect> {
         let dy = r.y as f32 + r.height as f32 * 0.5 - cy;
         dx * dx + dy * dy
     };
-    out.sort_by(|a, b| dist(a).total_cmp(&dist(b)).then((a.y, a.x).cmp(&(b.y, b.x))));
+    out.sort_by(|a, b| {
+        dist(a)
+            .total_cmp(&dist(b))
+            .then((a.y, a.x).cmp(&(b.y, b.x)))
+    });
     out
 }
 

@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# The whole test suite, as CI runs it: formatting, lints, every test (in release: the tests
+# trace many rays), and the docs. Installs what it needs first.
+# Usage: bash scripts/test.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+source scripts/install-deps.sh
+export PATH="$HOME/.cargo/bin:$PATH"
+
+echo "== cargo fmt --check"
+cargo fmt --all -- --check
+echo "== cargo clippy"
+cargo clippy --release --all-targets --locked -- -D warnings
+echo "== cargo test (release)"
+cargo test --release --locked
+echo "== cargo doc"
+RUSTDOCFLAGS="-D warnings" cargo doc --release --no-deps --locked --quiet
