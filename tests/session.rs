@@ -29,7 +29,11 @@ fn collect(session: &Session, generation: u64, w: u32, h: u32) -> (Image, Vec<u3
             std::thread::sleep(Duration::from_millis(2));
             continue;
         };
-        assert_eq!(ev.generation(), generation, "an event of another generation: {ev:?}");
+        assert_eq!(
+            ev.generation(),
+            generation,
+            "an event of another generation: {ev:?}"
+        );
         match ev {
             SessionEvent::Tile(t) => {
                 for j in 0..t.rect.height {
@@ -58,7 +62,12 @@ fn converged_progressive_image_equals_batch_render() {
     let (img, passes) = collect(&session, generation, 96, 72);
     assert_eq!(passes, vec![1, 2, 4, 6]);
     let (batch, _) = render(&t, 6, 1, &|_, _| {}).expect("render");
-    let differing = img.pixels.iter().zip(&batch.pixels).filter(|(a, b)| a != b).count();
+    let differing = img
+        .pixels
+        .iter()
+        .zip(&batch.pixels)
+        .filter(|(a, b)| a != b)
+        .count();
     assert_eq!(differing, 0, "progressive and batch renders differ");
 }
 
@@ -85,5 +94,8 @@ fn restart_mid_pass_never_mixes_generations() {
     assert!(second > first);
     let (img, _) = collect(&session, second, 200, 150);
     let (batch, _) = render(&fast, 2, 0, &|_, _| {}).expect("render");
-    assert!(img == batch, "the second generation's image holds foreign pixels");
+    assert!(
+        img == batch,
+        "the second generation's image holds foreign pixels"
+    );
 }

@@ -101,7 +101,7 @@ impl FileBrowser {
             .collapsible(false)
             .show(ctx, |ui| {
                 ui.horizontal(|ui| {
-                    if ui.button("⬆ Up").clicked()
+                    if ui.button("Up").clicked()
                         && let Some(parent) = self.dir.parent()
                     {
                         go_to = Some(parent.to_path_buf());
@@ -111,26 +111,28 @@ impl FileBrowser {
                 if let Some(e) = &self.error {
                     ui.colored_label(egui::Color32::LIGHT_RED, e);
                 }
-                egui::ScrollArea::vertical().max_height(280.0).show(ui, |ui| {
-                    for (name, is_dir) in &self.entries {
-                        let label = if *is_dir {
-                            format!("📁 {name}")
-                        } else {
-                            name.clone()
-                        };
-                        let r = ui.selectable_label(self.name == *name, label);
-                        if r.clicked() {
-                            if *is_dir {
-                                go_to = Some(self.dir.join(name));
+                egui::ScrollArea::vertical()
+                    .max_height(280.0)
+                    .show(ui, |ui| {
+                        for (name, is_dir) in &self.entries {
+                            let label = if *is_dir {
+                                format!("{name}/")
                             } else {
-                                self.name = name.clone();
+                                name.clone()
+                            };
+                            let r = ui.selectable_label(self.name == *name, label);
+                            if r.clicked() {
+                                if *is_dir {
+                                    go_to = Some(self.dir.join(name));
+                                } else {
+                                    self.name = name.clone();
+                                }
+                            }
+                            if r.double_clicked() && !*is_dir {
+                                outcome = Outcome::Chose(self.purpose, self.dir.join(name));
                             }
                         }
-                        if r.double_clicked() && !*is_dir {
-                            outcome = Outcome::Chose(self.purpose, self.dir.join(name));
-                        }
-                    }
-                });
+                    });
                 ui.horizontal(|ui| {
                     ui.label("File:");
                     ui.text_edit_singleline(&mut self.name);

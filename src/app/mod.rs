@@ -113,7 +113,10 @@ pub struct ViewerApp {
 pub fn run(scene_arg: Option<&str>) -> anyhow::Result<()> {
     let (scene, label) = match scene_arg {
         Some(arg) => (load_scene_arg(arg)?, arg.to_string()),
-        None => (scene::builtin::load_builtin("default")?, "default".to_string()),
+        None => (
+            scene::builtin::load_builtin("default")?,
+            "default".to_string(),
+        ),
     };
     let options = eframe::NativeOptions {
         renderer: eframe::Renderer::Wgpu,
@@ -154,7 +157,11 @@ pub fn load_scene_arg(arg: &str) -> Result<Scene, scene::SceneError> {
 
 impl ViewerApp {
     /// The viewer over `scene`, drawing through the wgpu renderer of `cc`.
-    pub fn new(cc: &eframe::CreationContext<'_>, scene: Scene, label: String) -> Result<Self, String> {
+    pub fn new(
+        cc: &eframe::CreationContext<'_>,
+        scene: Scene,
+        label: String,
+    ) -> Result<Self, String> {
         let render_state = cc.wgpu_render_state.as_ref().ok_or_else(|| {
             "the viewer needs the wgpu renderer and no graphics adapter was found; use `raytree render SCENE -o out.png`".to_string()
         })?;
@@ -244,7 +251,11 @@ impl ViewerApp {
         let tracer = if rebuild || self.tracer.settings.accel != self.settings.trace.accel {
             Tracer::new(scene.clone(), self.settings.trace)
         } else {
-            Tracer::with_accel(scene.clone(), self.settings.trace, self.tracer.accel.clone())
+            Tracer::with_accel(
+                scene.clone(),
+                self.settings.trace,
+                self.tracer.accel.clone(),
+            )
         };
         self.tracer = Arc::new(tracer);
         if (w, h) != (self.scene.render.width, self.scene.render.height) {
@@ -379,7 +390,9 @@ impl ViewerApp {
                 Command::SaveScene(path) => {
                     let text = scene::scene_to_toml(&self.edit);
                     match export::write_text(&path, &text) {
-                        Ok(()) => self.messages.push((false, format!("saved {}", path.display()))),
+                        Ok(()) => self
+                            .messages
+                            .push((false, format!("saved {}", path.display()))),
                         Err(e) => self.error(e.to_string()),
                     }
                 }
@@ -388,7 +401,9 @@ impl ViewerApp {
                     Some(tree) => {
                         let json = serde_json::to_string_pretty(tree).unwrap_or_default();
                         match export::write_text(&path, &json) {
-                            Ok(()) => self.messages.push((false, format!("saved {}", path.display()))),
+                            Ok(()) => self
+                                .messages
+                                .push((false, format!("saved {}", path.display()))),
                             Err(e) => self.error(e.to_string()),
                         }
                     }
@@ -397,8 +412,11 @@ impl ViewerApp {
                 Command::Pick(x, y) => {
                     self.tree = pixel_tree(&self.tracer, x, y);
                     if let Some(hit) = self.tree.as_ref().and_then(|t| t.root.hit.as_ref()) {
-                        self.selected_material =
-                            self.scene.materials.iter().position(|m| m.name == hit.material);
+                        self.selected_material = self
+                            .scene
+                            .materials
+                            .iter()
+                            .position(|m| m.name == hit.material);
                     }
                 }
                 Command::FrameAll => {
@@ -430,7 +448,8 @@ impl ViewerApp {
     /// Writes the film at full resolution (never a window grab), stamped with its progress.
     fn export(&mut self, path: &Path) {
         let target = self.scene.render.samples;
-        let text = vec![
+        let text =
+            vec![
             ("Software".to_string(), format!("raytree {}", env!("CARGO_PKG_VERSION"))),
             ("raytree.scene".to_string(), self.scene_label.clone()),
             (
@@ -516,7 +535,10 @@ impl ViewerApp {
 
     /// Draws the render fitted into `ui`'s space and handles orbit, pan, zoom, click and hover.
     fn viewport(&mut self, ui: &mut egui::Ui) {
-        let (w, h) = (self.scene.render.width as f32, self.scene.render.height as f32);
+        let (w, h) = (
+            self.scene.render.width as f32,
+            self.scene.render.height as f32,
+        );
         let avail = ui.available_rect_before_wrap();
         if avail.width() < 1.0 || avail.height() < 1.0 {
             return; // a zero-area window: nothing to draw
@@ -525,12 +547,15 @@ impl ViewerApp {
         let size = egui::vec2(w * scale, h * scale);
         let rect = egui::Rect::from_center_size(avail.center(), size);
         let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
-        ui.painter().add(eframe::egui_wgpu::Callback::new_paint_callback(
-            rect,
-            DisplayCallback {
-                shared: self.display.clone(),
-            },
-        ));
+        response
+            .widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, "render viewport"));
+        ui.painter()
+            .add(eframe::egui_wgpu::Callback::new_paint_callback(
+                rect,
+                DisplayCallback {
+                    shared: self.display.clone(),
+                },
+            ));
         let to_pixel = |p: egui::Pos2| {
             let x = ((p.x - rect.min.x) / scale).floor();
             let y = ((p.y - rect.min.y) / scale).floor();
@@ -625,9 +650,11 @@ impl ViewerApp {
             (d.params.raw, d.params.exposure, d.params.tonemap)
         };
         let want_raw = self.prefs.mode != ImageMode::Render;
-        if mode != want_raw || exposure != self.prefs.exposure || tonemap != self.prefs.tonemap {
-            self.refresh_display();
-        } else if want_raw && self.last_mode != self.prefs.mode {
+        if mode != want_raw
+            || exposure != self.prefs.exposure
+            || tonemap != self.prefs.tonemap
+            || (want_raw && self.last_mode != self.prefs.mode)
+        {
             self.refresh_display();
         }
         self.last_mode = self.prefs.mode;

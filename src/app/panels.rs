@@ -79,12 +79,21 @@ pub fn frame_all(scene: &mut Scene) {
 
 // ---- small widgets ------------------------------------------------------------------------
 
+/// A label and a drag value named by it (for screen readers and UI tests).
+fn drag(ui: &mut Ui, label: &str, value: DragValue<'_>) -> bool {
+    let l = ui.label(label);
+    ui.add(value).labelled_by(l.id).changed()
+}
+
 fn vec3_edit(ui: &mut Ui, label: &str, v: &mut Vec3, speed: f32) -> bool {
     let mut changed = false;
     ui.horizontal(|ui| {
-        ui.label(label);
+        let l = ui.label(label);
         for c in [&mut v.x, &mut v.y, &mut v.z] {
-            changed |= ui.add(DragValue::new(c).speed(speed).max_decimals(4)).changed();
+            changed |= ui
+                .add(DragValue::new(c).speed(speed).max_decimals(4))
+                .labelled_by(l.id)
+                .changed();
         }
     });
     changed
@@ -93,14 +102,24 @@ fn vec3_edit(ui: &mut Ui, label: &str, v: &mut Vec3, speed: f32) -> bool {
 fn color_edit(ui: &mut Ui, label: &str, v: &mut Vec3) -> bool {
     let mut changed = false;
     ui.horizontal(|ui| {
-        ui.label(label);
+        let l = ui.label(label);
         for c in [&mut v.x, &mut v.y, &mut v.z] {
             changed |= ui
-                .add(DragValue::new(c).speed(0.01).range(0.0..=100.0).max_decimals(3))
+                .add(
+                    DragValue::new(c)
+                        .speed(0.01)
+                        .range(0.0..=100.0)
+                        .max_decimals(3),
+                )
+                .labelled_by(l.id)
                 .changed();
         }
         let mut rgb = [v.x.min(1.0), v.y.min(1.0), v.z.min(1.0)];
-        if ui.color_edit_button_rgb(&mut rgb).changed() {
+        if ui
+            .color_edit_button_rgb(&mut rgb)
+            .labelled_by(l.id)
+            .changed()
+        {
             *v = Vec3::from(rgb);
             changed = true;
         }
@@ -131,7 +150,7 @@ pub fn top_bar(app: &mut ViewerApp, ui: &mut Ui) {
     egui::Panel::top("menu").show(ui, |ui| {
         egui::MenuBar::new().ui(ui, |ui| {
             ui.menu_button("Scene", |ui| {
-                if ui.button("Open… (Ctrl+O)").clicked() {
+                if ui.button("Open... (Ctrl+O)").clicked() {
                     app.browser = Some(FileBrowser::new(BrowseFor::Open, app.start_dir(), ""));
                 }
                 ui.menu_button("Built-in", |ui| {
@@ -141,11 +160,15 @@ pub fn top_bar(app: &mut ViewerApp, ui: &mut Ui) {
                         }
                     }
                 });
-                if ui.button("Save scene as…").clicked() {
+                if ui.button("Save scene as...").clicked() {
                     let name = format!("{}.toml", app.file_stem());
-                    app.browser = Some(FileBrowser::new(BrowseFor::SaveScene, app.start_dir(), &name));
+                    app.browser = Some(FileBrowser::new(
+                        BrowseFor::SaveScene,
+                        app.start_dir(),
+                        &name,
+                    ));
                 }
-                if ui.button("Export render… (Ctrl+S)").clicked() {
+                if ui.button("Export render... (Ctrl+S)").clicked() {
                     let name = format!("{}.png", app.file_stem());
                     app.browser = Some(FileBrowser::new(BrowseFor::Export, app.start_dir(), &name));
                 }
@@ -164,9 +187,13 @@ pub fn top_bar(app: &mut ViewerApp, ui: &mut Ui) {
         let mut dismiss = None;
         for (i, (is_error, msg)) in app.messages.iter().enumerate().rev().take(3) {
             ui.horizontal(|ui| {
-                let color = if *is_error { Color32::LIGHT_RED } else { Color32::LIGHT_YELLOW };
+                let color = if *is_error {
+                    Color32::LIGHT_RED
+                } else {
+                    Color32::LIGHT_YELLOW
+                };
                 ui.colored_label(color, msg);
-                if ui.small_button("✕").clicked() {
+                if ui.small_button("x").clicked() {
                     dismiss = Some(i);
                 }
             });
@@ -248,85 +275,113 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                 )
                 .changed();
             ui.horizontal(|ui| {
-                ui.label("size");
-                restart |= ui.add(DragValue::new(&mut r.width).range(1..=8192)).changed();
-                ui.label("×");
-                restart |= ui.add(DragValue::new(&mut r.height).range(1..=8192)).changed();
+                restart |= drag(ui, "width", DragValue::new(&mut r.width).range(1..=8192));
+                restart |= drag(ui, "height", DragValue::new(&mut r.height).range(1..=8192));
             });
-            restart |= combo(ui, "shading", &mut r.shading, &[Shading::BlinnPhong, Shading::Phong]);
+            restart |= combo(
+                ui,
+                "shading",
+                &mut r.shading,
+                &[Shading::BlinnPhong, Shading::Phong],
+            );
             restart |= color_edit(ui, "background", &mut r.background);
             restart |= color_edit(ui, "ambient light", &mut r.ambient_light);
             let t = &mut app.settings.trace;
-            restart |= combo(ui, "sphere", &mut t.methods.sphere, &[SphereMethod::Robust, SphereMethod::Lecture]);
+            restart |= combo(
+                ui,
+                "sphere",
+                &mut t.methods.sphere,
+                &[SphereMethod::Robust, SphereMethod::Lecture],
+            );
             restart |= combo(
                 ui,
                 "triangle",
                 &mut t.methods.triangle,
-                &[TriangleMethod::Watertight, TriangleMethod::MollerTrumbore, TriangleMethod::Lecture],
+                &[
+                    TriangleMethod::Watertight,
+                    TriangleMethod::MollerTrumbore,
+                    TriangleMethod::Lecture,
+                ],
             );
             restart |= combo(
                 ui,
                 "offset",
                 &mut t.methods.offset,
-                &[OffsetMethod::ErrorBound, OffsetMethod::NormalScaled, OffsetMethod::Fixed],
+                &[
+                    OffsetMethod::ErrorBound,
+                    OffsetMethod::NormalScaled,
+                    OffsetMethod::Fixed,
+                ],
             );
             rebuild |= combo(
                 ui,
                 "accelerator",
                 &mut t.accel,
-                &[AccelKind::Auto, AccelKind::None, AccelKind::Grid, AccelKind::Bvh],
+                &[
+                    AccelKind::Auto,
+                    AccelKind::None,
+                    AccelKind::Grid,
+                    AccelKind::Bvh,
+                ],
             );
             ui.horizontal(|ui| {
-                ui.label("weight cutoff");
-                restart |= ui.add(DragValue::new(&mut t.cutoff).speed(0.001).range(0.0..=0.99)).changed();
+                restart |= drag(
+                    ui,
+                    "weight cutoff",
+                    DragValue::new(&mut t.cutoff).speed(0.001).range(0.0..=0.99),
+                );
             });
             ui.horizontal(|ui| {
-                ui.label("threads (0 = all)");
-                restart |= ui.add(DragValue::new(&mut app.settings.threads).range(0..=256)).changed();
+                restart |= drag(
+                    ui,
+                    "threads (0 = all)",
+                    DragValue::new(&mut app.settings.threads).range(0..=256),
+                );
             });
             ui.label(format!("accelerator in use: {:?}", app.tracer.accel.kind()));
         });
-    egui::CollapsingHeader::new("Display").default_open(true).show(ui, |ui| {
-        ui.horizontal(|ui| {
-            ui.label("image");
-            egui::ComboBox::from_id_salt("mode")
+    egui::CollapsingHeader::new("Display")
+        .default_open(true)
+        .show(ui, |ui| {
+            egui::ComboBox::from_label("image")
                 .selected_text(app.prefs.mode.label())
                 .show_ui(ui, |ui| {
                     for m in ImageMode::ALL {
                         ui.selectable_value(&mut app.prefs.mode, m, m.label());
                     }
                 });
-        });
-        ui.horizontal(|ui| {
-            ui.label("exposure");
-            ui.add(egui::Slider::new(&mut app.prefs.exposure, 0.01..=16.0).logarithmic(true));
-        });
-        ui.horizontal(|ui| {
-            ui.label("tonemap");
-            ui.radio_value(&mut app.prefs.tonemap, 0, "clamp");
-            ui.radio_value(&mut app.prefs.tonemap, 1, "Reinhard");
-            ui.radio_value(&mut app.prefs.tonemap, 2, "ACES");
-        });
-        if app.prefs.mode == ImageMode::Termination {
-            for (label, (r, g, b)) in TERMINATION_LEGEND {
-                ui.colored_label(Color32::from_rgb(r, g, b), format!("■ {label}"));
+            ui.add(
+                egui::Slider::new(&mut app.prefs.exposure, 0.01..=16.0)
+                    .logarithmic(true)
+                    .text("exposure"),
+            );
+            ui.horizontal(|ui| {
+                ui.label("tonemap");
+                ui.radio_value(&mut app.prefs.tonemap, 0, "clamp");
+                ui.radio_value(&mut app.prefs.tonemap, 1, "Reinhard");
+                ui.radio_value(&mut app.prefs.tonemap, 2, "ACES");
+            });
+            if app.prefs.mode == ImageMode::Termination {
+                for (label, (r, g, b)) in TERMINATION_LEGEND {
+                    ui.colored_label(Color32::from_rgb(r, g, b), format!("# {label}"));
+                }
             }
-        }
-    });
-    egui::CollapsingHeader::new("Camera").default_open(true).show(ui, |ui| {
-        let c = &mut app.edit.camera;
-        restart |= vec3_edit(ui, "position", &mut c.position, 0.05);
-        restart |= vec3_edit(ui, "look at ", &mut c.look_at, 0.05);
-        restart |= vec3_edit(ui, "up      ", &mut c.up, 0.01);
-        ui.horizontal(|ui| {
-            ui.label("fov y (°)");
-            restart |= ui.add(egui::Slider::new(&mut c.fov_y_deg, 1.0..=170.0)).changed();
         });
-        if ui.button("Frame all").clicked() {
-            app.pending.push(Command::FrameAll);
-        }
-        ui.small("drag: orbit · right/middle drag: pan · wheel: zoom");
-    });
+    egui::CollapsingHeader::new("Camera")
+        .default_open(true)
+        .show(ui, |ui| {
+            let c = &mut app.edit.camera;
+            restart |= vec3_edit(ui, "position", &mut c.position, 0.05);
+            restart |= vec3_edit(ui, "look at ", &mut c.look_at, 0.05);
+            restart |= vec3_edit(ui, "up      ", &mut c.up, 0.01);
+            restart |= ui
+                .add(egui::Slider::new(&mut c.fov_y_deg, 1.0..=170.0).text("fov y (°)"))
+                .changed();
+            if ui.button("Frame all").clicked() {
+                app.pending.push(Command::FrameAll);
+            }
+            ui.small("drag: orbit · right/middle drag: pan · wheel: zoom");
+        });
     egui::CollapsingHeader::new(format!("Lights ({})", app.edit.lights.len()))
         .default_open(true)
         .show(ui, |ui| {
@@ -340,8 +395,11 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                         restart |= vec3_edit(ui, "position", &mut l.position, 0.05);
                         restart |= color_edit(ui, "colour", &mut l.color);
                         ui.horizontal(|ui| {
-                            ui.label("radius");
-                            restart |= ui.add(DragValue::new(&mut l.radius).speed(0.01).range(0.0..=1e6)).changed();
+                            restart |= drag(
+                                ui,
+                                "radius",
+                                DragValue::new(&mut l.radius).speed(0.01).range(0.0..=1e6),
+                            );
                         });
                         if ui.button("Remove").clicked() {
                             remove = Some(i);
@@ -371,30 +429,36 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
             for (i, m) in app.edit.materials.iter_mut().enumerate() {
                 let selected = app.selected_material == Some(i);
                 let title = if selected {
-                    RichText::new(format!("▶ {}", m.name)).strong()
+                    RichText::new(format!("> {}", m.name)).strong()
                 } else {
                     RichText::new(&m.name)
                 };
                 let header = egui::CollapsingHeader::new(title).id_salt(("material", i));
-                let header = if selected { header.open(Some(true)) } else { header };
+                let header = if selected {
+                    header.open(Some(true))
+                } else {
+                    header
+                };
                 header.show(ui, |ui| restart |= material_editor(ui, m));
             }
         });
-    egui::CollapsingHeader::new("Scene").default_open(false).show(ui, |ui| {
-        let s = &app.scene;
-        ui.label(format!(
-            "{} spheres, {} triangles, {} lights, {} materials",
-            s.spheres.len(),
-            s.triangles.len(),
-            s.lights.len(),
-            s.materials.len()
-        ));
-        for name in builtin::NAMES {
-            if ui.button(format!("Open built-in “{name}”")).clicked() {
-                app.pending.push(Command::OpenBuiltin(name.to_string()));
+    egui::CollapsingHeader::new("Scene")
+        .default_open(false)
+        .show(ui, |ui| {
+            let s = &app.scene;
+            ui.label(format!(
+                "{} spheres, {} triangles, {} lights, {} materials",
+                s.spheres.len(),
+                s.triangles.len(),
+                s.lights.len(),
+                s.materials.len()
+            ));
+            for name in builtin::NAMES {
+                if ui.button(format!("Open built-in \"{name}\"")).clicked() {
+                    app.pending.push(Command::OpenBuiltin(name.to_string()));
+                }
             }
-        }
-    });
+        });
     if rebuild {
         app.pending.push(Command::Rebuild);
     } else if restart {
@@ -410,10 +474,18 @@ fn material_editor(ui: &mut Ui, m: &mut Material) -> bool {
     changed |= color_edit(ui, "reflect kr ", &mut m.reflectivity);
     changed |= color_edit(ui, "transmit kt", &mut m.transparency);
     ui.horizontal(|ui| {
-        ui.label("shininess");
-        changed |= ui.add(DragValue::new(&mut m.shininess).speed(0.5).range(0.0..=10000.0)).changed();
-        ui.label("ior");
-        changed |= ui.add(DragValue::new(&mut m.ior).speed(0.01).range(0.01..=10.0)).changed();
+        changed |= drag(
+            ui,
+            "shininess",
+            DragValue::new(&mut m.shininess)
+                .speed(0.5)
+                .range(0.0..=10000.0),
+        );
+        changed |= drag(
+            ui,
+            "ior",
+            DragValue::new(&mut m.ior).speed(0.01).range(0.01..=10.0),
+        );
     });
     changed
 }
@@ -426,10 +498,10 @@ fn fmt3(v: Vec3) -> String {
 
 fn end_label(end: EndReason) -> &'static str {
     match end {
-        EndReason::NoHit => "no hit → background",
-        EndReason::HitLight => "hit a light → its colour",
-        EndReason::MaxDepth => "past max depth → background",
-        EndReason::Cutoff => "below weight cutoff → background",
+        EndReason::NoHit => "no hit -> background",
+        EndReason::HitLight => "hit a light -> its colour",
+        EndReason::MaxDepth => "past max depth -> background",
+        EndReason::Cutoff => "below weight cutoff -> background",
     }
 }
 
@@ -438,8 +510,11 @@ pub fn tree_panel(app: &mut ViewerApp, ui: &mut Ui) {
         return;
     };
     ui.horizontal(|ui| {
-        ui.heading(format!("Ray tree of ({}, {})", tree.pixel[0], tree.pixel[1]));
-        if ui.small_button("✕").clicked() {
+        ui.heading(format!(
+            "Ray tree of ({}, {})",
+            tree.pixel[0], tree.pixel[1]
+        ));
+        if ui.small_button("x").clicked() {
             app.tree = None;
         }
     });
@@ -449,9 +524,13 @@ pub fn tree_panel(app: &mut ViewerApp, ui: &mut Ui) {
         tree.nodes,
         if tree.truncated { " (truncated)" } else { "" }
     ));
-    if ui.button("Export tree as JSON…").clicked() {
+    if ui.button("Export tree as JSON...").clicked() {
         let name = format!("tree-{}-{}.json", tree.pixel[0], tree.pixel[1]);
-        app.browser = Some(FileBrowser::new(BrowseFor::ExportTree, app.start_dir(), &name));
+        app.browser = Some(FileBrowser::new(
+            BrowseFor::ExportTree,
+            app.start_dir(),
+            &name,
+        ));
     }
     egui::ScrollArea::vertical().show(ui, |ui| node_ui(ui, &tree.root, "0"));
 }
@@ -468,8 +547,12 @@ fn node_ui(ui: &mut Ui, node: &Node, path: &str) {
         (None, Some(hit)) => format!("{} ({})", hit.object, hit.material),
         _ => String::new(),
     };
-    let title = RichText::new(format!("{kind} d{} · {what} · {}", node.depth, fmt3(node.color)))
-        .color(kind_color(node.kind));
+    let title = RichText::new(format!(
+        "{kind} d{} · {what} · {}",
+        node.depth,
+        fmt3(node.color)
+    ))
+    .color(kind_color(node.kind));
     egui::CollapsingHeader::new(title)
         .id_salt(path)
         .default_open(node.depth < 2)
@@ -520,7 +603,13 @@ fn node_ui(ui: &mut Ui, node: &Node, path: &str) {
 }
 
 /// Draws the tree's rays over the image, projected with the render camera.
-pub fn draw_tree_overlay(painter: &egui::Painter, rect: egui::Rect, scale: f32, scene: &Scene, tree: &RayTree) {
+pub fn draw_tree_overlay(
+    painter: &egui::Painter,
+    rect: egui::Rect,
+    scale: f32,
+    scene: &Scene,
+    tree: &RayTree,
+) {
     let frame = CameraFrame::new(&scene.camera, scene.render.width, scene.render.height);
     let to_screen = |p: Vec3| {
         frame
@@ -556,7 +645,10 @@ pub fn draw_tree_overlay(painter: &egui::Painter, rect: egui::Rect, scale: f32, 
                 to_screen(hit.point),
                 to_screen(hit.point + hit.normal * scene_extent(scene) * 0.03),
             ) {
-                painter.line_segment([a, b], egui::Stroke::new(1.5, Color32::from_rgb(255, 0, 255)));
+                painter.line_segment(
+                    [a, b],
+                    egui::Stroke::new(1.5, Color32::from_rgb(255, 0, 255)),
+                );
             }
         }
         stack.extend(node.children.iter());
@@ -580,7 +672,10 @@ pub fn help_window(ctx: &egui::Context, open: &mut bool) {
                 ("Wheel", "zoom"),
                 ("Click", "ray tree of that pixel; selects its material"),
                 ("Ctrl+S", "export the render (PNG or EXR, full resolution)"),
-                ("Ctrl+O", "open a scene or OBJ (or drop the file on the window)"),
+                (
+                    "Ctrl+O",
+                    "open a scene or OBJ (or drop the file on the window)",
+                ),
                 ("Esc", "stop rendering"),
                 ("F1", "this help"),
             ] {

@@ -60,6 +60,10 @@ impl DisplayState {
     }
 
     pub fn mark(&mut self, rect: Rect) {
+        // While nothing paints (a hidden window), one full upload beats a growing list.
+        if self.dirty.len() >= 4096 {
+            self.mark_all();
+        }
         if !self.full {
             self.dirty.push(rect);
         }
@@ -163,11 +167,7 @@ impl GpuDisplay {
             texture: None,
             encode_srgb: !render_state.target_format.is_srgb(),
         };
-        render_state
-            .renderer
-            .write()
-            .callback_resources
-            .insert(gpu);
+        render_state.renderer.write().callback_resources.insert(gpu);
     }
 
     fn ensure_texture(&mut self, device: &wgpu::Device, width: u32, height: u32) -> bool {

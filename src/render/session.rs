@@ -61,11 +61,20 @@ pub struct TileUpdate {
 pub enum SessionEvent {
     Tile(TileUpdate),
     /// Every tile of a pass has been sent.
-    PassDone { generation: u64, pass: Pass },
+    PassDone {
+        generation: u64,
+        pass: Pass,
+    },
     /// The target sample count is reached.
-    Finished { generation: u64, secs: f64 },
+    Finished {
+        generation: u64,
+        secs: f64,
+    },
     /// A worker panicked; the render of this generation stopped.
-    Failed { generation: u64, message: String },
+    Failed {
+        generation: u64,
+        message: String,
+    },
 }
 
 impl SessionEvent {
@@ -111,7 +120,8 @@ impl LiveStats {
 /// The sample ranges of the passes after the preview: [0,1), [1,2), [2,4), [4,8), … ending at
 /// `target`.
 pub fn sample_batches(target: u32) -> Vec<std::ops::Range<u32>> {
-    let mut out = vec![0..1.min(target)];
+    let mut out = Vec::new();
+    out.push(0..1.min(target));
     let mut done = 1;
     while done < target {
         let next = (done * 2).min(target);
