@@ -6,9 +6,13 @@ set -euo pipefail
 SUDO=""
 if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
 
-# System packages: a C toolchain for crates with build scripts.
+# System packages: a C toolchain for crates with build scripts; the X11/Wayland client
+# libraries the window needs; Mesa's software Vulkan (lavapipe) so the viewer and its tests run
+# without a GPU; Xvfb to run the window without a display.
 need=()
-for pkg in build-essential pkg-config curl ca-certificates; do
+for pkg in build-essential pkg-config curl ca-certificates \
+  libvulkan1 mesa-vulkan-drivers libxkbcommon-x11-0 libx11-xcb1 libxcursor1 libxi6 libxrandr2 \
+  libwayland-client0 libwayland-cursor0 libgl1 xvfb; do
   dpkg -s "$pkg" >/dev/null 2>&1 || need+=("$pkg")
 done
 if [ ${#need[@]} -gt 0 ]; then

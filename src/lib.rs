@@ -8,6 +8,7 @@
 //! no-op one.
 
 pub mod accel;
+pub mod app;
 pub mod export;
 pub mod geometry;
 pub mod ray_tree;

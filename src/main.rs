@@ -22,7 +22,7 @@ use raytree::{export, ray_tree};
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
-    /// Scene to open in the viewer (not built yet: use `raytree render`).
+    /// Scene to open in the viewer (default: the built-in default scene).
     scene: Option<String>,
 }
 
@@ -297,10 +297,7 @@ fn run(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
-        None => bail!(
-            "the interactive viewer is not built yet; render with `raytree render {} -o out.png`",
-            cli.scene.as_deref().unwrap_or("default")
-        ),
+        None => raytree::app::run(cli.scene.as_deref()),
     }
 }
 

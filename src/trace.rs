@@ -80,12 +80,16 @@ impl RayCounts {
     }
 }
 
-/// Per-sample facts for the image modes: the deepest ray traced, how the primary ray's
-/// branch ended and the rays traced.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// Per-sample facts for the image modes: the deepest ray traced, the rays traced (shadow rays
+/// included), every way its branches ended, and the normal at the primary hit.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SampleInfo {
     pub depth_reached: u32,
     pub rays: u32,
+    /// Bit `1 << reason as u8` for each [`EndReason`] met anywhere in the tree.
+    pub ends: u8,
+    /// Unit normal (turned towards the camera) at the primary hit; zero when it met no surface.
+    pub normal: Vec3,
 }
 
 /// The surface a ray met, as the tree shows it.
@@ -168,7 +172,9 @@ pub fn prim_set(scene: &Scene) -> PrimSet {
 /// A scene made ready to trace: the immutable snapshot workers read.
 pub struct Tracer {
     pub scene: Arc<Scene>,
-    pub accel: Accel,
+    /// Shared, so edits that leave the geometry alone (camera, lights, materials, methods)
+    /// reuse it instead of rebuilding.
+    pub accel: Arc<Accel>,
     pub settings: TraceSettings,
     /// Lights with a radius, which end the rays that meet them.
     visible_lights: Vec<usize>,
@@ -185,8 +191,16 @@ enum Found {
 impl Tracer {
     pub fn new(scene: Arc<Scene>, settings: TraceSettings) -> Self {
         let start = std::time::Instant::now();
-        let accel = Accel::build(settings.accel, &prim_set(&scene));
+        let accel = Arc::new(Accel::build(settings.accel, &prim_set(&scene)));
         let build_secs = start.elapsed().as_secs_f64();
+        let mut tracer = Self::with_accel(scene, settings, accel);
+        tracer.build_secs = build_secs;
+        tracer
+    }
+
+    /// A tracer over an accelerator already built for this scene's spheres and triangles
+    /// (the caller guarantees the geometry and `settings.accel` are unchanged).
+    pub fn with_accel(scene: Arc<Scene>, settings: TraceSettings, accel: Arc<Accel>) -> Self {
         let visible_lights = (0..scene.lights.len())
             .filter(|&i| scene.lights[i].radius > 0.0)
             .collect();
@@ -195,7 +209,7 @@ impl Tracer {
             accel,
             settings,
             visible_lights,
-            build_secs,
+            build_secs: 0.0,
         }
     }
 
@@ -257,10 +271,12 @@ impl Tracer {
         let background = self.scene.render.background;
         if depth > self.scene.render.max_depth {
             rec.end(EndReason::MaxDepth);
+            info.ends |= 1 << EndReason::MaxDepth as u8;
             return background;
         }
         if weight.max_element() < self.settings.cutoff {
             rec.end(EndReason::Cutoff);
+            info.ends |= 1 << EndReason::Cutoff as u8;
             return background;
         }
         counts.count(kind);
@@ -269,10 +285,12 @@ impl Tracer {
         match self.intersect(ray) {
             Found::Nothing => {
                 rec.end(EndReason::NoHit);
+                info.ends |= 1 << EndReason::NoHit as u8;
                 background
             }
             Found::Light(i) => {
                 rec.end(EndReason::HitLight);
+                info.ends |= 1 << EndReason::HitLight as u8;
                 self.scene.lights[i].color
             }
             Found::Prim(hit) => self.shade(ray, &hit, depth, weight, counts, info, rec),
@@ -327,6 +345,9 @@ impl Tracer {
         let (p, n) = (surface.point, surface.normal);
         let v = -ray.dir;
         rec.hit(&surface, v);
+        if depth == 0 {
+            info.normal = n;
+        }
         let material = scene.material(surface.material);
 
         let ambient = ambient_term(material, scene.render.ambient_light);

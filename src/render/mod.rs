@@ -4,6 +4,7 @@
 
 pub mod camera;
 pub mod sampling;
+pub mod session;
 
 use std::ops::Range;
 use std::panic::{AssertUnwindSafe, catch_unwind};

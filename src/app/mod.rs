@@ -1,0 +1,673 @@
+//! The desktop viewer (SPEC §5): the only module that uses egui, eframe and wgpu.
+//!
+//! State is split as egui apps do: [`Prefs`] is persisted UI state (serde); the session, the
+//! GPU display and the tracer are runtime resources. Panels edit a working copy of the scene
+//! and the settings and return [`Command`]s; [`ViewerApp::apply`] carries them out once, at the
+//! end of the frame, where any edit restarts the progressive render with a new generation.
+
+mod file_browser;
+pub mod modes;
+mod panels;
+pub mod viewport;
+
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use eframe::egui;
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::accel::Accel;
+use crate::export;
+use crate::ray_tree::{RayTree, pixel_tree};
+use crate::render::session::{Pass, PixelAux, Session, SessionEvent};
+use crate::render::{Image, RenderSettings};
+use crate::scene::{self, Scene};
+use crate::trace::{TraceSettings, Tracer};
+use file_browser::{BrowseFor, FileBrowser};
+use modes::{ImageMode, mode_color};
+use viewport::{DisplayCallback, DisplayState, GpuDisplay, SharedDisplay};
+
+/// UI state kept between runs.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Prefs {
+    pub exposure: f32,
+    /// 0: clamp, 1: Reinhard, 2: ACES.
+    pub tonemap: u32,
+    pub mode: ImageMode,
+    pub last_dir: Option<PathBuf>,
+}
+
+impl Default for Prefs {
+    fn default() -> Self {
+        Self {
+            exposure: 1.0,
+            tonemap: 0,
+            mode: ImageMode::Render,
+            last_dir: None,
+        }
+    }
+}
+
+/// Everything a panel can ask for; applied once at the end of the frame.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Command {
+    /// The working copy of the scene or settings changed: render it.
+    Restart,
+    /// The scene's geometry or the accelerator changed: rebuild it, then render.
+    Rebuild,
+    OpenFile(PathBuf),
+    OpenBuiltin(String),
+    SaveScene(PathBuf),
+    Export(PathBuf),
+    ExportTree(PathBuf),
+    /// Show the ray tree of this pixel and select its material.
+    Pick(u32, u32),
+    FrameAll,
+    Stop,
+}
+
+/// Progress of the current generation, as the UI saw it.
+#[derive(Clone, Debug, Default)]
+struct Progress {
+    started: Option<Instant>,
+    /// Samples per pixel of the last complete pass (0: only the preview, or nothing yet).
+    samples_done: u32,
+    preview_done: bool,
+    finished_secs: Option<f64>,
+    /// Rays of the generation when it finished, for a steady Mrays/s readout.
+    pass_label: String,
+}
+
+/// The viewer.
+pub struct ViewerApp {
+    pub prefs: Prefs,
+    /// The scene being rendered and its working copy in the panels.
+    scene: Arc<Scene>,
+    pub edit: Scene,
+    pub settings: RenderSettings,
+    scene_label: String,
+    tracer: Arc<Tracer>,
+    session: Session,
+    generation: u64,
+    progress: Progress,
+    /// The film as the latest tiles left it: linear colour and sample-0 facts per pixel.
+    beauty: Vec<Vec3>,
+    aux: Vec<PixelAux>,
+    display: SharedDisplay,
+    /// Errors and notices, newest last; shown until dismissed.
+    pub messages: Vec<(bool, String)>,
+    pub selected_material: Option<usize>,
+    pub selected_light: Option<usize>,
+    pub tree: Option<RayTree>,
+    hover: Option<(u32, u32)>,
+    browser: Option<FileBrowser>,
+    show_help: bool,
+    last_mode: ImageMode,
+    pending: Vec<Command>,
+}
+
+/// Opens the window and runs the viewer until it is closed.
+pub fn run(scene_arg: Option<&str>) -> anyhow::Result<()> {
+    let (scene, label) = match scene_arg {
+        Some(arg) => (load_scene_arg(arg)?, arg.to_string()),
+        None => (
+            scene::builtin::load_builtin("default")?,
+            "default".to_string(),
+        ),
+    };
+    let options = eframe::NativeOptions {
+        renderer: eframe::Renderer::Wgpu,
+        viewport: egui::ViewportBuilder::default()
+            .with_title("raytree")
+            .with_inner_size([1400.0, 900.0])
+            .with_drag_and_drop(true),
+        ..Default::default()
+    };
+    eframe::run_native(
+        "raytree",
+        options,
+        Box::new(move |cc| {
+            let mut app = ViewerApp::new(cc, scene, label).map_err(|e| -> Box<dyn std::error::Error + Send + Sync> { e.into() })?;
+            if let Some(storage) = cc.storage
+                && let Some(prefs) = eframe::get_value::<Prefs>(storage, eframe::APP_KEY)
+            {
+                app.prefs = prefs;
+            }
+            Ok(Box::new(app))
+        }),
+    )
+    .map_err(|e| {
+        anyhow::anyhow!(
+            "cannot open the viewer window ({e}); without a display or graphics adapter, use `raytree render SCENE -o out.png`"
+        )
+    })
+}
+
+/// A scene file, OBJ, or built-in scene name (a file of that name wins).
+pub fn load_scene_arg(arg: &str) -> Result<Scene, scene::SceneError> {
+    let path = Path::new(arg);
+    if !path.exists() && scene::builtin::NAMES.contains(&arg) {
+        return scene::builtin::load_builtin(arg);
+    }
+    scene::load_scene_file(path)
+}
+
+impl ViewerApp {
+    /// The viewer over `scene`, drawing through the wgpu renderer of `cc`.
+    pub fn new(
+        cc: &eframe::CreationContext<'_>,
+        scene: Scene,
+        label: String,
+    ) -> Result<Self, String> {
+        let render_state = cc.wgpu_render_state.as_ref().ok_or_else(|| {
+            "the viewer needs the wgpu renderer and no graphics adapter was found; use `raytree render SCENE -o out.png`".to_string()
+        })?;
+        GpuDisplay::install(render_state);
+        Self::headless(scene, label)
+    }
+
+    /// The viewer's state without a window (the GPU display is installed by [`Self::new`]).
+    pub fn headless(scene: Scene, label: String) -> Result<Self, String> {
+        let settings = RenderSettings::default();
+        let session = Session::new(settings.threads)?;
+        let scene = Arc::new(scene);
+        let tracer = Arc::new(Tracer::new(scene.clone(), settings.trace));
+        let (w, h) = (scene.render.width, scene.render.height);
+        let mut app = Self {
+            prefs: Prefs::default(),
+            edit: (*scene).clone(),
+            scene,
+            settings,
+            scene_label: label,
+            tracer,
+            session,
+            generation: 0,
+            progress: Progress::default(),
+            beauty: vec![Vec3::ZERO; (w * h) as usize],
+            aux: vec![PixelAux::default(); (w * h) as usize],
+            display: Arc::new(Mutex::new(DisplayState::new(w, h))),
+            messages: Vec::new(),
+            selected_material: None,
+            selected_light: None,
+            tree: None,
+            hover: None,
+            browser: None,
+            show_help: false,
+            last_mode: ImageMode::Render,
+            pending: Vec::new(),
+        };
+        for w in app.scene.warnings.clone() {
+            app.messages.push((false, w));
+        }
+        app.restart(false);
+        Ok(app)
+    }
+
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
+
+    /// Samples per pixel in every pixel of the current generation (0 before the first full pass).
+    pub fn samples_done(&self) -> u32 {
+        self.progress.samples_done
+    }
+
+    pub fn is_finished(&self) -> bool {
+        self.progress.finished_secs.is_some()
+    }
+
+    /// The film as it stands: the mean of the samples done so far.
+    pub fn image(&self) -> Image {
+        Image {
+            width: self.scene.render.width,
+            height: self.scene.render.height,
+            pixels: self.beauty.clone(),
+        }
+    }
+
+    /// Queues a command, as a panel would.
+    pub fn command(&mut self, c: Command) {
+        self.pending.push(c);
+    }
+
+    fn error(&mut self, message: impl Into<String>) {
+        self.messages.push((true, message.into()));
+    }
+
+    /// Starts a new generation from the working copy; `rebuild` also rebuilds the accelerator.
+    fn restart(&mut self, rebuild: bool) {
+        if let Err(e) = self.session.set_threads(self.settings.threads) {
+            self.error(e);
+        }
+        let scene = Arc::new(self.edit.clone());
+        let (w, h) = (scene.render.width, scene.render.height);
+        let tracer = if rebuild || self.tracer.settings.accel != self.settings.trace.accel {
+            Tracer::new(scene.clone(), self.settings.trace)
+        } else {
+            Tracer::with_accel(
+                scene.clone(),
+                self.settings.trace,
+                self.tracer.accel.clone(),
+            )
+        };
+        self.tracer = Arc::new(tracer);
+        if (w, h) != (self.scene.render.width, self.scene.render.height) {
+            self.beauty = vec![Vec3::ZERO; (w * h) as usize];
+            self.aux = vec![PixelAux::default(); (w * h) as usize];
+        }
+        self.scene = scene;
+        self.display
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .resize(w, h);
+        let target = self.scene.render.samples;
+        let focus = self.hover.map(|(x, y)| (x as f32, y as f32));
+        self.generation = self.session.start(self.tracer.clone(), target, focus);
+        self.progress = Progress {
+            started: Some(Instant::now()),
+            pass_label: "preview".into(),
+            ..Progress::default()
+        };
+        // The tree follows the scene: re-trace the clicked pixel with the new settings.
+        if let Some(tree) = &self.tree {
+            let [x, y] = tree.pixel;
+            self.tree = pixel_tree(&self.tracer, x, y);
+        }
+    }
+
+    /// Takes the tiles that arrived, within a time budget so the UI stays responsive.
+    pub fn poll_session(&mut self) {
+        let budget = Instant::now();
+        let mut display = self.display.lock().unwrap_or_else(|p| p.into_inner());
+        let mode = self.prefs.mode;
+        let max_depth = self.scene.render.max_depth;
+        let w = self.scene.render.width;
+        while budget.elapsed().as_millis() < 8 {
+            let Some(event) = self.session.try_next() else {
+                break;
+            };
+            if event.generation() != self.generation {
+                continue;
+            }
+            match event {
+                SessionEvent::Tile(tile) => {
+                    let r = tile.rect;
+                    for j in 0..r.height {
+                        for i in 0..r.width {
+                            let src = (j * r.width + i) as usize;
+                            let dst = ((r.y + j) * w + r.x + i) as usize;
+                            self.beauty[dst] = tile.pixels[src];
+                            if let Some(aux) = &tile.aux {
+                                self.aux[dst] = aux[src];
+                            }
+                            let c = if mode == ImageMode::Render || tile.pass == Pass::Preview {
+                                tile.pixels[src]
+                            } else {
+                                mode_color(mode, &self.aux[dst], max_depth)
+                            };
+                            display.rgba[dst] = [c.x, c.y, c.z, 1.0];
+                        }
+                    }
+                    display.mark(r);
+                }
+                SessionEvent::PassDone { pass, .. } => match pass {
+                    Pass::Preview => {
+                        self.progress.preview_done = true;
+                        self.progress.pass_label = "1 sample".into();
+                    }
+                    Pass::Samples(n) => {
+                        self.progress.samples_done = n;
+                        self.progress.pass_label = format!("{n} samples");
+                    }
+                },
+                SessionEvent::Finished { secs, .. } => {
+                    self.progress.finished_secs = Some(secs);
+                }
+                SessionEvent::Failed { message, .. } => {
+                    drop(display);
+                    self.error(format!("{message}; the render stopped"));
+                    return;
+                }
+            }
+        }
+    }
+
+    /// Rewrites the whole display buffer for the current image mode.
+    fn refresh_display(&mut self) {
+        let mut display = self.display.lock().unwrap_or_else(|p| p.into_inner());
+        let mode = self.prefs.mode;
+        let max_depth = self.scene.render.max_depth;
+        for (i, px) in display.rgba.iter_mut().enumerate() {
+            let c = if mode == ImageMode::Render {
+                self.beauty[i]
+            } else {
+                mode_color(mode, &self.aux[i], max_depth)
+            };
+            *px = [c.x, c.y, c.z, 1.0];
+        }
+        display.params.exposure = self.prefs.exposure;
+        display.params.tonemap = self.prefs.tonemap;
+        display.params.raw = mode != ImageMode::Render;
+        display.mark_all();
+    }
+
+    /// Carries out the queued commands.
+    pub fn apply(&mut self) {
+        let commands = std::mem::take(&mut self.pending);
+        let mut restart = false;
+        let mut rebuild = false;
+        for c in commands {
+            match c {
+                Command::Restart => restart = true,
+                Command::Rebuild => {
+                    restart = true;
+                    rebuild = true;
+                }
+                Command::OpenFile(path) => match scene::load_scene_file(&path) {
+                    Ok(s) => {
+                        self.replace_scene(s, path.display().to_string());
+                        rebuild = true;
+                        restart = true;
+                    }
+                    // The message names the file, place and field; the old scene stays.
+                    Err(e) => self.error(e.to_string()),
+                },
+                Command::OpenBuiltin(name) => match scene::builtin::load_builtin(&name) {
+                    Ok(s) => {
+                        self.replace_scene(s, name);
+                        rebuild = true;
+                        restart = true;
+                    }
+                    Err(e) => self.error(e.to_string()),
+                },
+                Command::SaveScene(path) => {
+                    let text = scene::scene_to_toml(&self.edit);
+                    match export::write_text(&path, &text) {
+                        Ok(()) => self
+                            .messages
+                            .push((false, format!("saved {}", path.display()))),
+                        Err(e) => self.error(e.to_string()),
+                    }
+                }
+                Command::Export(path) => self.export(&path),
+                Command::ExportTree(path) => match &self.tree {
+                    Some(tree) => {
+                        let json = serde_json::to_string_pretty(tree).unwrap_or_default();
+                        match export::write_text(&path, &json) {
+                            Ok(()) => self
+                                .messages
+                                .push((false, format!("saved {}", path.display()))),
+                            Err(e) => self.error(e.to_string()),
+                        }
+                    }
+                    None => self.error("no ray tree to export: click a pixel first"),
+                },
+                Command::Pick(x, y) => {
+                    self.tree = pixel_tree(&self.tracer, x, y);
+                    if let Some(hit) = self.tree.as_ref().and_then(|t| t.root.hit.as_ref()) {
+                        self.selected_material = self
+                            .scene
+                            .materials
+                            .iter()
+                            .position(|m| m.name == hit.material);
+                    }
+                }
+                Command::FrameAll => {
+                    panels::frame_all(&mut self.edit);
+                    restart = true;
+                }
+                Command::Stop => {
+                    self.session.stop();
+                    self.generation = self.session.generation();
+                }
+            }
+        }
+        if restart {
+            self.restart(rebuild);
+        }
+    }
+
+    fn replace_scene(&mut self, s: Scene, label: String) {
+        for w in &s.warnings {
+            self.messages.push((false, w.clone()));
+        }
+        self.edit = s;
+        self.scene_label = label;
+        self.selected_material = None;
+        self.selected_light = None;
+        self.tree = None;
+    }
+
+    /// Writes the film at full resolution (never a window grab), stamped with its progress.
+    fn export(&mut self, path: &Path) {
+        let target = self.scene.render.samples;
+        let text =
+            vec![
+            ("Software".to_string(), format!("raytree {}", env!("CARGO_PKG_VERSION"))),
+            ("raytree.scene".to_string(), self.scene_label.clone()),
+            (
+                "raytree.samples".to_string(),
+                format!("{}/{}", self.progress.samples_done, target),
+            ),
+            (
+                "raytree.settings".to_string(),
+                serde_json::json!({
+                    "width": self.scene.render.width, "height": self.scene.render.height,
+                    "max_depth": self.scene.render.max_depth, "shading": self.scene.render.shading,
+                    "trace": self.settings.trace, "accel_used": self.tracer.accel.kind(),
+                })
+                .to_string(),
+            ),
+        ];
+        match export::write_image(path, &self.image(), &text) {
+            Ok(()) => self.messages.push((
+                false,
+                format!(
+                    "exported {} ({}/{} samples)",
+                    path.display(),
+                    self.progress.samples_done,
+                    target
+                ),
+            )),
+            Err(e) => self.error(e.to_string()),
+        }
+    }
+
+    fn shortcuts(&mut self, ctx: &egui::Context) {
+        use egui::{Key, KeyboardShortcut, Modifiers};
+        let save = KeyboardShortcut::new(Modifiers::COMMAND, Key::S);
+        let open = KeyboardShortcut::new(Modifiers::COMMAND, Key::O);
+        let (do_save, do_open, help, stop) = ctx.input_mut(|i| {
+            (
+                i.consume_shortcut(&save),
+                i.consume_shortcut(&open),
+                i.consume_key(Modifiers::NONE, Key::F1),
+                i.consume_key(Modifiers::NONE, Key::Escape),
+            )
+        });
+        if do_save {
+            let name = format!("{}.png", self.file_stem());
+            self.browser = Some(FileBrowser::new(BrowseFor::Export, self.start_dir(), &name));
+        }
+        if do_open {
+            self.browser = Some(FileBrowser::new(BrowseFor::Open, self.start_dir(), ""));
+        }
+        if help {
+            self.show_help = !self.show_help;
+        }
+        if stop {
+            self.pending.push(Command::Stop);
+        }
+        let dropped: Vec<PathBuf> = ctx.input(|i| {
+            i.raw
+                .dropped_files
+                .iter()
+                .map(|f| f.path().to_path_buf())
+                .collect()
+        });
+        if let Some(path) = dropped.into_iter().next() {
+            self.pending.push(Command::OpenFile(path));
+        }
+    }
+
+    fn file_stem(&self) -> String {
+        Path::new(&self.scene_label)
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("render")
+            .to_string()
+    }
+
+    fn start_dir(&self) -> PathBuf {
+        self.prefs
+            .last_dir
+            .clone()
+            .or_else(|| std::env::current_dir().ok())
+            .unwrap_or_else(|| PathBuf::from("."))
+    }
+
+    /// Draws the render fitted into `ui`'s space and handles orbit, pan, zoom, click and hover.
+    fn viewport(&mut self, ui: &mut egui::Ui) {
+        let (w, h) = (
+            self.scene.render.width as f32,
+            self.scene.render.height as f32,
+        );
+        let avail = ui.available_rect_before_wrap();
+        if avail.width() < 1.0 || avail.height() < 1.0 {
+            return; // a zero-area window: nothing to draw
+        }
+        let scale = (avail.width() / w).min(avail.height() / h);
+        let size = egui::vec2(w * scale, h * scale);
+        let rect = egui::Rect::from_center_size(avail.center(), size);
+        let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
+        response
+            .widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, "render viewport"));
+        ui.painter()
+            .add(eframe::egui_wgpu::Callback::new_paint_callback(
+                rect,
+                DisplayCallback {
+                    shared: self.display.clone(),
+                },
+            ));
+        let to_pixel = |p: egui::Pos2| {
+            let x = ((p.x - rect.min.x) / scale).floor();
+            let y = ((p.y - rect.min.y) / scale).floor();
+            (x >= 0.0 && y >= 0.0 && x < w && y < h).then_some((x as u32, y as u32))
+        };
+        self.hover = response.hover_pos().and_then(to_pixel);
+        if response.clicked()
+            && let Some((x, y)) = response.interact_pointer_pos().and_then(to_pixel)
+        {
+            self.pending.push(Command::Pick(x, y));
+        }
+        let delta = response.drag_delta();
+        if delta != egui::Vec2::ZERO {
+            if response.dragged_by(egui::PointerButton::Primary) {
+                panels::orbit(&mut self.edit.camera, delta.x * 0.01, delta.y * 0.01);
+                self.pending.push(Command::Restart);
+            } else if response.dragged_by(egui::PointerButton::Secondary)
+                || response.dragged_by(egui::PointerButton::Middle)
+            {
+                panels::pan(&mut self.edit.camera, delta.x / size.y, delta.y / size.y);
+                self.pending.push(Command::Restart);
+            }
+        }
+        if response.hovered() {
+            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+            if scroll != 0.0 {
+                panels::zoom(&mut self.edit.camera, (-scroll * 0.002).exp());
+                self.pending.push(Command::Restart);
+            }
+        }
+        // The tree's rays over the image: primary, reflected and refracted segments and shadow
+        // rays, projected with the camera, one colour per kind.
+        if let Some(tree) = &self.tree {
+            panels::draw_tree_overlay(ui.painter(), rect, scale, &self.scene, tree);
+        }
+    }
+}
+
+impl eframe::App for ViewerApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let ctx = ui.ctx().clone();
+        self.poll_session();
+        self.shortcuts(&ctx);
+        panels::top_bar(self, ui);
+        panels::status_bar(self, ui);
+        egui::Panel::left("settings")
+            .resizable(true)
+            .default_size(330.0)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| panels::side_panel(self, ui));
+            });
+        if self.tree.is_some() {
+            egui::Panel::right("tree")
+                .resizable(true)
+                .default_size(380.0)
+                .show(ui, |ui| panels::tree_panel(self, ui));
+        }
+        egui::CentralPanel::default().show(ui, |ui| self.viewport(ui));
+        if let Some(browser) = &mut self.browser {
+            match browser.show(&ctx) {
+                file_browser::Outcome::Open => {}
+                file_browser::Outcome::Cancel => self.browser = None,
+                file_browser::Outcome::Chose(purpose, path) => {
+                    self.prefs.last_dir = path.parent().map(Path::to_path_buf);
+                    self.pending.push(match purpose {
+                        BrowseFor::Open => Command::OpenFile(path),
+                        BrowseFor::SaveScene => Command::SaveScene(path),
+                        BrowseFor::Export => Command::Export(path),
+                        BrowseFor::ExportTree => Command::ExportTree(path),
+                    });
+                    self.browser = None;
+                }
+            }
+        }
+        panels::help_window(&ctx, &mut self.show_help);
+        self.apply();
+        self.refresh_if_mode_changed();
+        if !self.is_finished() {
+            ctx.request_repaint();
+        }
+    }
+
+    fn save(&mut self, storage: &mut dyn eframe::Storage) {
+        eframe::set_value(storage, eframe::APP_KEY, &self.prefs);
+    }
+}
+
+impl ViewerApp {
+    fn refresh_if_mode_changed(&mut self) {
+        let (mode, exposure, tonemap) = {
+            let d = self.display.lock().unwrap_or_else(|p| p.into_inner());
+            (d.params.raw, d.params.exposure, d.params.tonemap)
+        };
+        let want_raw = self.prefs.mode != ImageMode::Render;
+        if mode != want_raw
+            || exposure != self.prefs.exposure
+            || tonemap != self.prefs.tonemap
+            || (want_raw && self.last_mode != self.prefs.mode)
+        {
+            self.refresh_display();
+        }
+        self.last_mode = self.prefs.mode;
+    }
+
+    /// Starts the trace with the settings of the working copy (for callers outside the UI).
+    pub fn set_trace(&mut self, trace: TraceSettings) {
+        self.settings.trace = trace;
+        self.pending.push(Command::Rebuild);
+    }
+
+    /// The accelerator in use.
+    pub fn accel(&self) -> &Accel {
+        &self.tracer.accel
+    }
+}

@@ -1,0 +1,688 @@
+//! The panels: each edits the working copy of the scene or settings and queues commands; none
+//! applies anything itself.
+
+use eframe::egui::{self, Color32, DragValue, RichText, Ui};
+use glam::Vec3;
+
+use super::file_browser::{BrowseFor, FileBrowser};
+use super::modes::{ImageMode, TERMINATION_LEGEND};
+use super::{Command, ViewerApp};
+use crate::accel::AccelKind;
+use crate::geometry::{OffsetMethod, SphereMethod, TriangleMethod};
+use crate::ray_tree::{Node, RayTree};
+use crate::render::CameraFrame;
+use crate::scene::{Camera, Light, Material, Scene, Shading, builtin};
+use crate::trace::{EndReason, RayKind};
+
+/// The one palette of ray kinds, shared by the tree panel and the overlay.
+pub fn kind_color(kind: RayKind) -> Color32 {
+    match kind {
+        RayKind::Primary => Color32::from_rgb(240, 240, 240),
+        RayKind::Reflected => Color32::from_rgb(80, 170, 255),
+        RayKind::Refracted => Color32::from_rgb(90, 220, 120),
+        RayKind::Shadow => Color32::from_rgb(255, 200, 60),
+    }
+}
+
+/// Shadow rays that are blocked.
+pub const SHADOW_BLOCKED: Color32 = Color32::from_rgb(200, 60, 60);
+
+// ---- camera moves -------------------------------------------------------------------------
+
+/// Turns the camera about its target: `yaw` about the up axis, `pitch` about its right axis.
+pub fn orbit(camera: &mut Camera, yaw: f32, pitch: f32) {
+    let offset = camera.position - camera.look_at;
+    let up = camera.up.normalize_or(Vec3::Y);
+    let radius = offset.length();
+    let yawed = glam::Quat::from_axis_angle(up, -yaw) * offset;
+    let right = up.cross(-yawed).normalize_or(Vec3::X);
+    let pitched = glam::Quat::from_axis_angle(right, -pitch) * yawed;
+    // Never flip over the pole: keep 1° away from the up axis.
+    let cos = pitched.normalize().dot(up);
+    let next = if cos.abs() < 0.9998 { pitched } else { yawed };
+    camera.position = camera.look_at + next.normalize() * radius;
+}
+
+/// Moves camera and target together, by fractions of the image height.
+pub fn pan(camera: &mut Camera, dx: f32, dy: f32) {
+    let back = camera.position - camera.look_at;
+    let dist = back.length();
+    let right = camera.up.cross(back).normalize_or(Vec3::X);
+    let up = back.cross(right).normalize_or(Vec3::Y);
+    let span = 2.0 * dist * (camera.fov_y_deg.to_radians() * 0.5).tan();
+    let shift = (-dx * right + dy * up) * span;
+    camera.position += shift;
+    camera.look_at += shift;
+}
+
+/// Moves the camera towards (`factor` < 1) or away from its target.
+pub fn zoom(camera: &mut Camera, factor: f32) {
+    let back = camera.position - camera.look_at;
+    let len = (back.length() * factor).clamp(1e-4, 1e7);
+    camera.position = camera.look_at + back.normalize_or(Vec3::Z) * len;
+}
+
+/// Aims the camera at the scene's bounds from its current direction, the whole scene in view.
+pub fn frame_all(scene: &mut Scene) {
+    let Some((lo, hi)) = scene.bounds() else {
+        return;
+    };
+    let centre = (lo + hi) * 0.5;
+    let radius = ((hi - lo).length() * 0.5).max(1e-3);
+    let cam = &mut scene.camera;
+    let dir = (cam.position - cam.look_at).normalize_or(Vec3::Z);
+    let half = (cam.fov_y_deg.to_radians() * 0.5).min(1.5);
+    let dist = radius / half.sin() * 1.05;
+    cam.look_at = centre;
+    cam.position = centre + dir * dist;
+}
+
+// ---- small widgets ------------------------------------------------------------------------
+
+/// A label and a drag value named by it (for screen readers and UI tests).
+fn drag(ui: &mut Ui, label: &str, value: DragValue<'_>) -> bool {
+    let l = ui.label(label);
+    ui.add(value).labelled_by(l.id).changed()
+}
+
+fn vec3_edit(ui: &mut Ui, label: &str, v: &mut Vec3, speed: f32) -> bool {
+    let mut changed = false;
+    ui.horizontal(|ui| {
+        let l = ui.label(label);
+        for c in [&mut v.x, &mut v.y, &mut v.z] {
+            changed |= ui
+                .add(DragValue::new(c).speed(speed).max_decimals(4))
+                .labelled_by(l.id)
+                .changed();
+        }
+    });
+    changed
+}
+
+fn color_edit(ui: &mut Ui, label: &str, v: &mut Vec3) -> bool {
+    let mut changed = false;
+    ui.horizontal(|ui| {
+        let l = ui.label(label);
+        for c in [&mut v.x, &mut v.y, &mut v.z] {
+            changed |= ui
+                .add(
+                    DragValue::new(c)
+                        .speed(0.01)
+                        .range(0.0..=100.0)
+                        .max_decimals(3),
+                )
+                .labelled_by(l.id)
+                .changed();
+        }
+        let mut rgb = [v.x.min(1.0), v.y.min(1.0), v.z.min(1.0)];
+        if ui
+            .color_edit_button_rgb(&mut rgb)
+            .labelled_by(l.id)
+            .changed()
+        {
+            *v = Vec3::from(rgb);
+            changed = true;
+        }
+    });
+    changed
+}
+
+fn combo<T: PartialEq + Copy + std::fmt::Debug>(
+    ui: &mut Ui,
+    label: &str,
+    value: &mut T,
+    options: &[T],
+) -> bool {
+    let mut changed = false;
+    egui::ComboBox::from_label(label)
+        .selected_text(format!("{value:?}"))
+        .show_ui(ui, |ui| {
+            for &o in options {
+                changed |= ui.selectable_value(value, o, format!("{o:?}")).changed();
+            }
+        });
+    changed
+}
+
+// ---- panels -------------------------------------------------------------------------------
+
+pub fn top_bar(app: &mut ViewerApp, ui: &mut Ui) {
+    egui::Panel::top("menu").show(ui, |ui| {
+        egui::MenuBar::new().ui(ui, |ui| {
+            ui.menu_button("Scene", |ui| {
+                if ui.button("Open... (Ctrl+O)").clicked() {
+                    app.browser = Some(FileBrowser::new(BrowseFor::Open, app.start_dir(), ""));
+                }
+                ui.menu_button("Built-in", |ui| {
+                    for name in builtin::NAMES {
+                        if ui.button(*name).clicked() {
+                            app.command(Command::OpenBuiltin(name.to_string()));
+                        }
+                    }
+                });
+                if ui.button("Save scene as...").clicked() {
+                    let name = format!("{}.toml", app.file_stem());
+                    app.browser = Some(FileBrowser::new(
+                        BrowseFor::SaveScene,
+                        app.start_dir(),
+                        &name,
+                    ));
+                }
+                if ui.button("Export render... (Ctrl+S)").clicked() {
+                    let name = format!("{}.png", app.file_stem());
+                    app.browser = Some(FileBrowser::new(BrowseFor::Export, app.start_dir(), &name));
+                }
+            });
+            ui.menu_button("View", |ui| {
+                for mode in ImageMode::ALL {
+                    ui.radio_value(&mut app.prefs.mode, mode, mode.label());
+                }
+            });
+            if ui.button("Help (F1)").clicked() {
+                app.show_help = true;
+            }
+            ui.separator();
+            ui.label(RichText::new(&app.scene_label).strong());
+        });
+        let mut dismiss = None;
+        for (i, (is_error, msg)) in app.messages.iter().enumerate().rev().take(3) {
+            ui.horizontal(|ui| {
+                let color = if *is_error {
+                    Color32::LIGHT_RED
+                } else {
+                    Color32::LIGHT_YELLOW
+                };
+                ui.colored_label(color, msg);
+                if ui.small_button("x").clicked() {
+                    dismiss = Some(i);
+                }
+            });
+        }
+        if let Some(i) = dismiss {
+            app.messages.remove(i);
+        }
+    });
+}
+
+pub fn status_bar(app: &mut ViewerApp, ui: &mut Ui) {
+    egui::Panel::bottom("status").show(ui, |ui| {
+        let target = app.scene.render.samples;
+        let stats = app.session.stats().counts();
+        let elapsed = match (app.progress.finished_secs, app.progress.started) {
+            (Some(s), _) => s,
+            (None, Some(t)) => t.elapsed().as_secs_f64(),
+            _ => 0.0,
+        };
+        let mrays = |n: u64| n as f64 / elapsed.max(1e-6) / 1e6;
+        let (w, h) = (app.scene.render.width as u64, app.scene.render.height as u64);
+        let pass_fraction = app.session.stats().pixels_done.load(std::sync::atomic::Ordering::Relaxed) as f32 / (w * h).max(1) as f32;
+        let done = app.progress.samples_done as f32 / target.max(1) as f32;
+        let fraction = if app.is_finished() {
+            1.0
+        } else {
+            // Passes double the samples, so the last pass is half the work.
+            (done + pass_fraction.min(1.0) * (1.0 - done) * 0.5).min(0.999)
+        };
+        ui.horizontal(|ui| {
+            ui.add(
+                egui::ProgressBar::new(fraction)
+                    .desired_width(220.0)
+                    .text(format!("{}/{} spp", app.progress.samples_done, target)),
+            );
+            ui.label(format!(
+                "{} · {:.2} s · {:.2} Mrays/s (primary {:.2}, reflected {:.2}, refracted {:.2}, shadow {:.2}) · {} threads",
+                if app.is_finished() { "done" } else { &app.progress.pass_label },
+                elapsed,
+                mrays(stats.total()),
+                mrays(stats.primary),
+                mrays(stats.reflected),
+                mrays(stats.refracted),
+                mrays(stats.shadow),
+                app.session.threads(),
+            ));
+        });
+        ui.horizontal(|ui| {
+            if let Some((x, y)) = app.hover {
+                let i = (y * app.scene.render.width + x) as usize;
+                let c = app.beauty[i];
+                let a = app.aux[i];
+                ui.monospace(format!(
+                    "pixel ({x}, {y})  rgb ({:.4}, {:.4}, {:.4})  depth {}  rays {}  normal ({:.2}, {:.2}, {:.2})",
+                    c.x, c.y, c.z, a.depth_reached, a.rays, a.normal.x, a.normal.y, a.normal.z
+                ));
+            } else {
+                ui.monospace("move over the image for pixel values; click a pixel for its ray tree");
+            }
+        });
+    });
+}
+
+pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
+    let mut restart = false;
+    let mut rebuild = false;
+    egui::CollapsingHeader::new("Render settings")
+        .default_open(true)
+        .show(ui, |ui| {
+            let r = &mut app.edit.render;
+            restart |= ui
+                .add(egui::Slider::new(&mut r.max_depth, 0..=64).text("max depth"))
+                .changed();
+            restart |= ui
+                .add(
+                    egui::Slider::new(&mut r.samples, 1..=1024)
+                        .logarithmic(true)
+                        .text("samples"),
+                )
+                .changed();
+            ui.horizontal(|ui| {
+                restart |= drag(ui, "width", DragValue::new(&mut r.width).range(1..=8192));
+                restart |= drag(ui, "height", DragValue::new(&mut r.height).range(1..=8192));
+            });
+            restart |= combo(
+                ui,
+                "shading",
+                &mut r.shading,
+                &[Shading::BlinnPhong, Shading::Phong],
+            );
+            restart |= color_edit(ui, "background", &mut r.background);
+            restart |= color_edit(ui, "ambient light", &mut r.ambient_light);
+            let t = &mut app.settings.trace;
+            restart |= combo(
+                ui,
+                "sphere",
+                &mut t.methods.sphere,
+                &[SphereMethod::Robust, SphereMethod::Lecture],
+            );
+            restart |= combo(
+                ui,
+                "triangle",
+                &mut t.methods.triangle,
+                &[
+                    TriangleMethod::Watertight,
+                    TriangleMethod::MollerTrumbore,
+                    TriangleMethod::Lecture,
+                ],
+            );
+            restart |= combo(
+                ui,
+                "offset",
+                &mut t.methods.offset,
+                &[
+                    OffsetMethod::ErrorBound,
+                    OffsetMethod::NormalScaled,
+                    OffsetMethod::Fixed,
+                ],
+            );
+            rebuild |= combo(
+                ui,
+                "accelerator",
+                &mut t.accel,
+                &[
+                    AccelKind::Auto,
+                    AccelKind::None,
+                    AccelKind::Grid,
+                    AccelKind::Bvh,
+                ],
+            );
+            ui.horizontal(|ui| {
+                restart |= drag(
+                    ui,
+                    "weight cutoff",
+                    DragValue::new(&mut t.cutoff).speed(0.001).range(0.0..=0.99),
+                );
+            });
+            ui.horizontal(|ui| {
+                restart |= drag(
+                    ui,
+                    "threads (0 = all)",
+                    DragValue::new(&mut app.settings.threads).range(0..=256),
+                );
+            });
+            ui.label(format!("accelerator in use: {:?}", app.tracer.accel.kind()));
+        });
+    egui::CollapsingHeader::new("Display")
+        .default_open(true)
+        .show(ui, |ui| {
+            egui::ComboBox::from_label("image")
+                .selected_text(app.prefs.mode.label())
+                .show_ui(ui, |ui| {
+                    for m in ImageMode::ALL {
+                        ui.selectable_value(&mut app.prefs.mode, m, m.label());
+                    }
+                });
+            ui.add(
+                egui::Slider::new(&mut app.prefs.exposure, 0.01..=16.0)
+                    .logarithmic(true)
+                    .text("exposure"),
+            );
+            ui.horizontal(|ui| {
+                ui.label("tonemap");
+                ui.radio_value(&mut app.prefs.tonemap, 0, "clamp");
+                ui.radio_value(&mut app.prefs.tonemap, 1, "Reinhard");
+                ui.radio_value(&mut app.prefs.tonemap, 2, "ACES");
+            });
+            if app.prefs.mode == ImageMode::Termination {
+                for (label, (r, g, b)) in TERMINATION_LEGEND {
+                    ui.colored_label(Color32::from_rgb(r, g, b), format!("# {label}"));
+                }
+            }
+        });
+    egui::CollapsingHeader::new("Camera")
+        .default_open(true)
+        .show(ui, |ui| {
+            let c = &mut app.edit.camera;
+            restart |= vec3_edit(ui, "position", &mut c.position, 0.05);
+            restart |= vec3_edit(ui, "look at ", &mut c.look_at, 0.05);
+            restart |= vec3_edit(ui, "up      ", &mut c.up, 0.01);
+            restart |= ui
+                .add(egui::Slider::new(&mut c.fov_y_deg, 1.0..=170.0).text("fov y (°)"))
+                .changed();
+            if ui.button("Frame all").clicked() {
+                app.pending.push(Command::FrameAll);
+            }
+            ui.small("drag: orbit · right/middle drag: pan · wheel: zoom");
+        });
+    egui::CollapsingHeader::new(format!("Lights ({})", app.edit.lights.len()))
+        .default_open(true)
+        .show(ui, |ui| {
+            let mut remove = None;
+            for (i, l) in app.edit.lights.iter_mut().enumerate() {
+                let selected = app.selected_light == Some(i);
+                egui::CollapsingHeader::new(&l.name)
+                    .id_salt(("light", i))
+                    .default_open(selected)
+                    .show(ui, |ui| {
+                        restart |= vec3_edit(ui, "position", &mut l.position, 0.05);
+                        restart |= color_edit(ui, "colour", &mut l.color);
+                        ui.horizontal(|ui| {
+                            restart |= drag(
+                                ui,
+                                "radius",
+                                DragValue::new(&mut l.radius).speed(0.01).range(0.0..=1e6),
+                            );
+                        });
+                        if ui.button("Remove").clicked() {
+                            remove = Some(i);
+                        }
+                    });
+            }
+            if let Some(i) = remove {
+                app.edit.lights.remove(i);
+                restart = true;
+            }
+            if ui.button("Add light").clicked() {
+                let n = app.edit.lights.len() + 1;
+                let pos = app.edit.camera.position + Vec3::Y;
+                app.edit.lights.push(Light {
+                    name: format!("light {n}"),
+                    position: pos,
+                    color: Vec3::ONE,
+                    radius: 0.0,
+                });
+                restart = true;
+            }
+        });
+    egui::CollapsingHeader::new(format!("Materials ({})", app.edit.materials.len()))
+        .default_open(true)
+        .show(ui, |ui| {
+            ui.small("click an object in the image to select its material");
+            for (i, m) in app.edit.materials.iter_mut().enumerate() {
+                let selected = app.selected_material == Some(i);
+                let title = if selected {
+                    RichText::new(format!("> {}", m.name)).strong()
+                } else {
+                    RichText::new(&m.name)
+                };
+                let header = egui::CollapsingHeader::new(title).id_salt(("material", i));
+                let header = if selected {
+                    header.open(Some(true))
+                } else {
+                    header
+                };
+                header.show(ui, |ui| restart |= material_editor(ui, m));
+            }
+        });
+    egui::CollapsingHeader::new("Scene")
+        .default_open(false)
+        .show(ui, |ui| {
+            let s = &app.scene;
+            ui.label(format!(
+                "{} spheres, {} triangles, {} lights, {} materials",
+                s.spheres.len(),
+                s.triangles.len(),
+                s.lights.len(),
+                s.materials.len()
+            ));
+            for name in builtin::NAMES {
+                if ui.button(format!("Open built-in \"{name}\"")).clicked() {
+                    app.pending.push(Command::OpenBuiltin(name.to_string()));
+                }
+            }
+        });
+    if rebuild {
+        app.pending.push(Command::Rebuild);
+    } else if restart {
+        app.pending.push(Command::Restart);
+    }
+}
+
+fn material_editor(ui: &mut Ui, m: &mut Material) -> bool {
+    let mut changed = false;
+    changed |= color_edit(ui, "ambient ka ", &mut m.ambient);
+    changed |= color_edit(ui, "diffuse kd ", &mut m.diffuse);
+    changed |= color_edit(ui, "specular ks", &mut m.specular);
+    changed |= color_edit(ui, "reflect kr ", &mut m.reflectivity);
+    changed |= color_edit(ui, "transmit kt", &mut m.transparency);
+    ui.horizontal(|ui| {
+        changed |= drag(
+            ui,
+            "shininess",
+            DragValue::new(&mut m.shininess)
+                .speed(0.5)
+                .range(0.0..=10000.0),
+        );
+        changed |= drag(
+            ui,
+            "ior",
+            DragValue::new(&mut m.ior).speed(0.01).range(0.01..=10.0),
+        );
+    });
+    changed
+}
+
+// ---- the ray tree -------------------------------------------------------------------------
+
+fn fmt3(v: Vec3) -> String {
+    format!("({:.3}, {:.3}, {:.3})", v.x, v.y, v.z)
+}
+
+fn end_label(end: EndReason) -> &'static str {
+    match end {
+        EndReason::NoHit => "no hit -> background",
+        EndReason::HitLight => "hit a light -> its colour",
+        EndReason::MaxDepth => "past max depth -> background",
+        EndReason::Cutoff => "below weight cutoff -> background",
+    }
+}
+
+pub fn tree_panel(app: &mut ViewerApp, ui: &mut Ui) {
+    let Some(tree) = app.tree.clone() else {
+        return;
+    };
+    ui.horizontal(|ui| {
+        ui.heading(format!(
+            "Ray tree of ({}, {})",
+            tree.pixel[0], tree.pixel[1]
+        ));
+        if ui.small_button("x").clicked() {
+            app.tree = None;
+        }
+    });
+    ui.label(format!(
+        "colour {} · {} nodes{}",
+        fmt3(tree.color),
+        tree.nodes,
+        if tree.truncated { " (truncated)" } else { "" }
+    ));
+    if ui.button("Export tree as JSON...").clicked() {
+        let name = format!("tree-{}-{}.json", tree.pixel[0], tree.pixel[1]);
+        app.browser = Some(FileBrowser::new(
+            BrowseFor::ExportTree,
+            app.start_dir(),
+            &name,
+        ));
+    }
+    egui::ScrollArea::vertical().show(ui, |ui| node_ui(ui, &tree.root, "0"));
+}
+
+fn node_ui(ui: &mut Ui, node: &Node, path: &str) {
+    let kind = match node.kind {
+        RayKind::Primary => "primary",
+        RayKind::Reflected => "R",
+        RayKind::Refracted => "T",
+        RayKind::Shadow => "shadow",
+    };
+    let what = match (&node.end, &node.hit) {
+        (Some(end), _) => end_label(*end).to_string(),
+        (None, Some(hit)) => format!("{} ({})", hit.object, hit.material),
+        _ => String::new(),
+    };
+    let title = RichText::new(format!(
+        "{kind} d{} · {what} · {}",
+        node.depth,
+        fmt3(node.color)
+    ))
+    .color(kind_color(node.kind));
+    egui::CollapsingHeader::new(title)
+        .id_salt(path)
+        .default_open(node.depth < 2)
+        .show(ui, |ui| {
+            ui.small(format!("weight {} · dir {}", fmt3(node.weight), fmt3(node.direction)));
+            if let Some(hit) = &node.hit {
+                ui.small(format!(
+                    "t {:.4} · P {} · N {}{}",
+                    hit.t,
+                    fmt3(hit.point),
+                    fmt3(hit.normal),
+                    if hit.front_face { "" } else { " (inside)" }
+                ));
+                if let Some(b) = hit.barycentric {
+                    ui.small(format!("barycentric ({:.3}, {:.3}, {:.3})", b[0], b[1], b[2]));
+                }
+            }
+            for s in &node.shadow_rays {
+                let (text, color) = match (&s.blocked_by, s.facing_away) {
+                    (_, true) => (format!("{}: facing away (N·L {:.3})", s.light, s.n_dot_l), Color32::GRAY),
+                    (Some(b), _) => (format!("{}: blocked by {b}", s.light), SHADOW_BLOCKED),
+                    (None, false) => (
+                        format!(
+                            "{}: lit · N·L {:.3} · N·H {:.3} · R·V {:.3} · diffuse {} · specular {}",
+                            s.light, s.n_dot_l, s.n_dot_h, s.r_dot_v, fmt3(s.diffuse), fmt3(s.specular)
+                        ),
+                        kind_color(RayKind::Shadow),
+                    ),
+                };
+                ui.colored_label(color, RichText::new(text).small());
+            }
+            if let Some(l) = &node.local {
+                ui.small(format!(
+                    "local = ambient {} + diffuse {} + specular {} = {}",
+                    fmt3(l.ambient),
+                    fmt3(l.diffuse),
+                    fmt3(l.specular),
+                    fmt3(l.total)
+                ));
+            }
+            if node.total_internal_reflection {
+                ui.small("total internal reflection: kt goes to R");
+            }
+            for (i, child) in node.children.iter().enumerate() {
+                node_ui(ui, child, &format!("{path}.{i}"));
+            }
+        });
+}
+
+/// Draws the tree's rays over the image, projected with the render camera.
+pub fn draw_tree_overlay(
+    painter: &egui::Painter,
+    rect: egui::Rect,
+    scale: f32,
+    scene: &Scene,
+    tree: &RayTree,
+) {
+    let frame = CameraFrame::new(&scene.camera, scene.render.width, scene.render.height);
+    let to_screen = |p: Vec3| {
+        frame
+            .project(p)
+            .map(|(x, y)| egui::pos2(rect.min.x + x * scale, rect.min.y + y * scale))
+    };
+    let painter = painter.with_clip_rect(rect);
+    let mut stack = vec![&tree.root];
+    while let Some(node) = stack.pop() {
+        let end = match &node.hit {
+            Some(hit) => hit.point,
+            None => node.origin + node.direction * scene_extent(scene),
+        };
+        if let (Some(a), Some(b)) = (to_screen(node.origin), to_screen(end)) {
+            painter.line_segment([a, b], egui::Stroke::new(2.0, kind_color(node.kind)));
+        }
+        if let Some(hit) = &node.hit {
+            for s in &node.shadow_rays {
+                if s.facing_away {
+                    continue;
+                }
+                let light = hit.point + s.to_light * s.distance;
+                let color = if s.blocked_by.is_some() {
+                    SHADOW_BLOCKED
+                } else {
+                    kind_color(RayKind::Shadow)
+                };
+                if let (Some(a), Some(b)) = (to_screen(hit.point), to_screen(light)) {
+                    painter.line_segment([a, b], egui::Stroke::new(1.0, color));
+                }
+            }
+            if let (Some(a), Some(b)) = (
+                to_screen(hit.point),
+                to_screen(hit.point + hit.normal * scene_extent(scene) * 0.03),
+            ) {
+                painter.line_segment(
+                    [a, b],
+                    egui::Stroke::new(1.5, Color32::from_rgb(255, 0, 255)),
+                );
+            }
+        }
+        stack.extend(node.children.iter());
+    }
+}
+
+fn scene_extent(scene: &Scene) -> f32 {
+    scene
+        .bounds()
+        .map(|(lo, hi)| (hi - lo).length())
+        .unwrap_or(10.0)
+        .max(1e-3)
+}
+
+pub fn help_window(ctx: &egui::Context, open: &mut bool) {
+    egui::Window::new("Help").open(open).show(ctx, |ui| {
+        egui::Grid::new("keys").striped(true).show(ui, |ui| {
+            for (k, v) in [
+                ("Left drag", "orbit the camera about its target"),
+                ("Right or middle drag", "pan"),
+                ("Wheel", "zoom"),
+                ("Click", "ray tree of that pixel; selects its material"),
+                ("Ctrl+S", "export the render (PNG or EXR, full resolution)"),
+                (
+                    "Ctrl+O",
+                    "open a scene or OBJ (or drop the file on the window)",
+                ),
+                ("Esc", "stop rendering"),
+                ("F1", "this help"),
+            ] {
+                ui.strong(k);
+                ui.label(v);
+                ui.end_row();
+            }
+        });
+    });
+}

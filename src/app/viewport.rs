@@ -1,0 +1,303 @@
+//! The render on screen: a float texture that finished tiles are written into with
+//! `queue.write_texture` in the paint callback's prepare step, drawn by `shaders/display.wgsl`
+//! (exposure, tonemap, sRGB). The UI thread only marks rectangles dirty; the GPU side uploads
+//! just those.
+
+use std::sync::{Arc, Mutex};
+
+use eframe::egui_wgpu::{self, CallbackResources, CallbackTrait, ScreenDescriptor, wgpu};
+
+use crate::render::Rect;
+
+/// How the texture is shown.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DisplayParams {
+    pub exposure: f32,
+    /// 0: clamp, 1: Reinhard, 2: ACES.
+    pub tonemap: u32,
+    /// Image modes are display colours already: no exposure, no tonemap.
+    pub raw: bool,
+}
+
+/// What the texture should hold, shared between the UI thread (which writes pixels and marks
+/// rectangles dirty) and the paint callback (which uploads them).
+#[derive(Debug)]
+pub struct DisplayState {
+    pub width: u32,
+    pub height: u32,
+    /// Linear RGBA, row-major.
+    pub rgba: Vec<[f32; 4]>,
+    dirty: Vec<Rect>,
+    full: bool,
+    pub params: DisplayParams,
+}
+
+impl DisplayState {
+    pub fn new(width: u32, height: u32) -> Self {
+        Self {
+            width,
+            height,
+            rgba: vec![[0.0, 0.0, 0.0, 1.0]; (width * height) as usize],
+            dirty: Vec::new(),
+            full: true,
+            params: DisplayParams {
+                exposure: 1.0,
+                tonemap: 0,
+                raw: false,
+            },
+        }
+    }
+
+    /// Starts over at a new size (everything re-uploaded).
+    pub fn resize(&mut self, width: u32, height: u32) {
+        if (width, height) != (self.width, self.height) {
+            *self = Self {
+                params: self.params,
+                ..Self::new(width, height)
+            };
+        }
+        self.full = true;
+    }
+
+    pub fn mark(&mut self, rect: Rect) {
+        // While nothing paints (a hidden window), one full upload beats a growing list.
+        if self.dirty.len() >= 4096 {
+            self.mark_all();
+        }
+        if !self.full {
+            self.dirty.push(rect);
+        }
+    }
+
+    pub fn mark_all(&mut self) {
+        self.full = true;
+        self.dirty.clear();
+    }
+}
+
+pub type SharedDisplay = Arc<Mutex<DisplayState>>;
+
+/// GPU objects, created once and kept in egui_wgpu's callback resources.
+pub struct GpuDisplay {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    uniform: wgpu::Buffer,
+    texture: Option<(wgpu::Texture, wgpu::BindGroup, u32, u32)>,
+    encode_srgb: bool,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Uniform {
+    exposure: f32,
+    tonemap: u32,
+    encode_srgb: u32,
+    raw: u32,
+}
+
+impl GpuDisplay {
+    /// Builds the pipeline for the window's framebuffer format and stores it for the callback.
+    pub fn install(render_state: &egui_wgpu::RenderState) {
+        let device = &render_state.device;
+        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("raytree display.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("../../shaders/display.wgsl").into()),
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("raytree display"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("raytree display"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("raytree display"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &shader,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: &shader,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(render_state.target_format.into())],
+            }),
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: None,
+            multisample: wgpu::MultisampleState::default(),
+            multiview_mask: None,
+            cache: None,
+        });
+        let uniform = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("raytree display params"),
+            size: std::mem::size_of::<Uniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let gpu = GpuDisplay {
+            pipeline,
+            layout,
+            uniform,
+            texture: None,
+            encode_srgb: !render_state.target_format.is_srgb(),
+        };
+        render_state.renderer.write().callback_resources.insert(gpu);
+    }
+
+    fn ensure_texture(&mut self, device: &wgpu::Device, width: u32, height: u32) -> bool {
+        if matches!(self.texture, Some((_, _, w, h)) if (w, h) == (width, height)) {
+            return false;
+        }
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("raytree render"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("raytree display"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.uniform.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&view),
+                },
+            ],
+        });
+        self.texture = Some((texture, bind_group, width, height));
+        true
+    }
+}
+
+/// The paint callback of one frame.
+pub struct DisplayCallback {
+    pub shared: SharedDisplay,
+}
+
+fn upload(queue: &wgpu::Queue, texture: &wgpu::Texture, state: &DisplayState, rect: Rect) {
+    let w = state.width;
+    let bytes: &[u8] = bytemuck::cast_slice(&state.rgba);
+    queue.write_texture(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d {
+                x: rect.x,
+                y: rect.y,
+                z: 0,
+            },
+            aspect: wgpu::TextureAspect::All,
+        },
+        bytes,
+        wgpu::TexelCopyBufferLayout {
+            offset: ((rect.y * w + rect.x) as u64) * 16,
+            bytes_per_row: Some(w * 16),
+            rows_per_image: Some(rect.height),
+        },
+        wgpu::Extent3d {
+            width: rect.width,
+            height: rect.height,
+            depth_or_array_layers: 1,
+        },
+    );
+}
+
+impl CallbackTrait for DisplayCallback {
+    fn prepare(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        _screen: &ScreenDescriptor,
+        _encoder: &mut wgpu::CommandEncoder,
+        resources: &mut CallbackResources,
+    ) -> Vec<wgpu::CommandBuffer> {
+        let Some(gpu) = resources.get_mut::<GpuDisplay>() else {
+            return Vec::new();
+        };
+        let mut state = self.shared.lock().unwrap_or_else(|p| p.into_inner());
+        if state.width == 0 || state.height == 0 {
+            return Vec::new();
+        }
+        let recreated = gpu.ensure_texture(device, state.width, state.height);
+        if let Some((texture, _, _, _)) = &gpu.texture {
+            if recreated || state.full {
+                let all = Rect {
+                    x: 0,
+                    y: 0,
+                    width: state.width,
+                    height: state.height,
+                };
+                upload(queue, texture, &state, all);
+            } else {
+                for &rect in &state.dirty {
+                    upload(queue, texture, &state, rect);
+                }
+            }
+        }
+        state.full = false;
+        state.dirty.clear();
+        let u = Uniform {
+            exposure: state.params.exposure,
+            tonemap: state.params.tonemap,
+            encode_srgb: gpu.encode_srgb as u32,
+            raw: state.params.raw as u32,
+        };
+        queue.write_buffer(&gpu.uniform, 0, bytemuck::bytes_of(&u));
+        Vec::new()
+    }
+
+    fn paint(
+        &self,
+        _info: eframe::egui::PaintCallbackInfo,
+        render_pass: &mut wgpu::RenderPass<'static>,
+        resources: &CallbackResources,
+    ) {
+        let Some(gpu) = resources.get::<GpuDisplay>() else {
+            return;
+        };
+        if let Some((_, bind_group, _, _)) = &gpu.texture {
+            render_pass.set_pipeline(&gpu.pipeline);
+            render_pass.set_bind_group(0, bind_group, &[]);
+            render_pass.draw(0..3, 0..1);
+        }
+    }
+}

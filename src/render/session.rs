@@ -1,0 +1,413 @@
+//! The progressive render session behind the viewer (SPEC §4): rayon workers trace 32×32 tiles
+//! in passes — a coarse preview (one sample per 8×8 block, the block filled), every pixel at 1
+//! sample, then samples accumulated in doubling batches up to the target — nearest the focus
+//! point (image centre or cursor) first. Each start bumps a generation; workers drop stale work
+//! at once; finished tiles go over a bounded channel tagged with their generation, so the UI
+//! can never mix passes of two generations. The UI only ever calls `try_recv`.
+//!
+//! Each pixel's samples are added to its running sum in index order, exactly as
+//! [`super::render`] does, so the converged image equals the headless render bit for bit.
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::{CameraFrame, Rect, TILE_SIZE, tiles, trace_sample};
+use crate::trace::{RayCounts, Tracer};
+
+/// Side of the blocks of the coarse preview pass.
+pub const PREVIEW_BLOCK: u32 = 8;
+
+/// Capacity of the tile channel: enough for several passes of a large image between frames.
+const CHANNEL_CAPACITY: usize = 4096;
+
+/// Per-pixel facts from sample 0, for the image modes.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelAux {
+    pub depth_reached: u32,
+    pub rays: u32,
+    pub ends: u8,
+    pub normal: Vec3,
+}
+
+/// Which pass a tile belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pass {
+    /// One sample per block, blocks filled.
+    Preview,
+    /// Every pixel now holds the mean of `samples` samples.
+    Samples(u32),
+}
+
+/// A finished tile.
+#[derive(Clone, Debug)]
+pub struct TileUpdate {
+    pub generation: u64,
+    pub pass: Pass,
+    pub rect: Rect,
+    /// Linear colours, row-major within `rect`.
+    pub pixels: Vec<Vec3>,
+    /// Image-mode facts, sent with the first full-resolution pass only.
+    pub aux: Option<Vec<PixelAux>>,
+}
+
+/// What the session reports to the UI.
+#[derive(Clone, Debug)]
+pub enum SessionEvent {
+    Tile(TileUpdate),
+    /// Every tile of a pass has been sent.
+    PassDone {
+        generation: u64,
+        pass: Pass,
+    },
+    /// The target sample count is reached.
+    Finished {
+        generation: u64,
+        secs: f64,
+    },
+    /// A worker panicked; the render of this generation stopped.
+    Failed {
+        generation: u64,
+        message: String,
+    },
+}
+
+impl SessionEvent {
+    pub fn generation(&self) -> u64 {
+        match self {
+            SessionEvent::Tile(t) => t.generation,
+            SessionEvent::PassDone { generation, .. }
+            | SessionEvent::Finished { generation, .. }
+            | SessionEvent::Failed { generation, .. } => *generation,
+        }
+    }
+}
+
+/// Live counters of the current generation, read by the UI without locks.
+#[derive(Debug, Default)]
+pub struct LiveStats {
+    pub primary: AtomicU64,
+    pub reflected: AtomicU64,
+    pub refracted: AtomicU64,
+    pub shadow: AtomicU64,
+    /// Pixels finished in the current pass.
+    pub pixels_done: AtomicU64,
+}
+
+impl LiveStats {
+    fn add(&self, c: &RayCounts) {
+        self.primary.fetch_add(c.primary, Ordering::Relaxed);
+        self.reflected.fetch_add(c.reflected, Ordering::Relaxed);
+        self.refracted.fetch_add(c.refracted, Ordering::Relaxed);
+        self.shadow.fetch_add(c.shadow, Ordering::Relaxed);
+    }
+
+    pub fn counts(&self) -> RayCounts {
+        RayCounts {
+            primary: self.primary.load(Ordering::Relaxed),
+            reflected: self.reflected.load(Ordering::Relaxed),
+            refracted: self.refracted.load(Ordering::Relaxed),
+            shadow: self.shadow.load(Ordering::Relaxed),
+        }
+    }
+}
+
+/// The sample ranges of the passes after the preview: [0,1), [1,2), [2,4), [4,8), … ending at
+/// `target`.
+pub fn sample_batches(target: u32) -> Vec<std::ops::Range<u32>> {
+    let mut out = Vec::new();
+    out.push(0..1.min(target));
+    let mut done = 1;
+    while done < target {
+        let next = (done * 2).min(target);
+        out.push(done..next);
+        done = next;
+    }
+    out
+}
+
+/// Owns the worker pool and the channel; one per viewer.
+pub struct Session {
+    generation: Arc<AtomicU64>,
+    sender: SyncSender<SessionEvent>,
+    receiver: Receiver<SessionEvent>,
+    pool: Arc<rayon::ThreadPool>,
+    threads: usize,
+    stats: Arc<LiveStats>,
+    /// Events of older generations dropped on receipt.
+    stale_dropped: std::cell::Cell<u64>,
+}
+
+impl Session {
+    /// A session with `threads` workers (0: every core).
+    pub fn new(threads: usize) -> Result<Self, String> {
+        let (sender, receiver) = sync_channel(CHANNEL_CAPACITY);
+        Ok(Self {
+            generation: Arc::new(AtomicU64::new(0)),
+            sender,
+            receiver,
+            pool: Arc::new(build_pool(threads)?),
+            threads,
+            stats: Arc::new(LiveStats::default()),
+            stale_dropped: std::cell::Cell::new(0),
+        })
+    }
+
+    /// Changes the worker count (takes effect at the next start).
+    pub fn set_threads(&mut self, threads: usize) -> Result<(), String> {
+        if threads != self.threads {
+            self.pool = Arc::new(build_pool(threads)?);
+            self.threads = threads;
+        }
+        Ok(())
+    }
+
+    pub fn threads(&self) -> usize {
+        self.pool.current_num_threads()
+    }
+
+    pub fn generation(&self) -> u64 {
+        self.generation.load(Ordering::SeqCst)
+    }
+
+    pub fn stats(&self) -> &LiveStats {
+        &self.stats
+    }
+
+    /// Stops the current render: its workers drop their work at the next tile.
+    pub fn stop(&mut self) -> u64 {
+        self.generation.fetch_add(1, Ordering::SeqCst) + 1
+    }
+
+    /// Starts rendering the tracer's scene up to `target` samples, tiles nearest `focus`
+    /// (pixels; `None`: the image centre) first. Returns the new generation.
+    pub fn start(&mut self, tracer: Arc<Tracer>, target: u32, focus: Option<(f32, f32)>) -> u64 {
+        let generation = self.stop();
+        self.stats = Arc::new(LiveStats::default());
+        let job = Job {
+            tracer,
+            target: target.max(1),
+            focus,
+            generation,
+            current: self.generation.clone(),
+            failed: AtomicBool::new(false),
+            sender: self.sender.clone(),
+            stats: self.stats.clone(),
+        };
+        let pool = self.pool.clone();
+        // The coordinator runs on its own thread so the UI never waits; it only hands passes to
+        // the pool and stops as soon as the generation moves on.
+        std::thread::Builder::new()
+            .name(format!("raytree-render-{generation}"))
+            .spawn(move || pool.install(|| job.run()))
+            .map(|_| generation)
+            .unwrap_or(generation)
+    }
+
+    /// Events of older generations that arrived after a restart and were dropped.
+    pub fn stale_dropped(&self) -> u64 {
+        self.stale_dropped.get()
+    }
+
+    /// The next event, if one is waiting; stale generations are dropped here too.
+    pub fn try_next(&self) -> Option<SessionEvent> {
+        loop {
+            match self.receiver.try_recv() {
+                Ok(ev) if ev.generation() == self.generation() => return Some(ev),
+                Ok(_) => self.stale_dropped.set(self.stale_dropped.get() + 1),
+                Err(TryRecvError::Empty | TryRecvError::Disconnected) => return None,
+            }
+        }
+    }
+}
+
+fn build_pool(threads: usize) -> Result<rayon::ThreadPool, String> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .thread_name(|i| format!("raytree-worker-{i}"))
+        .build()
+        .map_err(|e| format!("cannot start {threads} render threads: {e}"))
+}
+
+struct Job {
+    tracer: Arc<Tracer>,
+    target: u32,
+    focus: Option<(f32, f32)>,
+    generation: u64,
+    current: Arc<AtomicU64>,
+    failed: AtomicBool,
+    sender: SyncSender<SessionEvent>,
+    stats: Arc<LiveStats>,
+}
+
+impl Job {
+    fn stale(&self) -> bool {
+        self.current.load(Ordering::Relaxed) != self.generation
+            || self.failed.load(Ordering::Relaxed)
+    }
+
+    fn send(&self, ev: SessionEvent) {
+        // The receiver lives as long as the session; a send error means the viewer is gone.
+        if self.sender.send(ev).is_err() {
+            self.failed.store(true, Ordering::Relaxed);
+        }
+    }
+
+    fn run(&self) {
+        let start = Instant::now();
+        let scene = &self.tracer.scene;
+        let (w, h) = (scene.render.width, scene.render.height);
+        let frame = CameraFrame::new(&scene.camera, w, h);
+        let mut order = tiles(w, h, TILE_SIZE);
+        if let Some((fx, fy)) = self.focus {
+            let dist = |r: &Rect| {
+                let dx = r.x as f32 + r.width as f32 * 0.5 - fx;
+                let dy = r.y as f32 + r.height as f32 * 0.5 - fy;
+                dx * dx + dy * dy
+            };
+            order.sort_by(|a, b| dist(a).total_cmp(&dist(b)));
+        }
+        let sums: Vec<Mutex<Vec<Vec3>>> = order
+            .iter()
+            .map(|r| Mutex::new(vec![Vec3::ZERO; (r.width * r.height) as usize]))
+            .collect();
+
+        self.pass(&order, Pass::Preview, |rect, _| {
+            self.preview_tile(&frame, rect)
+        });
+        for batch in sample_batches(self.target) {
+            if self.stale() {
+                return;
+            }
+            let pass = Pass::Samples(batch.end);
+            self.stats.pixels_done.store(0, Ordering::Relaxed);
+            self.pass(&order, pass, |rect, i| {
+                let mut tile_sums = sums[i].lock().unwrap_or_else(|p| p.into_inner());
+                let mut counts = RayCounts::default();
+                let mut aux = (batch.start == 0).then(Vec::new);
+                for j in 0..rect.height {
+                    for k in 0..rect.width {
+                        let (x, y) = (rect.x + k, rect.y + j);
+                        let sum = &mut tile_sums[(j * rect.width + k) as usize];
+                        for s in batch.clone() {
+                            let (c, info) =
+                                trace_sample(&self.tracer, &frame, x, y, s, &mut counts);
+                            *sum += c;
+                            if s == 0
+                                && let Some(aux) = aux.as_mut()
+                            {
+                                aux.push(PixelAux {
+                                    depth_reached: info.depth_reached,
+                                    rays: info.rays,
+                                    ends: info.ends,
+                                    normal: info.normal,
+                                });
+                            }
+                        }
+                    }
+                }
+                self.stats.add(&counts);
+                let n = batch.end as f32;
+                (tile_sums.iter().map(|s| *s / n).collect(), aux)
+            });
+        }
+        if !self.stale() {
+            self.send(SessionEvent::Finished {
+                generation: self.generation,
+                secs: start.elapsed().as_secs_f64(),
+            });
+        }
+    }
+
+    /// Runs one pass over all tiles in parallel, sending each finished tile.
+    fn pass(
+        &self,
+        order: &[Rect],
+        pass: Pass,
+        work: impl Fn(Rect, usize) -> (Vec<Vec3>, Option<Vec<PixelAux>>) + Sync,
+    ) {
+        order.par_iter().enumerate().for_each(|(i, &rect)| {
+            if self.stale() {
+                return;
+            }
+            match catch_unwind(AssertUnwindSafe(|| work(rect, i))) {
+                Ok((pixels, aux)) => {
+                    if self.stale() {
+                        return;
+                    }
+                    self.stats
+                        .pixels_done
+                        .fetch_add(pixels.len() as u64, Ordering::Relaxed);
+                    self.send(SessionEvent::Tile(TileUpdate {
+                        generation: self.generation,
+                        pass,
+                        rect,
+                        pixels,
+                        aux,
+                    }));
+                }
+                Err(panic) => {
+                    let message = panic
+                        .downcast_ref::<&str>()
+                        .map(|s| s.to_string())
+                        .or_else(|| panic.downcast_ref::<String>().cloned())
+                        .unwrap_or_else(|| "unknown panic".into());
+                    if !self.failed.swap(true, Ordering::Relaxed) {
+                        self.send(SessionEvent::Failed {
+                            generation: self.generation,
+                            message: format!(
+                                "a render worker failed on the tile at ({}, {}): {message}",
+                                rect.x, rect.y
+                            ),
+                        });
+                    }
+                }
+            }
+        });
+        if !self.stale() {
+            self.send(SessionEvent::PassDone {
+                generation: self.generation,
+                pass,
+            });
+        }
+    }
+
+    /// One centre sample per 8×8 block, copied to the whole block.
+    fn preview_tile(&self, frame: &CameraFrame, rect: Rect) -> (Vec<Vec3>, Option<Vec<PixelAux>>) {
+        let scene = &self.tracer.scene;
+        let (w, h) = (scene.render.width, scene.render.height);
+        let mut pixels = vec![Vec3::ZERO; (rect.width * rect.height) as usize];
+        let mut counts = RayCounts::default();
+        for by in (0..rect.height).step_by(PREVIEW_BLOCK as usize) {
+            for bx in (0..rect.width).step_by(PREVIEW_BLOCK as usize) {
+                let x = (rect.x + bx + PREVIEW_BLOCK / 2).min(w - 1);
+                let y = (rect.y + by + PREVIEW_BLOCK / 2).min(h - 1);
+                let (c, _) = trace_sample(&self.tracer, frame, x, y, 0, &mut counts);
+                for j in by..(by + PREVIEW_BLOCK).min(rect.height) {
+                    for i in bx..(bx + PREVIEW_BLOCK).min(rect.width) {
+                        pixels[(j * rect.width + i) as usize] = c;
+                    }
+                }
+            }
+        }
+        self.stats.add(&counts);
+        (pixels, None)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn batches_double_up_to_target() {
+        assert_eq!(sample_batches(1), vec![0..1]);
+        assert_eq!(sample_batches(5), vec![0..1, 1..2, 2..4, 4..5]);
+        assert_eq!(sample_batches(8).last(), Some(&(4..8)));
+    }
+}
