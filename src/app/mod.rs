@@ -8,6 +8,7 @@
 mod file_browser;
 pub mod modes;
 mod panels;
+pub mod tree_view;
 pub mod viewport;
 
 use std::path::{Path, PathBuf};
@@ -102,6 +103,8 @@ pub struct ViewerApp {
     pub selected_material: Option<usize>,
     pub selected_light: Option<usize>,
     pub tree: Option<RayTree>,
+    /// Selection, hover and the pinned tree, shared by the tree's views.
+    pub tree_state: tree_view::TreeState,
     hover: Option<(u32, u32)>,
     browser: Option<FileBrowser>,
     show_help: bool,
@@ -193,6 +196,7 @@ impl ViewerApp {
             selected_material: None,
             selected_light: None,
             tree: None,
+            tree_state: tree_view::TreeState::default(),
             hover: None,
             browser: None,
             show_help: false,
@@ -411,6 +415,7 @@ impl ViewerApp {
                 },
                 Command::Pick(x, y) => {
                     self.tree = pixel_tree(&self.tracer, x, y);
+                    self.tree_state.selected = Some(Vec::new());
                     if let Some(hit) = self.tree.as_ref().and_then(|t| t.root.hit.as_ref()) {
                         self.selected_material = self
                             .scene
@@ -549,11 +554,31 @@ impl ViewerApp {
         let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
         response
             .widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, "render viewport"));
+        // The tree's rays over the image: drawn by shaders/overlay.wgsl with the render
+        // camera's projection, one colour per ray kind, the hovered or selected node in white.
+        let overlay = self.tree.as_ref().map(|tree| {
+            let extent = self
+                .scene
+                .bounds()
+                .map(|(lo, hi)| (hi - lo).length())
+                .unwrap_or(10.0)
+                .max(1e-3);
+            let frame = crate::render::CameraFrame::new(
+                &self.scene.camera,
+                self.scene.render.width,
+                self.scene.render.height,
+            );
+            Arc::new(viewport::Overlay {
+                clip_from_world: frame.clip_from_world(extent * 1e-5, extent * 1e5),
+                vertices: tree_view::overlay_vertices(tree, &self.tree_state, extent),
+            })
+        });
         ui.painter()
             .add(eframe::egui_wgpu::Callback::new_paint_callback(
                 rect,
                 DisplayCallback {
                     shared: self.display.clone(),
+                    overlay,
                 },
             ));
         let to_pixel = |p: egui::Pos2| {
@@ -586,11 +611,6 @@ impl ViewerApp {
                 self.pending.push(Command::Restart);
             }
         }
-        // The tree's rays over the image: primary, reflected and refracted segments and shadow
-        // rays, projected with the camera, one colour per kind.
-        if let Some(tree) = &self.tree {
-            panels::draw_tree_overlay(ui.painter(), rect, scale, &self.scene, tree);
-        }
     }
 }
 
@@ -601,16 +621,26 @@ impl eframe::App for ViewerApp {
         self.shortcuts(&ctx);
         panels::top_bar(self, ui);
         panels::status_bar(self, ui);
+        // Hover is transient: the views set it again while the pointer stays on a node.
+        self.tree_state.hovered = None;
+        let tree = self.tree.clone();
+        if let Some(tree) = &tree {
+            egui::Panel::bottom("diagram")
+                .resizable(true)
+                .default_size(220.0)
+                .show(ui, |ui| tree_view::diagram(ui, tree, &mut self.tree_state));
+        }
         egui::Panel::left("settings")
             .resizable(true)
             .default_size(330.0)
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| panels::side_panel(self, ui));
             });
-        if self.tree.is_some() {
+        if tree.is_some() {
             egui::Panel::right("tree")
                 .resizable(true)
-                .default_size(380.0)
+                .default_size(420.0)
+                .max_size(560.0)
                 .show(ui, |ui| panels::tree_panel(self, ui));
         }
         egui::CentralPanel::default().show(ui, |ui| self.viewport(ui));
