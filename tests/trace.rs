@@ -1,129 +1,16 @@
 //! The trace against answers derived by hand: the lecture's quiz, reflection and refraction,
 //! max_depth semantics, shadows, and pixels of small scenes (1e-5).
 
-use std::sync::Arc;
+mod common;
 
+use common::{Build, close, looking, mat};
 use glam::{DVec3, Vec3};
 use raytree::accel::AccelKind;
 use raytree::geometry::{Ray, TriangleMethod, intersect_triangle, triangle_hit_point};
-use raytree::render::render;
-use raytree::scene::{
-    Camera, Light, Material, MaterialId, Object, ObjectId, ObjectSource, RenderParams, Scene,
-    Shading, Sphere, Triangle,
-};
+use raytree::scene::Shading;
 use raytree::shade::{halfway, light_terms};
-use raytree::trace::{TraceSettings, Tracer};
 
 const S: f32 = std::f32::consts::FRAC_1_SQRT_2;
-
-fn close(a: Vec3, b: Vec3, tol: f32) -> bool {
-    (a - b).abs().max_element() <= tol
-}
-
-/// A scene builder for hand-made test scenes.
-struct Build(Scene);
-
-impl Build {
-    fn new(camera: Camera, width: u32, height: u32) -> Self {
-        Build(Scene {
-            render: RenderParams {
-                width,
-                height,
-                max_depth: 5,
-                samples: 1,
-                background: Vec3::new(0.05, 0.1, 0.15),
-                ambient_light: Vec3::splat(0.5),
-                shading: Shading::BlinnPhong,
-            },
-            camera,
-            ..Scene::default()
-        })
-    }
-
-    fn material(mut self, m: Material) -> Self {
-        self.0.materials.push(m);
-        self
-    }
-
-    fn light(mut self, position: Vec3, color: Vec3) -> Self {
-        let name = format!("light {}", self.0.lights.len() + 1);
-        self.0.lights.push(Light {
-            name,
-            position,
-            color,
-            radius: 0.0,
-        });
-        self
-    }
-
-    fn sphere(mut self, name: &str, center: Vec3, radius: f32, material: u32) -> Self {
-        let object = ObjectId(self.0.objects.len() as u32);
-        self.0.objects.push(Object {
-            name: name.into(),
-            source: ObjectSource::Sphere,
-        });
-        self.0.spheres.push(Sphere {
-            center,
-            radius,
-            material: MaterialId(material),
-            object,
-        });
-        self
-    }
-
-    fn quad(mut self, name: &str, corners: [Vec3; 4], material: u32) -> Self {
-        let object = ObjectId(self.0.objects.len() as u32);
-        self.0.objects.push(Object {
-            name: name.into(),
-            source: ObjectSource::Triangle,
-        });
-        for vertices in [
-            [corners[0], corners[1], corners[2]],
-            [corners[0], corners[2], corners[3]],
-        ] {
-            self.0.triangles.push(Triangle {
-                vertices,
-                material: MaterialId(material),
-                object,
-            });
-        }
-        self
-    }
-
-    fn pixel(&self, x: u32, y: u32, accel: AccelKind) -> Vec3 {
-        let tracer = Tracer::new(
-            Arc::new(self.0.clone()),
-            TraceSettings {
-                accel,
-                ..TraceSettings::default()
-            },
-        );
-        let (image, _) = render(&tracer, 1, 1, &|_, _| {}).expect("render");
-        image.get(x, y)
-    }
-}
-
-fn looking(position: Vec3, look_at: Vec3, fov_y_deg: f32) -> Camera {
-    Camera {
-        position,
-        look_at,
-        up: Vec3::Y,
-        fov_y_deg,
-    }
-}
-
-fn mat(name: &str, ka: Vec3, kd: Vec3, ks: f32, n: f32, kr: f32) -> Material {
-    Material {
-        name: name.into(),
-        ambient: ka,
-        diffuse: kd,
-        specular: Vec3::splat(ks),
-        shininess: n,
-        reflectivity: Vec3::splat(kr),
-        transparency: Vec3::ZERO,
-        ior: 1.5,
-    }
-}
 
 #[test]
 fn lecture_quiz_numbers() {

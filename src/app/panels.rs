@@ -6,10 +6,10 @@ use glam::Vec3;
 
 use super::file_browser::{BrowseFor, FileBrowser};
 use super::modes::{ImageMode, TERMINATION_LEGEND};
+use super::tree_view;
 use super::{Command, ViewerApp};
 use crate::accel::AccelKind;
 use crate::geometry::{OffsetMethod, SphereMethod, TriangleMethod};
-use super::tree_view;
 use crate::scene::{Camera, Light, Material, Scene, Shading, builtin};
 
 // ---- camera moves -------------------------------------------------------------------------
@@ -484,7 +484,10 @@ pub fn tree_panel(app: &mut ViewerApp, ui: &mut Ui) {
         return;
     };
     ui.horizontal(|ui| {
-        ui.heading(format!("Ray tree of ({}, {})", tree.pixel[0], tree.pixel[1]));
+        ui.heading(format!(
+            "Ray tree of ({}, {})",
+            tree.pixel[0], tree.pixel[1]
+        ));
         if ui.small_button("x").clicked() {
             app.tree = None;
         }
@@ -511,7 +514,11 @@ pub fn tree_panel(app: &mut ViewerApp, ui: &mut Ui) {
         }
         if ui.button("Export tree as JSON...").clicked() {
             let name = format!("tree-{}-{}.json", tree.pixel[0], tree.pixel[1]);
-            app.browser = Some(FileBrowser::new(BrowseFor::ExportTree, app.start_dir(), &name));
+            app.browser = Some(FileBrowser::new(
+                BrowseFor::ExportTree,
+                app.start_dir(),
+                &name,
+            ));
         }
     });
     ui.separator();
@@ -536,9 +543,11 @@ pub fn tree_panel(app: &mut ViewerApp, ui: &mut Ui) {
         });
     ui.separator();
     let selected = state.selected.clone().unwrap_or_default();
-    egui::ScrollArea::both().id_salt("tree detail").show(ui, |ui| {
-        tree_view::detail(ui, &tree, &selected);
-    });
+    egui::ScrollArea::both()
+        .id_salt("tree detail")
+        .show(ui, |ui| {
+            tree_view::detail(ui, &tree, &selected);
+        });
 }
 
 pub fn help_window(ctx: &egui::Context, open: &mut bool) {

@@ -101,19 +101,33 @@ pub fn node_differs(a: &Node, b: &Node) -> bool {
             != b.hit.as_ref().map(|h| (&h.object, &h.material))
         || !close(a.color, b.color)
         || a.children.len() != b.children.len()
-        || a.shadow_rays.iter().map(|s| s.blocked_by.as_deref()).ne(b
-            .shadow_rays
+        || a.shadow_rays
             .iter()
-            .map(|s| s.blocked_by.as_deref()))
+            .map(|s| s.blocked_by.as_deref())
+            .ne(b.shadow_rays.iter().map(|s| s.blocked_by.as_deref()))
 }
 
 // ---- the list -----------------------------------------------------------------------------
 
 /// The tree as collapsible rows; `other` marks the rows that differ from another tree.
-pub fn tree_list(ui: &mut Ui, tree: &RayTree, state: &mut TreeState, other: Option<&RayTree>, salt: &str) {
+pub fn tree_list(
+    ui: &mut Ui,
+    tree: &RayTree,
+    state: &mut TreeState,
+    other: Option<&RayTree>,
+    salt: &str,
+) {
     let mut path = Vec::new();
     let compare = other.is_some();
-    list_node(ui, &tree.root, other.map(|o| &o.root), compare, &mut path, state, salt);
+    list_node(
+        ui,
+        &tree.root,
+        other.map(|o| &o.root),
+        compare,
+        &mut path,
+        state,
+        salt,
+    );
 }
 
 fn list_node(
@@ -183,7 +197,12 @@ const RADIUS: f32 = 11.0;
 
 /// Horizontal slot of every node: leaves get consecutive columns, parents sit over the middle
 /// of their children.
-fn layout(node: &Node, next_leaf: &mut f32, out: &mut Vec<(NodePath, f32, u32)>, path: &mut NodePath) -> f32 {
+fn layout(
+    node: &Node,
+    next_leaf: &mut f32,
+    out: &mut Vec<(NodePath, f32, u32)>,
+    path: &mut NodePath,
+) -> f32 {
     let x = if node.children.is_empty() {
         let x = *next_leaf;
         *next_leaf += 1.0;
@@ -208,17 +227,17 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) {
     let mut leaves = 0.0;
     layout(&tree.root, &mut leaves, &mut slots, &mut Vec::new());
     let depth = slots.iter().map(|s| s.2).max().unwrap_or(0) as f32;
-    let size = Vec2::new((leaves.max(1.0)) * COLUMN + 60.0, (depth + 1.0) * LEVEL + 40.0);
+    let size = Vec2::new(
+        (leaves.max(1.0)) * COLUMN + 60.0,
+        (depth + 1.0) * LEVEL + 40.0,
+    );
     egui::ScrollArea::both().id_salt("diagram").show(ui, |ui| {
         let (rect, response) = ui.allocate_exact_size(size, Sense::hover());
         response.widget_info(|| {
             egui::WidgetInfo::labeled(
                 egui::Role::Image,
                 true,
-                format!(
-                    "ray tree diagram of ({}, {})",
-                    tree.pixel[0], tree.pixel[1]
-                ),
+                format!("ray tree diagram of ({}, {})", tree.pixel[0], tree.pixel[1]),
             )
         });
         let painter = ui.painter_at(rect);
@@ -231,7 +250,9 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) {
         let place = |p: &[usize]| slots.iter().find(|s| s.0 == p).map(|s| pos(s.1, s.2));
         // Edges first, so the nodes sit on top.
         for (path, x, d) in &slots {
-            let Some(node) = node_at(&tree.root, path) else { continue };
+            let Some(node) = node_at(&tree.root, path) else {
+                continue;
+            };
             let here = pos(*x, *d);
             for (i, child) in node.children.iter().enumerate() {
                 let mut cp = path.clone();
@@ -251,7 +272,9 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) {
             }
         }
         for (path, x, d) in &slots {
-            let Some(node) = node_at(&tree.root, path) else { continue };
+            let Some(node) = node_at(&tree.root, path) else {
+                continue;
+            };
             let p = pos(*x, *d);
             // Shadow rays fan out to the upper right, one per light.
             for (k, s) in node.shadow_rays.iter().enumerate() {
@@ -267,7 +290,10 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) {
                 painter.line_segment([p, tip], Stroke::new(stroke, c));
                 if s.blocked_by.is_some() && !s.facing_away {
                     let d = 4.0;
-                    painter.line_segment([tip - Vec2::splat(d), tip + Vec2::splat(d)], Stroke::new(2.0, c));
+                    painter.line_segment(
+                        [tip - Vec2::splat(d), tip + Vec2::splat(d)],
+                        Stroke::new(2.0, c),
+                    );
                     painter.line_segment(
                         [tip + Vec2::new(-d, d), tip + Vec2::new(d, -d)],
                         Stroke::new(2.0, c),
@@ -306,7 +332,11 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) {
             );
             if node.end.is_some() {
                 // A leaf that was not shaded: a square with its end reason.
-                painter.rect_filled(Rect::from_center_size(p, Vec2::splat(RADIUS * 1.6)), 2.0, fill);
+                painter.rect_filled(
+                    Rect::from_center_size(p, Vec2::splat(RADIUS * 1.6)),
+                    2.0,
+                    fill,
+                );
             } else {
                 painter.circle_filled(p, RADIUS, fill);
             }
@@ -315,11 +345,21 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) {
                 RADIUS + 1.0,
                 Stroke::new(
                     if active { 3.0 } else { 1.5 },
-                    if active { color(HIGHLIGHT_RGB) } else { kind_color(node.kind) },
+                    if active {
+                        color(HIGHLIGHT_RGB)
+                    } else {
+                        kind_color(node.kind)
+                    },
                 ),
             );
             if node.total_internal_reflection {
-                painter.text(p + Vec2::new(RADIUS + 4.0, 0.0), egui::Align2::LEFT_CENTER, "TIR", egui::FontId::proportional(11.0), Color32::from_rgb(255, 150, 50));
+                painter.text(
+                    p + Vec2::new(RADIUS + 4.0, 0.0),
+                    egui::Align2::LEFT_CENTER,
+                    "TIR",
+                    egui::FontId::proportional(11.0),
+                    Color32::from_rgb(255, 150, 50),
+                );
             }
             painter.text(
                 p + Vec2::new(0.0, RADIUS + 9.0),
@@ -346,27 +386,50 @@ pub fn detail(ui: &mut Ui, tree: &RayTree, path: &[usize]) {
         return;
     };
     let phong = tree.settings.shading == Shading::Phong;
-    ui.label(RichText::new(node_summary(node)).strong().color(kind_color(node.kind)));
-    egui::Grid::new(("detail", path.to_vec())).num_columns(2).striped(true).show(ui, |ui| {
-        row(ui, "weight", fmt3(node.weight));
-        row(ui, "origin", fmt3(node.origin));
-        row(ui, "direction", fmt3(node.direction));
-        if let Some(end) = node.end {
-            row(ui, "ended", format!("{} -> colour {}", end_label(end), fmt3(node.color)));
-        }
-        if let Some(hit) = &node.hit {
-            row(ui, "object", format!("{} ({})", hit.object, hit.material));
-            row(ui, "t", format!("{:.6}", hit.t));
-            row(ui, "P", fmt3(hit.point));
-            row(ui, "N", format!("{}{}", fmt3(hit.normal), if hit.front_face { "" } else { " (inside)" }));
-            if let Some(b) = hit.barycentric {
-                row(ui, "barycentric", format!("({:.4}, {:.4}, {:.4})", b[0], b[1], b[2]));
+    ui.label(
+        RichText::new(node_summary(node))
+            .strong()
+            .color(kind_color(node.kind)),
+    );
+    egui::Grid::new(("detail", path.to_vec()))
+        .num_columns(2)
+        .striped(true)
+        .show(ui, |ui| {
+            row(ui, "weight", fmt3(node.weight));
+            row(ui, "origin", fmt3(node.origin));
+            row(ui, "direction", fmt3(node.direction));
+            if let Some(end) = node.end {
+                row(
+                    ui,
+                    "ended",
+                    format!("{} -> colour {}", end_label(end), fmt3(node.color)),
+                );
             }
-        }
-        if let Some(v) = node.view {
-            row(ui, "V", fmt3(v));
-        }
-    });
+            if let Some(hit) = &node.hit {
+                row(ui, "object", format!("{} ({})", hit.object, hit.material));
+                row(ui, "t", format!("{:.6}", hit.t));
+                row(ui, "P", fmt3(hit.point));
+                row(
+                    ui,
+                    "N",
+                    format!(
+                        "{}{}",
+                        fmt3(hit.normal),
+                        if hit.front_face { "" } else { " (inside)" }
+                    ),
+                );
+                if let Some(b) = hit.barycentric {
+                    row(
+                        ui,
+                        "barycentric",
+                        format!("({:.4}, {:.4}, {:.4})", b[0], b[1], b[2]),
+                    );
+                }
+            }
+            if let Some(v) = node.view {
+                row(ui, "V", fmt3(v));
+            }
+        });
     for s in &node.shadow_rays {
         ui.separator();
         let verdict = if s.facing_away {
@@ -374,58 +437,87 @@ pub fn detail(ui: &mut Ui, tree: &RayTree, path: &[usize]) {
         } else if let Some(b) = &s.blocked_by {
             format!(
                 "blocked by {b}{}",
-                s.blocked_at.map(|d| format!(" at {d:.4}")).unwrap_or_default()
+                s.blocked_at
+                    .map(|d| format!(" at {d:.4}"))
+                    .unwrap_or_default()
             )
         } else {
             "lit".to_string()
         };
-        ui.label(RichText::new(format!("light {}: {verdict}", s.light)).color(if s.blocked_by.is_some() {
-            color(SHADOW_BLOCKED_RGB)
-        } else {
-            color(kind_rgb(RayKind::Shadow))
-        }));
-        egui::Grid::new(("light", path.to_vec(), s.light.clone())).num_columns(2).striped(true).show(ui, |ui| {
-            row(ui, "L", fmt3(s.to_light));
-            row(ui, "distance", format!("{:.4}", s.distance));
-            row(ui, "N·L", format!("{:.6}", s.n_dot_l));
-            if phong {
-                row(ui, "R (Phong)", fmt3(s.mirror));
-                row(ui, "R·V", format!("{:.6}", s.r_dot_v));
-            } else {
-                row(ui, "H (Blinn)", fmt3(s.halfway));
-                row(ui, "N·H", format!("{:.6}", s.n_dot_h));
-            }
-            row(ui, "diffuse", fmt3(s.diffuse));
-            row(ui, "specular", fmt3(s.specular));
-        });
+        ui.label(
+            RichText::new(format!("light {}: {verdict}", s.light)).color(
+                if s.blocked_by.is_some() {
+                    color(SHADOW_BLOCKED_RGB)
+                } else {
+                    color(kind_rgb(RayKind::Shadow))
+                },
+            ),
+        );
+        egui::Grid::new(("light", path.to_vec(), s.light.clone()))
+            .num_columns(2)
+            .striped(true)
+            .show(ui, |ui| {
+                row(ui, "L", fmt3(s.to_light));
+                row(ui, "distance", format!("{:.4}", s.distance));
+                row(ui, "N·L", format!("{:.6}", s.n_dot_l));
+                if phong {
+                    row(ui, "R (Phong)", fmt3(s.mirror));
+                    row(ui, "R·V", format!("{:.6}", s.r_dot_v));
+                } else {
+                    row(ui, "H (Blinn)", fmt3(s.halfway));
+                    row(ui, "N·H", format!("{:.6}", s.n_dot_h));
+                }
+                row(ui, "diffuse", fmt3(s.diffuse));
+                row(ui, "specular", fmt3(s.specular));
+            });
     }
     if let Some(local) = &node.local {
         ui.separator();
-        egui::Grid::new(("sum", path.to_vec())).num_columns(2).striped(true).show(ui, |ui| {
-            row(ui, "ambient ka·A", fmt3(local.ambient));
-            row(ui, "diffuse (all lights)", fmt3(local.diffuse));
-            row(ui, "specular (all lights)", fmt3(local.specular));
-            row(ui, "local", fmt3(local.total));
-            let mut sum = local.total;
-            for child in &node.children {
-                let (name, w) = match child.kind {
-                    RayKind::Reflected => ("kr · reflected", node.kr.unwrap_or(Vec3::ZERO)),
-                    _ => ("kt · refracted", node.kt.unwrap_or(Vec3::ZERO)),
-                };
-                let term = w * child.color;
-                sum += term;
-                row(ui, name, format!("{} · {} = {}", fmt3(w), fmt3(child.color), fmt3(term)));
-            }
-            if node.total_internal_reflection {
-                row(ui, "", "total internal reflection: kt moved to R".to_string());
-            }
-            let ok = (sum - node.color).abs().max_element() <= 1e-5 * node.color.abs().max_element().max(1.0);
-            row(
-                ui,
-                "sum = colour",
-                format!("{} {}", fmt3(sum), if ok { "(equals the node colour)" } else { "(DIFFERS from the node colour)" }),
-            );
-        });
+        egui::Grid::new(("sum", path.to_vec()))
+            .num_columns(2)
+            .striped(true)
+            .show(ui, |ui| {
+                row(ui, "ambient ka·A", fmt3(local.ambient));
+                row(ui, "diffuse (all lights)", fmt3(local.diffuse));
+                row(ui, "specular (all lights)", fmt3(local.specular));
+                row(ui, "local", fmt3(local.total));
+                let mut sum = local.total;
+                for child in &node.children {
+                    let (name, w) = match child.kind {
+                        RayKind::Reflected => ("kr · reflected", node.kr.unwrap_or(Vec3::ZERO)),
+                        _ => ("kt · refracted", node.kt.unwrap_or(Vec3::ZERO)),
+                    };
+                    let term = w * child.color;
+                    sum += term;
+                    row(
+                        ui,
+                        name,
+                        format!("{} · {} = {}", fmt3(w), fmt3(child.color), fmt3(term)),
+                    );
+                }
+                if node.total_internal_reflection {
+                    row(
+                        ui,
+                        "",
+                        "total internal reflection: kt moved to R".to_string(),
+                    );
+                }
+                let ok = (sum - node.color).abs().max_element()
+                    <= 1e-5 * node.color.abs().max_element().max(1.0);
+                row(
+                    ui,
+                    "sum = colour",
+                    format!(
+                        "{} {}",
+                        fmt3(sum),
+                        if ok {
+                            "(equals the node colour)"
+                        } else {
+                            "(DIFFERS from the node colour)"
+                        }
+                    ),
+                );
+            });
     }
 }
 
@@ -490,13 +582,21 @@ pub fn overlay_vertices(
                 }
             }
             (None, Some(EndReason::NoHit)) => {
-                segment(node.origin, node.origin + node.direction * extent * 2.0, kind);
+                segment(
+                    node.origin,
+                    node.origin + node.direction * extent * 2.0,
+                    kind,
+                );
             }
             // Not traced (past max depth or below the cutoff): a short, faint stub.
             (None, Some(EndReason::MaxDepth | EndReason::Cutoff)) => {
                 let mut faint = kind;
                 faint[3] = 0.45;
-                segment(node.origin, node.origin + node.direction * extent * 0.08, faint);
+                segment(
+                    node.origin,
+                    node.origin + node.direction * extent * 0.08,
+                    faint,
+                );
             }
             // A visible light ends the ray at its surface.
             (None, _) => {

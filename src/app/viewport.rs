@@ -405,7 +405,11 @@ impl CallbackTrait for DisplayCallback {
             queue.write_buffer(&gpu.overlay_uniform, 0, bytemuck::bytes_of(&ou));
             let bytes: &[u8] = bytemuck::cast_slice(&overlay.vertices);
             let needed = bytes.len() as u64;
-            if gpu.overlay_vertices.as_ref().is_none_or(|(_, cap)| *cap < needed) {
+            if gpu
+                .overlay_vertices
+                .as_ref()
+                .is_none_or(|(_, cap)| *cap < needed)
+            {
                 let capacity = needed.next_power_of_two().max(4096);
                 let buffer = device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("raytree overlay segments"),

@@ -124,13 +124,20 @@ mod tests {
         };
         let frame = CameraFrame::new(&cam, 640, 480);
         let m = frame.clip_from_world(0.01, 1000.0);
-        for p in [Vec3::new(1.0, 1.0, -1.2), Vec3::new(-2.0, 0.0, 3.0), Vec3::ZERO] {
+        for p in [
+            Vec3::new(1.0, 1.0, -1.2),
+            Vec3::new(-2.0, 0.0, 3.0),
+            Vec3::ZERO,
+        ] {
             let c = m * p.extend(1.0);
             let (ndc_x, ndc_y, ndc_z) = (c.x / c.w, c.y / c.w, c.z / c.w);
             let x = (ndc_x + 1.0) * 0.5 * 640.0;
             let y = (1.0 - ndc_y) * 0.5 * 480.0;
             let (px, py) = frame.project(p).expect("in front");
-            assert!((x - px).abs() < 1e-2 && (y - py).abs() < 1e-2, "{x},{y} vs {px},{py}");
+            assert!(
+                (x - px).abs() < 1e-2 && (y - py).abs() < 1e-2,
+                "{x},{y} vs {px},{py}"
+            );
             assert!((0.0..=1.0).contains(&ndc_z), "depth {ndc_z}");
         }
     }
