@@ -357,7 +357,12 @@ fn write_node(out: &mut String, node: &Node, indent: usize) {
         fmt_v(node.direction)
     );
     if let Some(end) = node.end {
-        let _ = writeln!(out, " -> {end:?} => colour {}", fmt_v(node.color));
+        let light = node
+            .light
+            .as_ref()
+            .map(|l| format!(" ({} at t = {:.5})", l.name, l.t))
+            .unwrap_or_default();
+        let _ = writeln!(out, " -> {end:?}{light} => colour {}", fmt_v(node.color));
         return;
     }
     out.push('\n');
@@ -379,7 +384,12 @@ fn write_node(out: &mut String, node: &Node, indent: usize) {
     for s in &node.shadow_rays {
         let verdict = match (&s.blocked_by, s.facing_away) {
             (_, true) => "facing away".to_string(),
-            (Some(b), _) => format!("blocked by {b}"),
+            (Some(b), _) => format!(
+                "blocked by {b}{}",
+                s.blocked_at
+                    .map(|d| format!(" at {d:.4}"))
+                    .unwrap_or_default()
+            ),
             (None, false) => "lit".to_string(),
         };
         let _ = writeln!(
@@ -406,6 +416,16 @@ fn write_node(out: &mut String, node: &Node, indent: usize) {
     }
     if node.total_internal_reflection {
         let _ = writeln!(out, "{pad}  total internal reflection: kt goes to R");
+    }
+    if let (Some(kr), Some(kt)) = (node.kr, node.kt)
+        && !node.children.is_empty()
+    {
+        let _ = writeln!(
+            out,
+            "{pad}  children weighted kr {} and kt {}",
+            fmt_v(kr),
+            fmt_v(kt)
+        );
     }
     for child in &node.children {
         write_node(out, child, indent + 1);
