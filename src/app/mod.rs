@@ -311,7 +311,7 @@ impl ViewerApp {
                             if let Some(aux) = &tile.aux {
                                 self.aux[dst] = aux[src];
                             }
-                            let c = if mode == ImageMode::Render || tile.pass == Pass::Preview {
+                            let c = if mode == ImageMode::Render {
                                 tile.pixels[src]
                             } else {
                                 mode_color(mode, &self.aux[dst], max_depth)
