@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{Build, close, looking, mat};
+use common::{Build, close, floor, looking, mat, wall_z};
 use glam::Vec3;
 use raytree::ray_tree::{MAX_NODES, Node, RayTree, pixel_tree};
 use raytree::scene::Material;
@@ -57,26 +57,8 @@ fn mirrors(max_depth: u32) -> Build {
             0.5,
         ))
         .light(Vec3::new(0.0, 0.0, 0.0), Vec3::ONE)
-        .quad(
-            "far mirror",
-            [
-                Vec3::new(-5.0, -5.0, -2.0),
-                Vec3::new(5.0, -5.0, -2.0),
-                Vec3::new(5.0, 5.0, -2.0),
-                Vec3::new(-5.0, 5.0, -2.0),
-            ],
-            0,
-        )
-        .quad(
-            "near mirror",
-            [
-                Vec3::new(-5.0, -5.0, 2.0),
-                Vec3::new(-5.0, 5.0, 2.0),
-                Vec3::new(5.0, 5.0, 2.0),
-                Vec3::new(5.0, -5.0, 2.0),
-            ],
-            0,
-        );
+        .quad("far mirror", wall_z(-2.0, 5.0, true), 0)
+        .quad("near mirror", wall_z(2.0, 5.0, false), 0);
     b.0.render.max_depth = max_depth;
     b
 }
@@ -170,16 +152,7 @@ fn total_internal_reflection_moves_kt_to_r() {
     let b = Build::new(looking(Vec3::ZERO, Vec3::NEG_Z, 60.0), 5, 5)
         .material(glass("glass", 0.1, 0.9))
         .light(Vec3::new(0.0, 5.0, 0.0), Vec3::ONE)
-        .quad(
-            "entry face",
-            [
-                Vec3::new(-3.0, -3.0, -2.0),
-                Vec3::new(3.0, -3.0, -2.0),
-                Vec3::new(3.0, 3.0, -2.0),
-                Vec3::new(-3.0, 3.0, -2.0),
-            ],
-            0,
-        )
+        .quad("entry face", wall_z(-2.0, 3.0, true), 0)
         // The plane y = z + 4, its front facing (0, 1, −1)/√2: met from behind at 45°.
         .triangle(
             "slanted face",
@@ -216,16 +189,7 @@ fn shadow_ray_names_its_blocker() {
         .material(mat("blocker", Vec3::ONE, Vec3::ONE, 0.0, 1.0, 0.0))
         .light(Vec3::new(0.0, 4.0, -2.0), Vec3::ONE)
         .sphere("blocker", Vec3::new(0.0, 1.0, -2.0), 0.5, 1)
-        .quad(
-            "floor",
-            [
-                Vec3::new(-10.0, -1.0, 10.0),
-                Vec3::new(10.0, -1.0, 10.0),
-                Vec3::new(10.0, -1.0, -20.0),
-                Vec3::new(-10.0, -1.0, -20.0),
-            ],
-            0,
-        );
+        .quad("floor", floor(), 0);
     let t = tree(&b);
     let s = &t.root.shadow_rays[0];
     assert_eq!(t.root.hit.as_ref().expect("floor").object, "floor");
@@ -276,16 +240,7 @@ fn trees_are_capped_but_colours_stay_exact() {
         .light(Vec3::new(0.0, 5.0, 0.0), Vec3::ONE);
     for k in 1..=10 {
         let z = -(k as f32);
-        b = b.quad(
-            &format!("pane {k}"),
-            [
-                Vec3::new(-5.0, -5.0, z),
-                Vec3::new(5.0, -5.0, z),
-                Vec3::new(5.0, 5.0, z),
-                Vec3::new(-5.0, 5.0, z),
-            ],
-            0,
-        );
+        b = b.quad(&format!("pane {k}"), wall_z(z, 5.0, true), 0);
     }
     b.0.render.max_depth = 14;
     let tracer = b.tracer();

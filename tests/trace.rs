@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{Build, close, looking, mat};
+use common::{Build, close, floor, looking, mat, wall_z};
 use glam::{DVec3, Vec3};
 use raytree::accel::AccelKind;
 use raytree::geometry::{Ray, TriangleMethod, intersect_triangle, triangle_hit_point};
@@ -107,26 +107,8 @@ fn mirror_and_wall(max_depth: u32) -> Build {
             0.0,
         ))
         .light(Vec3::ZERO, Vec3::ONE)
-        .quad(
-            "mirror",
-            [
-                Vec3::new(-5.0, -5.0, -2.0),
-                Vec3::new(5.0, -5.0, -2.0),
-                Vec3::new(5.0, 5.0, -2.0),
-                Vec3::new(-5.0, 5.0, -2.0),
-            ],
-            0,
-        )
-        .quad(
-            "wall",
-            [
-                Vec3::new(-5.0, -5.0, 2.0),
-                Vec3::new(-5.0, 5.0, 2.0),
-                Vec3::new(5.0, 5.0, 2.0),
-                Vec3::new(5.0, -5.0, 2.0),
-            ],
-            1,
-        );
+        .quad("mirror", wall_z(-2.0, 5.0, true), 0)
+        .quad("wall", wall_z(2.0, 5.0, false), 1);
     b.0.render.max_depth = max_depth;
     b
 }
@@ -160,16 +142,7 @@ fn shadowed_floor_point_is_ambient_only() {
         .material(mat("blocker", Vec3::ONE, Vec3::ONE, 0.0, 1.0, 0.0))
         .light(Vec3::new(0.0, 4.0, -2.0), Vec3::ONE)
         .sphere("blocker", Vec3::new(0.0, 1.0, -2.0), 0.5, 1)
-        .quad(
-            "floor",
-            [
-                Vec3::new(-10.0, -1.0, 10.0),
-                Vec3::new(10.0, -1.0, 10.0),
-                Vec3::new(10.0, -1.0, -20.0),
-                Vec3::new(-10.0, -1.0, -20.0),
-            ],
-            0,
-        );
+        .quad("floor", floor(), 0);
     for accel in [AccelKind::None, AccelKind::Grid, AccelKind::Bvh] {
         let got = b.pixel(2, 2, accel);
         assert!(close(got, floor_ka * 0.5, 1e-6), "{accel:?}: {got}");
@@ -192,16 +165,7 @@ fn phong_uses_mirror_direction_of_the_light() {
     let mut b = Build::new(looking(Vec3::ZERO, Vec3::new(0.0, -1.0, -2.0), 40.0), 5, 5)
         .material(mat("floor", ka, Vec3::splat(0.8), 0.5, 10.0, 0.0))
         .light(Vec3::new(0.0, 4.0, -2.0), Vec3::ONE)
-        .quad(
-            "floor",
-            [
-                Vec3::new(-10.0, -1.0, 10.0),
-                Vec3::new(10.0, -1.0, 10.0),
-                Vec3::new(10.0, -1.0, -20.0),
-                Vec3::new(-10.0, -1.0, -20.0),
-            ],
-            0,
-        );
+        .quad("floor", floor(), 0);
     b.0.render.shading = Shading::Phong;
     let v = DVec3::new(0.0, 1.0, 2.0).normalize();
     let expect = ka.as_dvec3() * 0.5 + DVec3::splat(0.8) + 0.5 * v.y.powf(10.0);

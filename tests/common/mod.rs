@@ -148,3 +148,34 @@ pub fn mat(name: &str, ka: Vec3, kd: Vec3, ks: f32, n: f32, kr: f32) -> Material
         ior: 1.5,
     }
 }
+
+/// A square of half-size `half` in the plane z = `z`, counter-clockwise seen from +z (its front
+/// faces +z) or from −z.
+pub fn wall_z(z: f32, half: f32, front_towards_plus_z: bool) -> [Vec3; 4] {
+    let (a, b) = (-half, half);
+    if front_towards_plus_z {
+        [
+            Vec3::new(a, a, z),
+            Vec3::new(b, a, z),
+            Vec3::new(b, b, z),
+            Vec3::new(a, b, z),
+        ]
+    } else {
+        [
+            Vec3::new(a, a, z),
+            Vec3::new(a, b, z),
+            Vec3::new(b, b, z),
+            Vec3::new(b, a, z),
+        ]
+    }
+}
+
+/// The floor y = −1 facing up, 10 wide to either side and from z = 10 to z = −20.
+pub fn floor() -> [Vec3; 4] {
+    [
+        Vec3::new(-10.0, -1.0, 10.0),
+        Vec3::new(10.0, -1.0, 10.0),
+        Vec3::new(10.0, -1.0, -20.0),
+        Vec3::new(-10.0, -1.0, -20.0),
+    ]
+}
