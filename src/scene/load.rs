@@ -52,7 +52,12 @@ pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
             )));
         }
     };
-    let text = read_text(path)
+    let max_bytes = if is_obj {
+        MAX_MESH_FILE_BYTES
+    } else {
+        MAX_SCENE_FILE_BYTES
+    };
+    let text = read_text(path, max_bytes)
         .map_err(|reason| SceneError(format!("{file}: cannot read the scene file: {reason}.")))?;
     let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let resolve = fs_resolver(folder);
@@ -94,14 +99,55 @@ pub fn load_scene_str_with(
 
 /// A resolver reading files relative to `folder`.
 pub fn fs_resolver(folder: PathBuf) -> impl Fn(&str) -> Result<String, String> {
-    move |path: &str| read_text(&folder.join(path)).map_err(|reason| format!("{path}: {reason}"))
+    move |path: &str| {
+        read_text(&folder.join(path), MAX_MESH_FILE_BYTES)
+            .map_err(|reason| format!("{path}: {reason}"))
+    }
 }
 
-/// Reads a text file, tolerating stray non-UTF-8 bytes (old MTL files carry Latin-1 comments).
-fn read_text(path: &Path) -> Result<String, String> {
-    std::fs::read(path)
-        .map(|bytes| String::from_utf8_lossy(&bytes).into_owned())
-        .map_err(|e| os_reason(&e))
+/// Largest scene (`.toml`) file read. Hand-written and exported scenes are kilobytes; the TOML
+/// tree takes several times the text, so the cap also bounds the parser's memory.
+pub const MAX_SCENE_FILE_BYTES: u64 = 64 << 20;
+
+/// Largest OBJ or MTL file read: about 20 million triangles of OBJ text. The memory a mesh
+/// needs is estimated from its counts before it is parsed (see `obj`); this cap comes first,
+/// so that a huge or endless file is refused before it is read at all.
+pub const MAX_MESH_FILE_BYTES: u64 = 512 << 20;
+
+/// Reads a text file of at most `max_bytes`, tolerating stray non-UTF-8 bytes (old MTL files
+/// carry Latin-1 comments). Only regular files are read: a device such as `/dev/zero` or a
+/// pipe would never end (or block), and a folder is never what was meant.
+fn read_text(path: &Path, max_bytes: u64) -> Result<String, String> {
+    use std::io::Read;
+    let meta = std::fs::metadata(path).map_err(|e| os_reason(&e))?;
+    if meta.is_dir() {
+        return Err("it is a folder, not a file".into());
+    }
+    if !meta.is_file() {
+        return Err("it is not a regular file (a device, a pipe or a socket)".into());
+    }
+    let too_big = |size: u64| {
+        format!(
+            "it is {}, more than the {} a file may have",
+            crate::render::format_bytes(size),
+            crate::render::format_bytes(max_bytes)
+        )
+    };
+    if meta.len() > max_bytes {
+        return Err(too_big(meta.len()));
+    }
+    let file = std::fs::File::open(path).map_err(|e| os_reason(&e))?;
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    // `take` also stops a file that grows while it is read.
+    file.take(max_bytes + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| os_reason(&e))?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(too_big(bytes.len() as u64));
+    }
+    // Valid UTF-8 is taken as it is, without the copy `from_utf8_lossy` would make.
+    Ok(String::from_utf8(bytes)
+        .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned()))
 }
 
 /// The OS's reason without the platform-specific "(os error N)" tail, for stable messages.
@@ -790,6 +836,18 @@ impl SceneBuilder<'_> {
         let Some((file, file_span)) = s.string("file")? else {
             return Err(s.missing("file", "an OBJ path relative to the scene file"));
         };
+        // Only OBJ files are meshes: a scene (or anything else) named here would be read as
+        // OBJ text and make no sense, and scenes never include scenes, so there are no cycles.
+        if !obj::is_obj_path(&file) {
+            return Err(s.error(
+                &file_span,
+                "file",
+                format!(
+                    "must name an OBJ file (ending in `.obj`), got \"{}\"",
+                    short(&file).escape_debug()
+                ),
+            ));
+        }
         let override_name = s.string("material")?.map(|(n, _)| n);
         let material_override = match override_name {
             Some(_) => Some(self.material(s, "material")?),
