@@ -83,8 +83,9 @@ struct RenderArgs {
     /// Samples per pixel (sample 0 is the pixel centre).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
     samples: Option<u32>,
-    /// Worker threads; 0 uses every core.
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads; 0 uses every core (at most 1024).
+    #[arg(long, default_value_t = 0,
+          value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1024))]
     threads: usize,
     /// No progress bar.
     #[arg(short, long)]

@@ -101,7 +101,7 @@ pub fn load_scene_str_with(
 pub fn fs_resolver(folder: PathBuf) -> impl Fn(&str) -> Result<String, String> {
     move |path: &str| {
         read_text(&folder.join(path), MAX_MESH_FILE_BYTES)
-            .map_err(|reason| format!("{path}: {reason}"))
+            .map_err(|reason| format!("{}: {reason}", short_path(path)))
     }
 }
 
@@ -190,8 +190,9 @@ impl Src<'_> {
     }
 
     /// The source text of a value, as the user wrote it, for "got ..." in messages.
-    fn slice(&self, span: &Range<usize>) -> &str {
-        self.text.get(span.clone()).unwrap_or("?")
+    /// At most 40 characters of it, so that a message stays a sentence.
+    fn slice(&self, span: &Range<usize>) -> String {
+        short(self.text.get(span.clone()).unwrap_or("?"))
     }
 }
 
@@ -240,6 +241,16 @@ pub(crate) fn short(text: &str) -> String {
         Some((i, _)) => format!("{}…", &text[..i]),
         None => text.to_string(),
     }
+}
+
+/// A path as written, cut to its last 80 characters: the file name is the part that matters.
+pub(crate) fn short_path(path: &str) -> String {
+    let count = path.chars().count();
+    if count <= 80 {
+        return path.to_string();
+    }
+    let tail: String = path.chars().skip(count - 79).collect();
+    format!("…{tail}")
 }
 
 /// The closest of `known` to `word` if it is a plausible typo, for "did you mean" hints.
@@ -324,7 +335,8 @@ impl<'s, 't, 'i> Section<'s, 't, 'i> {
                 return Err(src.error(
                     &key.span(),
                     format!(
-                        "{what} has an unknown field `{key_text}`{hint}; its fields are {}",
+                        "{what} has an unknown field `{}`{hint}; its fields are {}",
+                        short(key_text),
                         list_and(&known)
                     ),
                 ));
@@ -844,7 +856,7 @@ impl SceneBuilder<'_> {
                 "file",
                 format!(
                     "must name an OBJ file (ending in `.obj`), got \"{}\"",
-                    short(&file).escape_debug()
+                    short_path(&file).escape_debug()
                 ),
             ));
         }
@@ -881,7 +893,7 @@ impl SceneBuilder<'_> {
             &obj::MeshRequest {
                 object,
                 object_name: &name,
-                label: &file,
+                label: &short_path(&file),
                 key: &file,
                 text: &text,
                 resolve: self.resolve,
@@ -889,11 +901,12 @@ impl SceneBuilder<'_> {
                 placement: &placement,
             },
         )
-        .map_err(|p| cannot(format!("{file}{}", p.with_line())))?;
+        .map_err(|p| cannot(format!("{}{}", short_path(&file), p.with_line())))?;
         if loaded == 0 {
-            self.scene
-                .warnings
-                .push(format!("{file}: the mesh has no triangles to show."));
+            self.scene.warnings.push(format!(
+                "{}: the mesh has no triangles to show.",
+                short_path(&file)
+            ));
         }
         Ok(())
     }

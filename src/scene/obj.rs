@@ -14,7 +14,7 @@ use std::sync::Once;
 
 use glam::{Mat3, Vec3};
 
-use super::load::{ResolveFn, SceneError, check_camera, default_material};
+use super::load::{ResolveFn, SceneError, check_camera, default_material, short, short_path};
 use super::{Camera, Light, Material, MaterialId, Object, ObjectId, ObjectSource, Scene, Triangle};
 use crate::render::{MemoryLimit, memory_limit, mesh_memory_estimate};
 
@@ -292,8 +292,8 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
         if req.material_override.is_some() {
             return Ok(Default::default());
         }
-        let name = path.to_string_lossy();
-        let text = (req.resolve)(&sibling(req.key, &name)).map_err(|reason| {
+        let name = short_path(&path.to_string_lossy());
+        let text = (req.resolve)(&sibling(req.key, &path.to_string_lossy())).map_err(|reason| {
             mtl_warnings.borrow_mut().push(format!(
                 "{}: cannot read the material library `{name}` ({reason}); its faces use the default material.",
                 req.label
@@ -394,7 +394,15 @@ fn warn_unknown_usemtl(req: &MeshRequest, known: &[tobj::Material], warnings: &m
         .filter(|name| !name.is_empty() && !known.iter().any(|m| m.name == *name))
         .collect();
     if !unknown.is_empty() {
-        let names: Vec<String> = unknown.iter().map(|n| format!("`{n}`")).collect();
+        // A handful of names, so that the warning stays one readable sentence.
+        let mut names: Vec<String> = unknown
+            .iter()
+            .take(5)
+            .map(|n| format!("`{}`", short(n)))
+            .collect();
+        if unknown.len() > 5 {
+            names.push(format!("{} more", unknown.len() - 5));
+        }
         warnings.push(format!(
             "{}: `usemtl` names materials that no material library defines ({}); their faces use the default material.",
             req.label,
@@ -435,7 +443,7 @@ pub fn material_from_mtl(
     let mut invalid = |key: &str, got: String, fallback: String| {
         warnings.push(format!(
             "{label}: material `{}` has an invalid `{key}` {got}; using {fallback}.",
-            m.name
+            short(&m.name)
         ));
     };
     let mut rgb = |value: Option<[f32; 3]>, key: &str, fallback: Vec3| match value {
@@ -460,7 +468,7 @@ pub fn material_from_mtl(
             let fb = fallback.to_string();
             warnings.push(format!(
                 "{label}: material `{}` has an invalid `{key}` {x}; using {fb}.",
-                m.name
+                short(&m.name)
             ));
             None
         }
