@@ -215,7 +215,33 @@ fn mtl_for_tobj(text: &str) -> Result<Cow<'_, str>, (usize, String)> {
     Ok(fixed.map_or(Cow::Borrowed(text), Cow::Owned))
 }
 
-/// Vertices (`v`) and triangles (after triangulation; a 1- or 2-corner element counts as one
+/// True for a polyline (`l`) statement.
+fn is_polyline(line: &str) -> bool {
+    line.split_whitespace().next() == Some("l")
+}
+
+/// OBJ text without its polylines, and how many there were. A polyline has no surface to
+/// trace, but tobj reads `l` like `f`, so `l 1 2 3` would be drawn as a triangle; each one
+/// becomes an empty comment, so line numbers in messages stay right.
+fn without_polylines(text: &str) -> (Cow<'_, str>, usize) {
+    if !text.lines().any(is_polyline) {
+        return (Cow::Borrowed(text), 0);
+    }
+    let mut out = String::with_capacity(text.len());
+    let mut count = 0;
+    for line in text.lines() {
+        if is_polyline(line) {
+            out.push('#');
+            count += 1;
+        } else {
+            out.push_str(line);
+        }
+        out.push('\n');
+    }
+    (Cow::Owned(out), count)
+}
+
+/// Vertices (`v`) and triangles (after triangulation; a 1- or 2-corner face counts as one
 /// degenerate triangle, as tobj makes it) of OBJ text, counted without parsing numbers.
 pub(crate) fn obj_counts(text: &str) -> (u64, u64) {
     let (mut vertices, mut triangles) = (0u64, 0u64);
@@ -223,7 +249,7 @@ pub(crate) fn obj_counts(text: &str) -> (u64, u64) {
         let mut words = line.split_whitespace();
         match words.next() {
             Some("v") => vertices += 1,
-            Some("f" | "l") => triangles += (words.count() as u64).saturating_sub(2).max(1),
+            Some("f") => triangles += (words.count() as u64).saturating_sub(2).max(1),
             _ => {}
         }
     }
@@ -314,11 +340,12 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
             ));
         })
     };
-    let (models, mtl_materials) = match load_obj(req.text, load_mtl) {
+    let (text, polylines) = without_polylines(req.text);
+    let (models, mtl_materials) = match load_obj(&text, load_mtl) {
         Ok(Ok(loaded)) => loaded,
         Ok(Err(e)) => {
             return Err(ObjProblem {
-                line: error_line(req.text),
+                line: error_line(&text),
                 reason: e.to_string(),
             });
         }
@@ -326,6 +353,13 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     };
     let mtl_materials = mtl_materials.unwrap_or_default();
     let mut warnings = mtl_warnings.into_inner();
+    if polylines > 0 {
+        let s = if polylines == 1 { "" } else { "s" };
+        warnings.push(format!(
+            "{}: ignored {polylines} polyline{s} (`l`): a line has no surface to show.",
+            req.label
+        ));
+    }
     if req.material_override.is_none() && warnings.is_empty() {
         warn_unknown_usemtl(req, &mtl_materials, &mut warnings);
     }
@@ -645,7 +679,9 @@ mod tests {
             source: "a test".into(),
         };
         let mut text = String::from("v 0 0 0\nv 1 0 0\nv 0 1 0\n");
-        assert_eq!(obj_counts("f 1 2 3 4 5\nl 1 2\nf 1\nv 1 1 1\n"), (1, 5));
+        assert_eq!(obj_counts("f 1 2 3 4 5\nl 1 2\nf 1\nv 1 1 1\n"), (1, 4));
+        let (stripped, n) = without_polylines("v 0 0 0\n l 1 2 3\nf 1 1 1\n");
+        assert_eq!((stripped.as_ref(), n), ("v 0 0 0\n#\nf 1 1 1\n", 1));
         assert!(check_mesh_memory(&Scene::default(), &text, &limit).is_ok());
         text += &"f 1 2 3\n".repeat(3000);
         let e = check_mesh_memory(&Scene::default(), &text, &limit).expect_err("over 1 MiB");
