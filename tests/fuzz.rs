@@ -24,6 +24,7 @@ mod hostile_support;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
 use hostile_support::{check_invariants, is_one_line, render_tiny};
@@ -33,7 +34,7 @@ use raytree::scene::builtin::{NAMES, scene_text};
 use raytree::scene::{load_scene_file, load_scene_str_with};
 
 /// Cases per target in the short run.
-const SHORT_TOML_CASES: u32 = 3000;
+const SHORT_TOML_CASES: u32 = 20000;
 const SHORT_OBJ_CASES: u32 = 2000;
 const SHORT_CLI_CASES: u32 = 60;
 
@@ -248,7 +249,7 @@ const HEADERS: &[&str] = &[
 enum Edit {
     FlipByte(usize, u8),
     Truncate(usize),
-    ReplaceNumber(usize, &'static str),
+    ReplaceNumber(usize, String),
     SwapValues(usize, usize),
     InsertLine(usize, String),
     DeleteLine(usize),
@@ -271,7 +272,11 @@ fn edit() -> impl Strategy<Value = Edit> {
         2 => (any::<usize>(), any::<u8>()).prop_map(|(a, b)| Edit::FlipByte(a, b)),
         1 => any::<usize>().prop_map(Edit::Truncate),
         4 => (any::<usize>(), proptest::sample::select(NUMBERS))
-            .prop_map(|(a, b)| Edit::ReplaceNumber(a, b)),
+            .prop_map(|(a, b)| Edit::ReplaceNumber(a, b.to_string())),
+        3 => (any::<usize>(), any::<f32>())
+            .prop_map(|(a, f)| Edit::ReplaceNumber(a, format!("{f:?}"))),
+        2 => (any::<usize>(), -3i64..70)
+            .prop_map(|(a, i)| Edit::ReplaceNumber(a, i.to_string())),
         2 => (any::<usize>(), any::<usize>()).prop_map(|(a, b)| Edit::SwapValues(a, b)),
         3 => (any::<usize>(), line).prop_map(|(a, l)| Edit::InsertLine(a, l)),
         1 => any::<usize>().prop_map(Edit::DeleteLine),
@@ -419,7 +424,8 @@ fn fuzz_scene_toml() {
             .cloned()
             .ok_or_else(|| format!("{path}: no such file"))
     };
-    let strategy = (0..seeds.len(), proptest::collection::vec(edit(), 1..6));
+    let strategy = (0..seeds.len(), proptest::collection::vec(edit(), 1..4));
+    let loaded = AtomicU32::new(0);
     run(
         "scene TOML",
         cases(SHORT_TOML_CASES, 1),
@@ -434,10 +440,12 @@ fn fuzz_scene_toml() {
                         panic!("loaded, but breaks the rule: {rule}\n{text}");
                     }
                     render_tiny(&scene);
+                    loaded.fetch_add(1, Ordering::Relaxed);
                 }
             }
         },
     );
+    eprintln!("  {} of the mutated scenes loaded", loaded.into_inner());
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -520,9 +528,13 @@ struct MeshCase {
     placement: String,
 }
 
+/// A mostly well-formed mesh (vertices, then faces whose indices are mostly in range, colours
+/// of three numbers) with a few hostile lines mixed in, so that cases get past the parser to
+/// the checks behind it; `hostile` lines alone rarely would.
 fn mesh_case() -> impl Strategy<Value = MeshCase> {
     let placement = proptest::sample::select(
         &[
+            "",
             "",
             "scale = -1\n",
             "scale = [1, -2, 3]\n",
@@ -532,16 +544,59 @@ fn mesh_case() -> impl Strategy<Value = MeshCase> {
             "material = \"default\"\n",
         ][..],
     );
+    let mostly_numbers = || {
+        prop_oneof![
+            12 => (-4i32..5).prop_map(|i| i.to_string()),
+            6 => (-2.0f32..2.0).prop_map(|f| f.to_string()),
+            1 => coordinate(),
+        ]
+    };
+    let vertex = (mostly_numbers(), mostly_numbers(), mostly_numbers())
+        .prop_map(|(x, y, z)| format!("v {x} {y} {z}"));
+    let index = prop_oneof![
+        10 => (1i64..10).prop_map(|i| i.to_string()),
+        2 => (-9i64..0).prop_map(|i| i.to_string()),
+        1 => corner(),
+    ];
+    let face = proptest::collection::vec(index, 1..8).prop_map(|c| format!("f {}", c.join(" ")));
+    let colour = (
+        proptest::sample::select(&["Ka", "Kd", "Ks"][..]),
+        mostly_numbers(),
+        mostly_numbers(),
+        mostly_numbers(),
+    )
+        .prop_map(|(k, r, g, b)| format!("{k} {r} {g} {b}"));
     (
-        proptest::collection::vec(obj_line(), 0..40),
-        proptest::collection::vec(mtl_line(), 0..12),
+        proptest::collection::vec(vertex, 0..12),
+        proptest::collection::vec(face, 0..16),
+        proptest::collection::vec((any::<usize>(), obj_line()), 0..3),
+        proptest::collection::vec(colour, 0..4),
+        proptest::collection::vec(mtl_line(), 0..3),
+        any::<bool>(),
         placement,
     )
-        .prop_map(|(obj, mtl, placement)| MeshCase {
-            obj: obj.join("\n") + "\n",
-            mtl: mtl.join("\n") + "\n",
-            placement: placement.to_string(),
-        })
+        .prop_map(
+            |(vertices, faces, hostile, colours, mtl_extra, use_mtl, placement)| {
+                let mut obj = Vec::new();
+                if use_mtl {
+                    obj.push("mtllib m.mtl".to_string());
+                    obj.push("usemtl red".to_string());
+                }
+                obj.extend(vertices);
+                obj.extend(faces);
+                for (at, line) in hostile {
+                    obj.insert(at % (obj.len() + 1), line);
+                }
+                let mut mtl = vec!["newmtl red".to_string()];
+                mtl.extend(colours);
+                mtl.extend(mtl_extra);
+                MeshCase {
+                    obj: obj.join("\n") + "\n",
+                    mtl: mtl.join("\n") + "\n",
+                    placement: placement.to_string(),
+                }
+            },
+        )
 }
 
 #[test]
@@ -549,6 +604,7 @@ fn fuzz_obj_and_mtl() {
     let dir = tempfile::tempdir().expect("temp dir");
     let obj_path = dir.path().join("m.obj");
     let obj_file = obj_path.display().to_string();
+    let (as_mesh, bare) = (AtomicU32::new(0), AtomicU32::new(0));
     run(
         "OBJ and MTL",
         cases(SHORT_OBJ_CASES, 1),
@@ -576,6 +632,9 @@ fn fuzz_obj_and_mtl() {
                         panic!("loaded, but breaks the rule: {rule}");
                     }
                     render_tiny(&scene);
+                    if !scene.triangles.is_empty() {
+                        as_mesh.fetch_add(1, Ordering::Relaxed);
+                    }
                 }
             }
             // As a bare OBJ from disk: the camera is framed on it.
@@ -594,9 +653,15 @@ fn fuzz_obj_and_mtl() {
                         panic!("loaded, but breaks the rule: {rule}");
                     }
                     render_tiny(&scene);
+                    bare.fetch_add(1, Ordering::Relaxed);
                 }
             }
         },
+    );
+    eprintln!(
+        "  {} loaded with triangles as a mesh, {} as a bare OBJ",
+        as_mesh.into_inner(),
+        bare.into_inner()
     );
 }
 
@@ -609,96 +674,106 @@ fn pick(options: &'static [&'static str]) -> BoxedStrategy<String> {
         .boxed()
 }
 
-/// A flag and its value (or none); valid values are small so that renders stay cheap.
+/// A flag and its value (or none): mostly valid values, small enough that renders stay cheap,
+/// and now and then an invalid one.
 fn flag() -> impl Strategy<Value = Vec<String>> {
-    let size = &[
-        "0",
-        "1",
-        "3",
-        "8",
-        "16385",
-        "-1",
-        "abc",
-        "",
-        "1e3",
-        "4294967296",
-        " 8",
-    ][..];
-    let with = |name: &'static str, values: &'static [&'static str]| {
-        pick(values).prop_map(move |v| vec![name.to_string(), v])
-    };
+    let with =
+        |name: &'static str, valid: &'static [&'static str], invalid: &'static [&'static str]| {
+            prop_oneof![4 => pick(valid), 1 => pick(invalid)]
+                .prop_map(move |v| vec![name.to_string(), v])
+        };
+    let bad_size = &["0", "16385", "-1", "abc", "", "1e3", "4294967296", " 8"][..];
     prop_oneof![
-        with("--width", size),
-        with("--height", size),
-        with("--samples", &["0", "1", "2", "65537", "x", "-3"]),
-        with("--max-depth", &["0", "5", "64", "65", "-1", "x"]),
+        with("--width", &["1", "3", "8", "17"], bad_size),
+        with("--height", &["1", "2", "8", "13"], bad_size),
+        with("--samples", &["1", "2", "3"], &["0", "65537", "x", "-3"]),
+        with("--max-depth", &["0", "5", "64"], &["65", "-1", "x"]),
         with(
             "--threads",
-            &["0", "1", "2", "1025", "-1", "x", "99999999999999999999"]
+            &["0", "1", "2"],
+            &["1025", "-1", "x", "99999999999999999999"]
         ),
-        with("--cutoff", &["0", "0.5", "1", "-1", "nan", "inf", "x"]),
-        with("--accel", &["auto", "none", "grid", "bvh", "octree", ""]),
-        with("--sphere", &["lecture", "robust", "x"]),
+        with(
+            "--cutoff",
+            &["0", "0.5", "0.01"],
+            &["1", "-1", "nan", "inf", "x"]
+        ),
+        with("--accel", &["auto", "none", "grid", "bvh"], &["octree", ""]),
+        with("--sphere", &["lecture", "robust"], &["x"]),
         with(
             "--triangle",
-            &["watertight", "moller-trumbore", "plane", "x"]
+            &["watertight", "moller-trumbore", "plane"],
+            &["x"]
         ),
-        with("--offset", &["fixed", "normal", "error-bound", "x"]),
-        with("--shading", &["phong", "blinn-phong", "gouraud"]),
-        with(
-            "--pixel",
-            &["0,0", "3,3", "5000,1", "1;2", "-1,0", "", "1,", ",1", "x,y"]
-        ),
-        with(
-            "-o",
-            &[
-                "OUT/a.png",
-                "OUT/a.exr",
-                "OUT/a.PNG",
-                "OUT/a.jpg",
-                "OUT/",
-                "OUT/no/a.png",
-                "",
-                "/dev/full"
-            ]
-        ),
-        with("--stats-json", &["OUT/s.json", "OUT/no/s.json"]),
-        pick(&[
-            "--json",
-            "-q",
-            "--quiet",
-            "--help",
-            "--version",
-            "--bogus",
-            "-",
-            "--",
-            "-x"
-        ])
-        .prop_map(|f| vec![f]),
+        with("--offset", &["fixed", "normal", "error-bound"], &["x"]),
+        with("--shading", &["phong", "blinn-phong"], &["gouraud"]),
+        with("--stats-json", &["OUT/s.json"], &["OUT/no/s.json", "OUT"]),
+        pick(&["--bogus", "-", "--", "-x", "--help"]).prop_map(|f| vec![f]),
     ]
 }
 
+/// Scenes that load fast at their own size, scenes that fail, and things that are no scene.
+const CLI_SCENES: &[&str] = &[
+    "quiz",
+    "quiz",
+    "tests/fixtures/hostile/empty.toml",
+    "tests/fixtures/hostile/one_and_two_vertex_faces.obj",
+    "tests/fixtures/hostile/mtl_nan.obj",
+    "tests/fixtures/hostile/found_bvh_far_scale.toml",
+    "tests/fixtures/hostile/nan_center.toml",
+    "tests/fixtures/hostile/binary_garbage.obj",
+    "tests/fixtures/hostile/zero_device.obj",
+    "tests/fixtures/bad/broken_mesh.toml",
+    "nope",
+    "",
+    "-",
+    ".",
+    "/dev/zero",
+];
+
 fn command_line() -> impl Strategy<Value = Vec<String>> {
-    // Never a command that opens the viewer on a loadable scene: no window in a test.
-    let subcommand = pick(&["render", "tree", "scenes", "rendr", "help", "RENDER"]);
-    let scene = pick(&[
-        "quiz",
-        "nope",
-        "",
-        "-",
-        ".",
-        "/dev/zero",
-        "tests/fixtures/hostile/empty.toml",
-        "tests/fixtures/hostile/nan_center.toml",
-        "tests/fixtures/hostile/binary_garbage.obj",
-        "tests/fixtures/hostile/one_and_two_vertex_faces.obj",
-        "tests/fixtures/hostile/zero_device.obj",
-        "tests/fixtures/bad/broken_mesh.toml",
-    ]);
-    (
-        subcommand,
-        scene,
-        proptest::collection::vec(flag(), 0..6),
+    let flags = |n: usize| proptest::collection::vec(flag(), 0..n);
+    let render = (
+        pick(CLI_SCENES),
+        prop_oneof![
+            6 => pick(&["OUT/a.png", "OUT/a.exr", "OUT/a.PNG"]),
+            1 => pick(&["OUT/a.jpg", "OUT/", "OUT/no/a.png", "", "/dev/full"]),
+        ],
+        any::<bool>(),
+        flags(4),
+    )
+        .prop_map(|(scene, out, quiet, flags)| {
+            let mut args = vec!["render".to_string(), scene, "-o".into(), out];
+            if quiet {
+                args.push("-q".into());
+            }
+            args.extend(flags.into_iter().flatten());
+            args
+        });
+    let tree = (
+        pick(CLI_SCENES),
+        prop_oneof![
+            4 => pick(&["0,0", "3,3", "100,100", "200,200"]),
+            1 => pick(&["5000,1", "1;2", "-1,0", "", "1,", ",1", "x,y", "4294967296,0"]),
+        ],
+        any::<bool>(),
+        flags(3),
+    )
+        .prop_map(|(scene, pixel, json, flags)| {
+            let mut args = vec!["tree".to_string(), scene, "--pixel".into(), pixel];
+            if json {
+                args.push("--json".into());
+            }
+            args.extend(flags.into_iter().flatten());
+            args
+        });
+    // Anything in any order. Never a command that opens the viewer on a loadable scene (no
+    // window in a test): a first word that is no subcommand is taken as a scene name, and
+    // these fail to load.
+    let noise = (
+        pick(&["render", "tree", "scenes", "rendr", "help", "RENDER"]),
+        pick(CLI_SCENES),
+        flags(6),
         any::<bool>(),
     )
         .prop_map(|(sub, scene, flags, scene_last)| {
@@ -711,13 +786,15 @@ fn command_line() -> impl Strategy<Value = Vec<String>> {
                 args.push(scene);
             }
             args
-        })
+        });
+    prop_oneof![4 => render, 2 => tree, 2 => noise]
 }
 
 #[test]
 fn fuzz_command_line() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().display().to_string();
+    let codes = [(); 3].map(|()| AtomicU32::new(0));
     run(
         "command line",
         cases(SHORT_CLI_CASES, 100),
@@ -739,6 +816,9 @@ fn fuzz_command_line() {
             let stderr = String::from_utf8_lossy(&output.stderr);
             let lines: Vec<&str> = stderr.lines().collect();
             let code = output.status.code();
+            if let Some(c @ 0..=2) = code {
+                codes[c as usize].fetch_add(1, Ordering::Relaxed);
+            }
             assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
             match code {
                 Some(0) => assert!(
@@ -766,4 +846,6 @@ fn fuzz_command_line() {
             }
         },
     );
+    let [ok, failed, usage] = codes.map(AtomicU32::into_inner);
+    eprintln!("  exit codes: {ok} succeeded, {failed} refused, {usage} usage errors");
 }

@@ -297,6 +297,22 @@ const ANY: Rule = |_| None;
 const NON_NEGATIVE: Rule = |x| (x < 0.0).then_some("must be at least 0");
 const POSITIVE: Rule = |x| (x <= 0.0).then_some("must be greater than 0");
 const NON_ZERO: Rule = |x| (x == 0.0).then_some("must not be 0");
+/// Positions (and radii) must lie within this distance of the origin. The BVH's traversal is
+/// exact only for scenes below about 1e17 in size (`accel/bvh.rs`), its build overflows to NaN
+/// near `f32::MAX` (a mesh moved to x = 3e38 made it panic: `found_bvh_far.toml`), and at 1e15
+/// an `f32` already cannot tell apart points 1e8 apart, so no meaningful scene is larger.
+pub const MAX_COORDINATE: f32 = 1e15;
+const COORDINATE: Rule = |x| {
+    (x.abs() > MAX_COORDINATE).then_some("must be within ±1e15 (raytree's limit on scene size)")
+};
+const RADIUS: Rule = |x| match POSITIVE(x) {
+    Some(problem) => Some(problem),
+    None => COORDINATE(x),
+};
+const LIGHT_RADIUS: Rule = |x| match NON_NEGATIVE(x) {
+    Some(problem) => Some(problem),
+    None => COORDINATE(x),
+};
 const FOV: Rule =
     |x| (x <= 0.0 || x >= 180.0).then_some("must be between 0 and 180 degrees (both excluded)");
 
@@ -699,9 +715,9 @@ impl SceneBuilder<'_> {
             self.scene.lights.push(Light {
                 name,
                 // Without a position, a headlight: a light at the eye.
-                position: s.vec3("position", self.scene.camera.position, ANY)?,
+                position: s.vec3("position", self.scene.camera.position, COORDINATE)?,
                 color: s.color("color", Vec3::ONE, NON_NEGATIVE)?,
-                radius: s.f32("radius", 0.0, NON_NEGATIVE)?,
+                radius: s.f32("radius", 0.0, LIGHT_RADIUS)?,
             });
         }
 
@@ -787,8 +803,8 @@ impl SceneBuilder<'_> {
         name: String,
         object: ObjectId,
     ) -> Result<(), SceneError> {
-        let center = s.vec3("center", Vec3::ZERO, ANY)?;
-        let radius = s.f32("radius", 1.0, POSITIVE)?;
+        let center = s.vec3("center", Vec3::ZERO, COORDINATE)?;
+        let radius = s.f32("radius", 1.0, RADIUS)?;
         let material = self.material(s, "material")?;
         self.scene.objects.push(Object {
             name,
@@ -822,7 +838,7 @@ impl SceneBuilder<'_> {
         };
         let mut vertices = [Vec3::ZERO; 3];
         for (v, corner) in vertices.iter_mut().zip(corners.iter()) {
-            *v = s.vec3_of("vertices", corner, ANY)?;
+            *v = s.vec3_of("vertices", corner, COORDINATE)?;
         }
         if !obj::is_visible_triangle(&vertices) {
             return Err(s.error(
@@ -866,7 +882,7 @@ impl SceneBuilder<'_> {
             None => None,
         };
         let placement = MeshPlacement {
-            translate: s.vec3("translate", Vec3::ZERO, ANY)?,
+            translate: s.vec3("translate", Vec3::ZERO, COORDINATE)?,
             rotate_deg: s.vec3("rotate", Vec3::ZERO, ANY)?,
             scale: s.scalar_or_vec3(
                 "scale",
@@ -1001,8 +1017,8 @@ fn parse_render(s: &Section) -> Result<RenderParams, SceneError> {
 fn parse_camera(s: &Section) -> Result<Camera, SceneError> {
     let d = Camera::default();
     let camera = Camera {
-        position: s.vec3("position", d.position, ANY)?,
-        look_at: s.vec3("look_at", d.look_at, ANY)?,
+        position: s.vec3("position", d.position, COORDINATE)?,
+        look_at: s.vec3("look_at", d.look_at, COORDINATE)?,
         up: s.vec3("up", d.up, ANY)?,
         fov_y_deg: s.f32("fov_y", d.fov_y_deg, FOV)?,
     };

@@ -14,7 +14,9 @@ use std::sync::Once;
 
 use glam::{Mat3, Vec3};
 
-use super::load::{ResolveFn, SceneError, check_camera, default_material, short, short_path};
+use super::load::{
+    MAX_COORDINATE, ResolveFn, SceneError, check_camera, default_material, short, short_path,
+};
 use super::{Camera, Light, Material, MaterialId, Object, ObjectId, ObjectSource, Scene, Triangle};
 use crate::render::{MemoryLimit, memory_limit, mesh_memory_estimate};
 
@@ -367,7 +369,7 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     let linear = req.placement.linear();
     let mirrors = req.placement.mirrors();
     let mut mtl_ids: Vec<Option<MaterialId>> = vec![None; mtl_materials.len()];
-    let (mut added, mut dropped) = (0usize, 0usize);
+    let (mut added, mut dropped, mut too_far) = (0usize, 0usize, 0usize);
     for model in &models {
         let mesh = &model.mesh;
         let mut material = None;
@@ -385,6 +387,10 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
             }
             if !is_visible_triangle(&v) {
                 dropped += 1;
+                continue;
+            }
+            if v.iter().any(|p| p.abs().max_element() > MAX_COORDINATE) {
+                too_far += 1;
                 continue;
             }
             // Materials are added on first use, so a scene lists only what it shows.
@@ -410,6 +416,13 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
         let s = if dropped == 1 { "" } else { "s" };
         warnings.push(format!(
             "{}: dropped {dropped} degenerate triangle{s} (zero area or non-finite vertices).",
+            req.label
+        ));
+    }
+    if too_far > 0 {
+        let s = if too_far == 1 { "" } else { "s" };
+        warnings.push(format!(
+            "{}: dropped {too_far} triangle{s} placed beyond ±1e15, raytree's limit on scene size.",
             req.label
         ));
     }

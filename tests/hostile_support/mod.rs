@@ -10,12 +10,14 @@ use std::sync::Arc;
 use glam::Vec3;
 use raytree::render::render;
 use raytree::scene::Scene;
+use raytree::scene::load::MAX_COORDINATE;
 use raytree::trace::{TraceSettings, Tracer};
 
 /// Every number finite, sizes in range, radii > 0, triangles of non-zero area, ids in range,
 /// names unique, a usable camera; `Err` says which rule broke.
 pub fn check_invariants(scene: &Scene) -> Result<(), String> {
-    let finite = |v: Vec3| v.is_finite();
+    // Finite, and within raytree's limit on scene size (the BVH's arithmetic needs it).
+    let finite = |v: Vec3| v.is_finite() && v.abs().max_element() <= MAX_COORDINATE;
     let colour = |v: Vec3| v.is_finite() && v.cmpge(Vec3::ZERO).all();
     let r = &scene.render;
     ensure((1..=16384).contains(&r.width), "width in 1..=16384")?;
@@ -25,8 +27,9 @@ pub fn check_invariants(scene: &Scene) -> Result<(), String> {
     ensure(colour(r.background), "background finite, ≥ 0")?;
     ensure(colour(r.ambient_light), "ambient light finite, ≥ 0")?;
     let c = &scene.camera;
+    // A bare OBJ's camera is framed from outside its bounds, so it may be farther out.
     ensure(
-        finite(c.position) && finite(c.look_at) && finite(c.up),
+        c.position.is_finite() && c.look_at.is_finite() && c.up.is_finite(),
         "camera finite",
     )?;
     ensure(
@@ -42,7 +45,10 @@ pub fn check_invariants(scene: &Scene) -> Result<(), String> {
     )?;
     for l in &scene.lights {
         ensure(finite(l.position) && colour(l.color), "light finite")?;
-        ensure(l.radius.is_finite() && l.radius >= 0.0, "light radius ≥ 0")?;
+        ensure(
+            l.radius.is_finite() && (0.0..=MAX_COORDINATE).contains(&l.radius),
+            "light radius ≥ 0",
+        )?;
     }
     for m in &scene.materials {
         for v in [
@@ -63,7 +69,7 @@ pub fn check_invariants(scene: &Scene) -> Result<(), String> {
     let (n_materials, n_objects) = (scene.materials.len(), scene.objects.len());
     for s in &scene.spheres {
         ensure(finite(s.center), "sphere centre finite")?;
-        ensure(s.radius.is_finite() && s.radius > 0.0, "radius > 0")?;
+        ensure(s.radius > 0.0 && s.radius <= MAX_COORDINATE, "radius > 0")?;
         ensure((s.material.0 as usize) < n_materials, "sphere material id")?;
         ensure((s.object.0 as usize) < n_objects, "sphere object id")?;
     }
