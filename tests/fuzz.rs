@@ -601,7 +601,14 @@ fn mesh_case() -> impl Strategy<Value = MeshCase> {
 
 #[test]
 fn fuzz_obj_and_mtl() {
-    let dir = tempfile::tempdir().expect("temp dir");
+    // Two small files are written per case: in memory where the system offers it.
+    let shm = Path::new("/dev/shm");
+    let dir = if shm.is_dir() {
+        tempfile::tempdir_in(shm)
+    } else {
+        tempfile::tempdir()
+    }
+    .expect("temp dir");
     let obj_path = dir.path().join("m.obj");
     let obj_file = obj_path.display().to_string();
     let (as_mesh, bare) = (AtomicU32::new(0), AtomicU32::new(0));

@@ -226,3 +226,49 @@ fn slider_bursts_through_the_window() {
     assert_eq!(h.state().scene().render.max_depth, (edits - 1) % 9);
     assert_converged(h.state());
 }
+
+/// Known gap (see docs/reliability.md): a scene wider than the largest texture eframe's device
+/// allows (8192: egui-wgpu asks for exactly that limit) loads, and the viewer then asks wgpu
+/// for a texture it cannot have. Run with `--ignored` to check a fix in the app.
+#[test]
+#[ignore = "app: the display texture is not checked against the adapter's limits"]
+fn a_scene_wider_than_the_largest_texture_is_refused() {
+    // The device eframe asks for in the real window (textures up to 8192), not kittest's.
+    let mut setup = egui_kittest::wgpu::default_wgpu_setup();
+    if let eframe::egui_wgpu::WgpuSetup::CreateNew(new) = &mut setup {
+        new.device_descriptor =
+            eframe::egui_wgpu::WgpuSetupCreateNew::without_display_handle().device_descriptor;
+    }
+    let renderer = egui_kittest::wgpu::WgpuTestRenderer::from_setup(setup);
+    let scene = small("quiz", 9000, 4, 1);
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(800.0, 500.0))
+        .renderer(renderer)
+        .build_eframe(|cc| ViewerApp::new(cc, scene, "wide".into()).expect("the viewer starts"));
+    for _ in 0..5 {
+        h.step();
+    }
+    // Drawing runs the paint callback, which creates the texture.
+    h.render().expect("the window draws");
+    assert!(
+        h.state().messages.iter().any(|(error, _)| *error),
+        "no message about the size"
+    );
+}
+
+/// Known gap (see docs/reliability.md): the panels edit positions without the loader's
+/// ±1e15 bound, and a BVH build over a primitive near f32::MAX panics in obvhs.
+#[test]
+#[ignore = "app/accel: edits bypass the loader's scene-size bound"]
+fn an_edit_far_beyond_the_scene_size_limit_does_not_panic() {
+    let mut app =
+        ViewerApp::headless(small("default", 32, 24, 1), "far".into()).expect("the viewer starts");
+    let mut far = app.edit.spheres[0];
+    far.center = Vec3::new(3e38, 0.0, 0.0);
+    for _ in 0..8 {
+        app.edit.spheres.push(far);
+    }
+    app.command(Command::Rebuild);
+    app.apply();
+    settle(&mut app);
+}
