@@ -35,8 +35,8 @@ use raytree::scene::{load_scene_file, load_scene_str_with};
 
 /// Cases per target in the short run.
 const SHORT_TOML_CASES: u32 = 20000;
-const SHORT_OBJ_CASES: u32 = 2000;
-const SHORT_CLI_CASES: u32 = 60;
+const SHORT_OBJ_CASES: u32 = 20000;
+const SHORT_CLI_CASES: u32 = 200;
 
 fn cases(short: u32, scale: u32) -> u32 {
     std::env::var("RAYTREE_FUZZ_CASES")
@@ -553,12 +553,18 @@ fn mesh_case() -> impl Strategy<Value = MeshCase> {
     };
     let vertex = (mostly_numbers(), mostly_numbers(), mostly_numbers())
         .prop_map(|(x, y, z)| format!("v {x} {y} {z}"));
-    let index = prop_oneof![
-        10 => (1i64..10).prop_map(|i| i.to_string()),
-        2 => (-9i64..0).prop_map(|i| i.to_string()),
-        1 => corner(),
-    ];
-    let face = proptest::collection::vec(index, 1..8).prop_map(|c| format!("f {}", c.join(" ")));
+    // Faces index the vertices there are, mostly: `n` is known when the faces are drawn.
+    let faces = |n: i64| {
+        let index = prop_oneof![
+            10 => (1..=n).prop_map(|i| i.to_string()),
+            2 => (-n..0).prop_map(|i| i.to_string()),
+            1 => corner(),
+        ];
+        proptest::collection::vec(
+            proptest::collection::vec(index, 1..8).prop_map(|c| format!("f {}", c.join(" "))),
+            0..16,
+        )
+    };
     let colour = (
         proptest::sample::select(&["Ka", "Kd", "Ks"][..]),
         mostly_numbers(),
@@ -566,17 +572,22 @@ fn mesh_case() -> impl Strategy<Value = MeshCase> {
         mostly_numbers(),
     )
         .prop_map(|(k, r, g, b)| format!("{k} {r} {g} {b}"));
+    let geometry = (1i64..12).prop_flat_map(move |n| {
+        (
+            proptest::collection::vec(vertex.clone(), n as usize),
+            faces(n),
+        )
+    });
     (
-        proptest::collection::vec(vertex, 0..12),
-        proptest::collection::vec(face, 0..16),
-        proptest::collection::vec((any::<usize>(), obj_line()), 0..3),
+        geometry,
+        proptest::collection::vec((any::<usize>(), obj_line()), 0..2),
         proptest::collection::vec(colour, 0..4),
         proptest::collection::vec(mtl_line(), 0..3),
         any::<bool>(),
         placement,
     )
         .prop_map(
-            |(vertices, faces, hostile, colours, mtl_extra, use_mtl, placement)| {
+            |((vertices, faces), hostile, colours, mtl_extra, use_mtl, placement)| {
                 let mut obj = Vec::new();
                 if use_mtl {
                     obj.push("mtllib m.mtl".to_string());
