@@ -24,6 +24,12 @@ use crate::geometry::{
 use crate::scene::{MaterialId, ObjectId, Scene};
 use crate::shade::{LightTerms, ambient_term, light_terms, reflect, refract};
 
+/// Rays (shadow rays included) one sample may trace; past it, branches end as
+/// [`EndReason::Cutoff`]. Natural scenes use a few dozen; the budget bounds the work of
+/// pathological ones (a glass ball in a box of mirrors at depth 64 would otherwise trace
+/// millions of rays for one pixel) while the tree and the image still agree exactly.
+pub const MAX_RAYS_PER_SAMPLE: u32 = 1 << 16;
+
 /// What a ray is, in the tree and in the statistics.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -281,7 +287,9 @@ impl Tracer {
             info.ends |= 1 << EndReason::MaxDepth as u8;
             return background;
         }
-        if weight.max_element() < self.settings.cutoff {
+        // Adaptive depth: a weight below the cutoff, or a sample that has used its ray budget
+        // (glass between mirrors doubles its rays every few levels), ends the branch.
+        if weight.max_element() < self.settings.cutoff || info.rays >= MAX_RAYS_PER_SAMPLE {
             rec.end(EndReason::Cutoff);
             info.ends |= 1 << EndReason::Cutoff as u8;
             return background;

@@ -465,11 +465,10 @@ fn usage_errors_are_one_line() {
     assert!(String::from_utf8_lossy(&output.stdout).lines().count() > 5);
 }
 
-/// Known gap (see docs/reliability.md): recursion is bounded by depth, but not the work: glass
-/// between mirrors doubles its rays every few levels, and a click at depth 64 traces millions
-/// of rays on the UI thread. Run with `--ignored` to check a ray budget or default cutoff.
+/// Recursion is bounded by depth, and the work by a ray budget per sample: glass between
+/// mirrors doubles its rays every few levels, so without the budget one click at depth 64
+/// traced millions of rays on the UI thread.
 #[test]
-#[ignore = "trace: no ray budget per sample; the click takes about a minute at depth 64"]
 fn a_click_on_glass_between_mirrors_at_depth_64_stays_interactive() {
     let scene = load_scene_file(
         Path::new(CORPUS)

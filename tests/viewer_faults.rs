@@ -227,11 +227,9 @@ fn slider_bursts_through_the_window() {
     assert_converged(h.state());
 }
 
-/// Known gap (see docs/reliability.md): a scene wider than the largest texture eframe's device
-/// allows (8192: egui-wgpu asks for exactly that limit) loads, and the viewer then asks wgpu
-/// for a texture it cannot have. Run with `--ignored` to check a fix in the app.
+/// A scene wider than the largest texture eframe's device allows (8192: egui-wgpu asks for
+/// exactly that limit) is shown scaled down to it, with a message.
 #[test]
-#[ignore = "app: the display texture is not checked against the adapter's limits"]
 fn a_scene_wider_than_the_largest_texture_is_refused() {
     // The device eframe asks for in the real window (textures up to 8192), not kittest's.
     let mut setup = egui_kittest::wgpu::default_wgpu_setup();
@@ -256,10 +254,9 @@ fn a_scene_wider_than_the_largest_texture_is_refused() {
     );
 }
 
-/// Known gap (see docs/reliability.md): the panels edit positions without the loader's
-/// ±1e15 bound, and a BVH build over a primitive near f32::MAX panics in obvhs.
+/// Edits are held to the loader's ±1e15 bound (a BVH build over a primitive near f32::MAX
+/// panics in obvhs): the far spheres are refused and the scene stays.
 #[test]
-#[ignore = "app/accel: edits bypass the loader's scene-size bound"]
 fn an_edit_far_beyond_the_scene_size_limit_does_not_panic() {
     let mut app =
         ViewerApp::headless(small("default", 32, 24, 1), "far".into()).expect("the viewer starts");

@@ -108,6 +108,8 @@ pub struct ViewerApp {
     hover: Option<(u32, u32)>,
     browser: Option<FileBrowser>,
     show_help: bool,
+    /// The largest texture side the GPU allows: the render is never larger on screen.
+    max_side: u32,
     last_mode: ImageMode,
     pending: Vec<Command>,
 }
@@ -149,6 +151,85 @@ pub fn run(scene_arg: Option<&str>) -> anyhow::Result<()> {
     })
 }
 
+/// Holds what the panels can change to the loader's rules, so an edit never hands the tracer
+/// what a scene file could not (`geometry`: also check every sphere and triangle).
+fn check_edit(s: &Scene, geometry: bool) -> Result<(), String> {
+    use crate::scene::load::{MAX_COORDINATE, MAX_DEPTH_LIMIT, MAX_IMAGE_SIZE, MAX_SAMPLES};
+    let placed = |v: Vec3| v.is_finite() && v.abs().max_element() <= MAX_COORDINATE;
+    let coefficient = |v: Vec3| v.is_finite() && v.min_element() >= 0.0;
+    let r = &s.render;
+    if !(1..=MAX_IMAGE_SIZE).contains(&r.width) || !(1..=MAX_IMAGE_SIZE).contains(&r.height) {
+        return Err(format!("width and height must be 1 to {MAX_IMAGE_SIZE}"));
+    }
+    if !(1..=MAX_SAMPLES).contains(&r.samples) || r.max_depth > MAX_DEPTH_LIMIT {
+        return Err(format!(
+            "samples must be 1 to {MAX_SAMPLES} and max depth at most {MAX_DEPTH_LIMIT}"
+        ));
+    }
+    if !coefficient(r.background) || !coefficient(r.ambient_light) {
+        return Err("background and ambient light must be finite and not negative".into());
+    }
+    let c = &s.camera;
+    if !placed(c.position) || !placed(c.look_at) || !c.up.is_finite() {
+        return Err("the camera's position, target and up must be finite and within ±1e15".into());
+    }
+    let view = c.look_at - c.position;
+    if view.length_squared() == 0.0 || c.up.cross(view).length_squared() == 0.0 {
+        return Err("the camera's target must differ from its position and its up must not lie along the view".into());
+    }
+    if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
+        return Err("the camera's fov y must be between 0 and 180 degrees".into());
+    }
+    for l in &s.lights {
+        if !placed(l.position)
+            || !coefficient(l.color)
+            || !(l.radius >= 0.0 && l.radius <= MAX_COORDINATE)
+        {
+            return Err(format!(
+                "light `{}` needs a finite position within ±1e15, a colour not negative and a radius from 0 to 1e15",
+                l.name
+            ));
+        }
+    }
+    for m in &s.materials {
+        let ok = [
+            m.ambient,
+            m.diffuse,
+            m.specular,
+            m.reflectivity,
+            m.transparency,
+        ]
+        .into_iter()
+        .all(coefficient)
+            && m.shininess.is_finite()
+            && m.shininess >= 0.0
+            && m.ior.is_finite()
+            && m.ior > 0.0;
+        if !ok {
+            return Err(format!(
+                "material `{}` needs finite coefficients not negative, shininess ≥ 0 and ior > 0",
+                m.name
+            ));
+        }
+    }
+    if geometry {
+        let spheres = s
+            .spheres
+            .iter()
+            .all(|sp| placed(sp.center) && sp.radius > 0.0 && sp.radius <= MAX_COORDINATE);
+        let triangles = s
+            .triangles
+            .iter()
+            .all(|t| t.vertices.iter().all(|&v| placed(v)));
+        if !spheres || !triangles {
+            return Err(
+                "every sphere and triangle must lie within ±1e15 with a radius above 0".into(),
+            );
+        }
+    }
+    Ok(())
+}
+
 /// A scene file, OBJ, or built-in scene name (a file of that name wins).
 pub fn load_scene_arg(arg: &str) -> Result<Scene, scene::SceneError> {
     let path = Path::new(arg);
@@ -169,11 +250,16 @@ impl ViewerApp {
             "the viewer needs the wgpu renderer and no graphics adapter was found; use `raytree render SCENE -o out.png`".to_string()
         })?;
         GpuDisplay::install(render_state);
-        Self::headless(scene, label)
+        let max_side = render_state.device.limits().max_texture_dimension_2d;
+        Self::with_limit(scene, label, max_side)
     }
 
     /// The viewer's state without a window (the GPU display is installed by [`Self::new`]).
     pub fn headless(scene: Scene, label: String) -> Result<Self, String> {
+        Self::with_limit(scene, label, crate::scene::load::MAX_IMAGE_SIZE)
+    }
+
+    fn with_limit(scene: Scene, label: String, max_side: u32) -> Result<Self, String> {
         let settings = RenderSettings::default();
         let session = Session::new(settings.threads)?;
         let scene = Arc::new(scene);
@@ -200,6 +286,7 @@ impl ViewerApp {
             hover: None,
             browser: None,
             show_help: false,
+            max_side: max_side.max(1),
             last_mode: ImageMode::Render,
             pending: Vec::new(),
         };
@@ -249,6 +336,28 @@ impl ViewerApp {
     fn restart(&mut self, rebuild: bool) {
         if let Err(e) = self.session.set_threads(self.settings.threads) {
             self.error(e);
+        }
+        // An edit is held to the loader's rules; a bad one is refused and the scene stays.
+        if let Err(e) = check_edit(&self.edit, rebuild) {
+            self.error(format!("{e}; the edit was undone"));
+            self.edit = (*self.scene).clone();
+            if self.generation > 0 {
+                return;
+            }
+        }
+        let (w, h) = (self.edit.render.width, self.edit.render.height);
+        if w.max(h) > self.max_side {
+            let k = self.max_side as f64 / w.max(h) as f64;
+            let (nw, nh) = (
+                ((w as f64 * k) as u32).max(1),
+                ((h as f64 * k) as u32).max(1),
+            );
+            self.error(format!(
+                "the viewer shows at most {} pixels across (this graphics adapter's limit): showing {w}x{h} at {nw}x{nh}; `raytree render` renders the full size",
+                self.max_side
+            ));
+            self.edit.render.width = nw;
+            self.edit.render.height = nh;
         }
         let scene = Arc::new(self.edit.clone());
         let (w, h) = (scene.render.width, scene.render.height);
