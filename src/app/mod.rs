@@ -181,9 +181,9 @@ fn check_edit(s: &Scene, geometry: bool) -> Result<(), String> {
         return Err("the camera's fov y must be between 0 and 180 degrees".into());
     }
     for l in &s.lights {
-        if !placed(l.position)
-            || !coefficient(l.color)
-            || !(l.radius >= 0.0 && l.radius <= MAX_COORDINATE)
+        if !(placed(l.position)
+            && coefficient(l.color)
+            && (0.0..=MAX_COORDINATE).contains(&l.radius))
         {
             return Err(format!(
                 "light `{}` needs a finite position within ±1e15, a colour not negative and a radius from 0 to 1e15",
