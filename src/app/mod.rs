@@ -345,16 +345,25 @@ impl ViewerApp {
                 return;
             }
         }
+        // The viewer's buffers must fit the GPU's largest texture and the memory budget: a
+        // larger render is shown scaled down (with a message); `raytree render` does full size.
         let (w, h) = (self.edit.render.width, self.edit.render.height);
-        if w.max(h) > self.max_side {
-            let k = self.max_side as f64 / w.max(h) as f64;
+        let limit = crate::render::memory_limit();
+        let per_pixel = crate::render::viewer_memory_estimate(1, 1).max(1);
+        let max_pixels = (limit.bytes / per_pixel).max(1) as f64;
+        let k = (self.max_side as f64 / w.max(h) as f64)
+            .min((max_pixels / (w as f64 * h as f64)).sqrt())
+            .min(1.0);
+        if k < 1.0 {
             let (nw, nh) = (
                 ((w as f64 * k) as u32).max(1),
                 ((h as f64 * k) as u32).max(1),
             );
             self.error(format!(
-                "the viewer shows at most {} pixels across (this graphics adapter's limit): showing {w}x{h} at {nw}x{nh}; `raytree render` renders the full size",
-                self.max_side
+                "the viewer shows at most {} pixels across and {:.0} MiB of buffers ({}): showing {w}x{h} at {nw}x{nh}; `raytree render` renders the full size",
+                self.max_side,
+                limit.bytes as f64 / (1 << 20) as f64,
+                limit.source
             ));
             self.edit.render.width = nw;
             self.edit.render.height = nh;
