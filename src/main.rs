@@ -18,7 +18,7 @@ use raytree::{export, ray_tree};
 /// raytree: recursive (Whitted) ray tracing with the ray tracing tree of every pixel.
 ///
 /// SCENE is a scene file (.toml), a bare OBJ file (.obj), or the name of a built-in scene:
-/// default, quiz, glass, box.
+/// default, quiz, glass, box, acne, cracks.
 #[derive(Parser, Debug)]
 #[command(version, about, long_about, max_term_width = 100)]
 struct Cli {

@@ -452,25 +452,33 @@ pub fn bench_chart(report: &BenchReport, scene_name: &str) -> Chart {
     let mut series: Vec<Series> = Knob::ALL
         .iter()
         .map(|&k| {
-            let pts = report
-                .points
-                .iter()
-                .filter(|p| p.knob == k)
-                .map(|p| (p.secs, p.error.mean_flip))
-                .collect();
-            Series::new(k.name(), pts)
+            let of_knob: Vec<&BenchPoint> = report.points.iter().filter(|p| p.knob == k).collect();
+            let pts = of_knob.iter().map(|p| (p.secs, p.error.mean_flip)).collect();
+            let s = Series::new(k.name(), pts);
+            match k {
+                // Ordered values: a line; methods and accelerators: labelled points.
+                Knob::MaxDepth | Knob::Samples | Knob::Cutoff => s,
+                _ => s.styled(
+                    SeriesStyle::Points,
+                    of_knob.iter().map(|p| p.value.clone()).collect(),
+                ),
+            }
         })
         .filter(|s| !s.points.is_empty())
         .collect();
-    let front = pareto_front(&report.points)
-        .into_iter()
-        .map(|i| (report.points[i].secs, report.points[i].error.mean_flip))
+    let front_idx = pareto_front(&report.points);
+    let front = front_idx
+        .iter()
+        .map(|&i| (report.points[i].secs, report.points[i].error.mean_flip))
         .collect();
-    series.push(Series {
-        name: "Pareto front".into(),
-        points: front,
-        style: SeriesStyle::Front,
-    });
+    let labels = front_idx
+        .iter()
+        .map(|&i| {
+            let p = &report.points[i];
+            format!("{} {}", p.knob.name(), p.value)
+        })
+        .collect();
+    series.push(Series::new("Pareto front", front).styled(SeriesStyle::Front, labels));
     Chart {
         title: format!(
             "{scene_name}: error against time ({}x{}, reference {} spp, depth {})",

@@ -22,6 +22,8 @@ pub const CHART_SIZE: (u32, u32) = (960, 620);
 pub enum SeriesStyle {
     /// Points joined in order.
     LinePoints,
+    /// Points only (the values of the series have no order, e.g. methods).
+    Points,
     /// A thick black line over the other series (the Pareto front), points ringed.
     Front,
 }
@@ -32,6 +34,8 @@ pub struct Series {
     pub name: String,
     pub points: Vec<(f64, f64)>,
     pub style: SeriesStyle,
+    /// A text next to each point (empty: none).
+    pub labels: Vec<String>,
 }
 
 impl Series {
@@ -40,6 +44,16 @@ impl Series {
             name: name.into(),
             points,
             style: SeriesStyle::LinePoints,
+            labels: Vec::new(),
+        }
+    }
+
+    /// The same series drawn as `style` with `labels` next to its points.
+    pub fn styled(self, style: SeriesStyle, labels: Vec<String>) -> Self {
+        Self {
+            style,
+            labels,
+            ..self
         }
     }
 }
@@ -126,12 +140,12 @@ fn axis_range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
         return if log { (0.1, 10.0) } else { (0.0, 1.0) };
     }
     if log {
-        let (lo, hi) = if lo == hi {
-            (lo / 2.0, hi * 2.0)
-        } else {
-            (lo, hi)
-        };
-        (lo / 1.3, hi * 1.3)
+        // Whole decades: plotters labels a log axis only from its first power of ten up.
+        // Padded a little so the end labels are inside the plot.
+        let lo = 10f64.powf(lo.log10().floor());
+        let hi = 10f64.powf(hi.log10().ceil());
+        let hi = if lo == hi { hi * 10.0 } else { hi };
+        (lo / 1.05, hi * 1.05)
     } else {
         let pad = if hi > lo { 0.05 * (hi - lo) } else { 0.5 };
         let lo = if lo >= 0.0 && lo - pad < 0.0 {
@@ -196,6 +210,8 @@ where
     cc.configure_mesh()
         .x_desc(chart.x_label.as_str())
         .y_desc(chart.y_label.as_str())
+        .x_labels(12)
+        .y_labels(12)
         .x_label_formatter(&|v| format_tick(*v))
         .y_label_formatter(&|v| format_tick(*v))
         .label_style(("sans-serif", 14))
@@ -211,35 +227,57 @@ where
     };
     let mut colour_index = 0;
     for s in &chart.series {
-        let points: Vec<(f64, f64)> = s.points.iter().filter(visible).copied().collect();
-        match s.style {
-            SeriesStyle::LinePoints => {
-                let colour = Palette99::pick(colour_index).to_rgba();
+        let shown: Vec<(usize, (f64, f64))> = s
+            .points
+            .iter()
+            .copied()
+            .enumerate()
+            .filter(|(_, p)| visible(&p))
+            .collect();
+        let points: Vec<(f64, f64)> = shown.iter().map(|(_, p)| *p).collect();
+        let (colour, line_width, ring) = match s.style {
+            SeriesStyle::Front => (BLACK.to_rgba(), 3, true),
+            _ => {
                 colour_index += 1;
-                cc.draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
-                    .map_err(err)?
-                    .label(s.name.as_str())
-                    .legend(move |(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(3))
-                    });
-                cc.draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))
-                    .map_err(err)?;
+                (Palette99::pick(colour_index - 1).to_rgba(), 2, false)
             }
-            SeriesStyle::Front => {
-                cc.draw_series(LineSeries::new(points.clone(), BLACK.stroke_width(3)))
-                    .map_err(err)?
-                    .label(s.name.as_str())
-                    .legend(|(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(3))
-                    });
-                cc.draw_series(
-                    points
-                        .iter()
-                        .map(|&p| Circle::new(p, 7, BLACK.stroke_width(2))),
-                )
-                .map_err(err)?;
-            }
+        };
+        let legend = move |(x, y): (i32, i32)| {
+            PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(3))
+        };
+        if s.style == SeriesStyle::Points {
+            cc.draw_series(
+                points
+                    .iter()
+                    .map(|&p| Circle::new(p, 5, colour.filled())),
+            )
+            .map_err(err)?
+            .label(s.name.as_str())
+            .legend(legend);
+        } else {
+            cc.draw_series(LineSeries::new(
+                points.clone(),
+                colour.stroke_width(line_width),
+            ))
+            .map_err(err)?
+            .label(s.name.as_str())
+            .legend(legend);
+            cc.draw_series(points.iter().map(|&p| {
+                if ring {
+                    Circle::new(p, 7, colour.stroke_width(2))
+                } else {
+                    Circle::new(p, 3, colour.filled())
+                }
+            }))
+            .map_err(err)?;
         }
+        let labelled = shown
+            .iter()
+            .filter_map(|(i, p)| s.labels.get(*i).map(|l| (*p, l.as_str())));
+        cc.draw_series(labelled.map(|(p, l)| {
+            EmptyElement::at(p) + Text::new(l.to_string(), (7, -16), ("sans-serif", 12))
+        }))
+        .map_err(err)?;
     }
     cc.configure_series_labels()
         .position(SeriesLabelPosition::UpperRight)
@@ -274,11 +312,10 @@ mod tests {
             y_log: false,
             series: vec![
                 Series::new("a", vec![(1.0, 0.0), (10.0, 5.0), (0.0, 1.0)]),
-                Series {
-                    name: "front".into(),
-                    points: vec![(1.0, 0.0), (10.0, 5.0)],
-                    style: SeriesStyle::Front,
-                },
+                Series::new("front", vec![(1.0, 0.0), (10.0, 5.0)])
+                    .styled(SeriesStyle::Front, vec!["a".into(), "b".into()]),
+                Series::new("methods", vec![(2.0, 1.0), (3.0, 2.0)])
+                    .styled(SeriesStyle::Points, vec![]),
             ],
         };
         let svg = chart_svg(&chart).expect("svg");
