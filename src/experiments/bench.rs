@@ -453,7 +453,10 @@ pub fn bench_chart(report: &BenchReport, scene_name: &str) -> Chart {
         .iter()
         .map(|&k| {
             let of_knob: Vec<&BenchPoint> = report.points.iter().filter(|p| p.knob == k).collect();
-            let pts = of_knob.iter().map(|p| (p.secs, p.error.mean_flip)).collect();
+            let pts = of_knob
+                .iter()
+                .map(|p| (p.secs, p.error.mean_flip))
+                .collect();
             let s = Series::new(k.name(), pts);
             match k {
                 // Ordered values: a line; methods and accelerators: labelled points.

@@ -246,14 +246,10 @@ where
             PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(3))
         };
         if s.style == SeriesStyle::Points {
-            cc.draw_series(
-                points
-                    .iter()
-                    .map(|&p| Circle::new(p, 5, colour.filled())),
-            )
-            .map_err(err)?
-            .label(s.name.as_str())
-            .legend(legend);
+            cc.draw_series(points.iter().map(|&p| Circle::new(p, 5, colour.filled())))
+                .map_err(err)?
+                .label(s.name.as_str())
+                .legend(legend);
         } else {
             cc.draw_series(LineSeries::new(
                 points.clone(),

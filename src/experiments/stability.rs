@@ -442,6 +442,49 @@ pub fn centroid_misses(
 }
 
 // =============================================================================================
+// T5: small triangles far from the ray origin
+
+/// Rays from `distance` (in triangle sizes) at random triangles of size 1 near the origin, seen
+/// at up to `max_tilt_deg` from face-on, through a point the `f64` oracle puts well inside
+/// (every barycentric ≥ 0.1). Returns (tested, misses). The watertight test's conservative
+/// `t > δt` check (pbrt-v4) grows with the ray-relative coordinates: far enough away it
+/// rejects the hit itself.
+pub fn far_triangle_misses(
+    method: TriangleMethod,
+    distance: f32,
+    max_tilt_deg: f32,
+    n: usize,
+    rng: &mut Pcg,
+) -> (usize, usize) {
+    let (mut tested, mut misses) = (0, 0);
+    let max_tilt = max_tilt_deg.to_radians();
+    for _ in 0..n {
+        let a = rng.unit();
+        let b = rng.perpendicular(a);
+        let c = rng.in_box(Vec3::splat(-1.0), Vec3::ONE);
+        let v = [c + a * 0.6, c - a * 0.3 + b * 0.5, c - a * 0.3 - b * 0.5];
+        let normal = a.cross(b);
+        // A direction at `tilt` from the normal.
+        let tilt = rng.range(0.0, max_tilt);
+        let side = rng.perpendicular(normal);
+        let towards = (normal * tilt.cos() + side * tilt.sin()).normalize();
+        let (w1, w2) = (rng.range(0.15, 0.45), rng.range(0.15, 0.45));
+        let target = v[0] + w1 * (v[1] - v[0]) + w2 * (v[2] - v[0]);
+        let origin = target + towards * distance;
+        let ray = Ray::new(origin, (target - origin).normalize());
+        let Some((t, b0, b1, b2)) = triangle_hit_f64(&v, &ray) else {
+            continue;
+        };
+        if t <= 0.0 || b0.min(b1).min(b2) < 0.1 {
+            continue;
+        }
+        tested += 1;
+        misses += usize::from(intersect_triangle(method, &v, &ray, 0.0, f32::INFINITY).is_none());
+    }
+    (tested, misses)
+}
+
+// =============================================================================================
 // T4: bad triangles in a valid mesh
 
 /// T4 figures.
@@ -850,7 +893,7 @@ pub struct RefractCell {
     pub tir_mismatch: usize,
     /// Largest `| |T| − 1 |`.
     pub max_len_err: f64,
-    /// Largest `|sin θt − η·sin θi|` (`η = ηi/ηt`), in `f64` from the `f32` vectors.
+    /// Largest `|(ηt/ηi)·sin θt − sin θi|`, in `f64` from the `f32` vectors.
     pub max_snell_residual: f64,
     /// Largest `|refract(−T, −n, 1/η) + u|`: refraction reversed must give the incoming ray.
     /// Near the critical angle `cos θt = sqrt(k)` turns an `ε` error of `k` into `sqrt(ε)`.
@@ -894,7 +937,8 @@ pub fn refract_cell(ior: f32, entering: bool, n: usize, rng: &mut Pcg) -> Refrac
         cell.max_len_err = cell.max_len_err.max((td.length() - 1.0).abs());
         let sin_t = td.cross(nd).length() / td.length();
         let sin_i = ud.cross(nd).length() / ud.length();
-        let residual = (sin_t - f64::from(eta) * sin_i).abs();
+        // STABILITY's form: η·sin θt − sin θi with η = ηt/ηi = 1/eta.
+        let residual = (sin_t / f64::from(eta) - sin_i).abs();
         cell.max_snell_residual = cell.max_snell_residual.max(residual);
         match refract(-t, -nrm, 1.0 / eta) {
             Some(back) => {
