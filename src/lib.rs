@@ -9,6 +9,7 @@
 
 pub mod accel;
 pub mod app;
+pub mod experiments;
 pub mod export;
 pub mod geometry;
 pub mod ray_tree;

@@ -3,10 +3,12 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand};
 use raytree::accel::AccelKind;
+use raytree::experiments::{bench, rows};
 use raytree::geometry::{Methods, OffsetMethod, SphereMethod, TriangleMethod};
 use raytree::render::{RenderSettings, render};
 use raytree::scene::{self, Scene, Shading};
@@ -16,7 +18,7 @@ use raytree::{export, ray_tree};
 /// raytree: recursive (Whitted) ray tracing with the ray tracing tree of every pixel.
 ///
 /// SCENE is a scene file (.toml), a bare OBJ file (.obj), or the name of a built-in scene:
-/// default, quiz, glass, box.
+/// default, quiz, glass, box, acne, cracks.
 #[derive(Parser, Debug)]
 #[command(version, about, long_about, max_term_width = 100)]
 struct Cli {
@@ -32,6 +34,13 @@ enum Command {
     Render(RenderArgs),
     /// Print the ray tracing tree of one pixel's centre sample.
     Tree(TreeArgs),
+    /// Chart render time against image error for every speed/accuracy knob (bench.csv,
+    /// bench.svg, bench.png) and build/render time against triangle count per accelerator
+    /// (scaling.csv, scaling.svg, scaling.png).
+    Bench(BenchArgs),
+    /// Measure where the naive intersection, offset and refraction methods fail and that the
+    /// robust ones hold (the rows of STABILITY.md): stability.md and one chart per row.
+    Stability(StabilityArgs),
     /// List the built-in scenes.
     Scenes,
 }
@@ -93,8 +102,49 @@ struct RenderArgs {
     /// Write the statistics as JSON to this file.
     #[arg(long)]
     stats_json: Option<PathBuf>,
+    /// Also print the geometry's memory: the accelerator, the scene's records, bytes per
+    /// primitive.
+    #[arg(long)]
+    stats: bool,
     #[command(flatten)]
     overrides: SceneOverrides,
+}
+
+#[derive(Args, Debug)]
+struct BenchArgs {
+    /// Scene file, OBJ file or built-in scene name.
+    scene: String,
+    /// Folder for the CSV files and charts (created if missing).
+    #[arg(long)]
+    out: PathBuf,
+    /// A small image, one run per point and smaller meshes: seconds instead of minutes.
+    #[arg(long)]
+    quick: bool,
+    /// Image width of the sweep (default: the scene's; --quick: 96).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    width: Option<u32>,
+    /// Image height of the sweep (default: the scene's; --quick: 72).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    height: Option<u32>,
+    /// Worker threads; 0 uses every core.
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// Skip the accelerator scaling sweep.
+    #[arg(long)]
+    no_scaling: bool,
+}
+
+#[derive(Args, Debug)]
+struct StabilityArgs {
+    /// Folder for stability.md and the charts (created if missing).
+    #[arg(long)]
+    out: PathBuf,
+    /// Print one JSON object per row (its measured figures) instead of the table.
+    #[arg(long)]
+    json: bool,
+    /// Fewer rays per cell (1000) and smaller builds: seconds instead of minutes.
+    #[arg(long)]
+    quick: bool,
 }
 
 #[derive(Args, Debug)]
@@ -260,6 +310,146 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         stats.render_secs,
         stats.mrays_per_sec()
     );
+    if args.stats {
+        let m = bench::MemoryStats::of(&tracer);
+        println!(
+            "memory: accelerator {} B + scene records {} B for {} triangles and {} spheres = \
+             {:.1} B per primitive ({} skipped{})",
+            m.accel_bytes,
+            m.scene_bytes,
+            m.triangles,
+            m.spheres,
+            m.bytes_per_prim(),
+            tracer.accel.skipped_prims(),
+            tracer
+                .accel
+                .bvh_depth()
+                .map(|d| format!(", BVH depth {d}"))
+                .unwrap_or_default(),
+        );
+    }
+    Ok(())
+}
+
+/// A progress bar for the sweeps: position, length and what is running.
+fn sweep_bar() -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(1);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} {msg}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar
+}
+
+fn run_bench(args: &BenchArgs) -> Result<()> {
+    let scene = load_scene(&args.scene)?;
+    print_warnings(&scene);
+    let (mut opts, scaling) = if args.quick {
+        (bench::BenchOptions::quick(), bench::ScalingOptions::quick())
+    } else {
+        (bench::BenchOptions::full(), bench::ScalingOptions::full())
+    };
+    opts.width = args.width.or(opts.width);
+    opts.height = args.height.or(opts.height);
+    opts.threads = args.threads;
+    let scaling = bench::ScalingOptions {
+        threads: args.threads,
+        ..scaling
+    };
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let cancel = AtomicBool::new(false);
+    let bar = sweep_bar();
+    let show = |p: &bench::BenchProgress| {
+        bar.set_length(p.steps as u64);
+        bar.set_position(p.step as u64);
+        bar.set_message(p.what.clone());
+    };
+    let report = bench::run_sweep(&scene, &opts, &show, &cancel)?;
+    bar.finish_and_clear();
+    bench::write_bench(&args.out, &report, &args.scene)?;
+    println!(
+        "wrote {} and bench.svg/.png ({} points, reference {}x{} at {} spp, depth {}, {:.1} s)",
+        args.out.join("bench.csv").display(),
+        report.points.len(),
+        report.reference.width,
+        report.reference.height,
+        report.reference.samples,
+        report.reference.max_depth,
+        report.reference.secs
+    );
+    println!("Pareto-optimal settings (time against mean FLIP):");
+    for line in bench::pareto_lines(&report) {
+        println!("  {line}");
+    }
+    let changed: Vec<String> = bench::accel_changes(&report)
+        .iter()
+        .filter(|(_, n)| *n > 0)
+        .map(|(k, n)| format!("{} changed {n} pixels", bench::value_name(k)))
+        .collect();
+    if changed.is_empty() {
+        println!("accelerators: none, grid and bvh give the identical image (0 differing pixels)");
+    }
+    if !args.no_scaling {
+        let bar = sweep_bar();
+        let show = |p: &bench::BenchProgress| {
+            bar.set_length(p.steps as u64);
+            bar.set_position(p.step as u64);
+            bar.set_message(p.what.clone());
+        };
+        let points = bench::run_scaling(&scaling, &show, &cancel)?;
+        bar.finish_and_clear();
+        bench::write_scaling(&args.out, &points, &scaling)?;
+        println!(
+            "wrote {} and scaling.svg/.png",
+            args.out.join("scaling.csv").display()
+        );
+        for line in bench::crossover_lines(&points) {
+            println!("  {line}");
+        }
+    }
+    if !changed.is_empty() {
+        bail!("an accelerator changed the image: {}", changed.join(", "));
+    }
+    Ok(())
+}
+
+fn run_stability(args: &StabilityArgs) -> Result<()> {
+    let opts = if args.quick {
+        rows::StabilityOptions::quick()
+    } else {
+        rows::StabilityOptions::full()
+    };
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let bar = indicatif::ProgressBar::new_spinner();
+    let measured = rows::rows(&opts, &|id| bar.set_message(format!("row {id}")));
+    bar.finish_and_clear();
+    rows::write_stability(&args.out, &measured)?;
+    if args.json {
+        for row in &measured {
+            println!(
+                "{}",
+                serde_json::to_string(row).context("cannot encode a row")?
+            );
+        }
+    } else {
+        print!("{}", rows::markdown_table(&measured));
+        println!(
+            "wrote {} and the charts",
+            args.out.join("stability.md").display()
+        );
+    }
+    let failed: Vec<&str> = measured
+        .iter()
+        .filter(|r| r.verdict == rows::Verdict::No)
+        .map(|r| r.id)
+        .collect();
+    if !failed.is_empty() {
+        bail!("rows {} miss their targets", failed.join(", "));
+    }
     Ok(())
 }
 
@@ -292,6 +482,8 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Some(Command::Render(args)) => run_render(&args),
         Some(Command::Tree(args)) => run_tree(&args),
+        Some(Command::Bench(args)) => run_bench(&args),
+        Some(Command::Stability(args)) => run_stability(&args),
         Some(Command::Scenes) => {
             for name in scene::builtin::NAMES {
                 println!("{name}");

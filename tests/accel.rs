@@ -2,60 +2,11 @@
 //! barycentrics; ties to the lower id) and the identical occlusion verdict for every ray, over
 //! random and degenerate scenes (STABILITY B1, B2, T1 "including through the BVH", T4).
 
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use raytree::accel::{AUTO_MIN_BVH_PRIMS, Accel, AccelKind, PrimHit, PrimSet};
+use raytree::experiments::meshes::octasphere;
+use raytree::experiments::rng::Pcg;
 use raytree::geometry::{Methods, Ray, SphereMethod, TriangleMethod};
-
-/// PCG32 (O'Neill), enough for seeded test inputs.
-struct Pcg(u64);
-
-impl Pcg {
-    fn new(seed: u64) -> Self {
-        let mut p = Pcg(seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407));
-        p.next_u32();
-        p
-    }
-    fn next_u32(&mut self) -> u32 {
-        let old = self.0;
-        self.0 = old
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
-        let rot = (old >> 59) as u32;
-        xorshifted.rotate_right(rot)
-    }
-    fn f32(&mut self) -> f32 {
-        (self.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0)
-    }
-    fn range(&mut self, a: f32, b: f32) -> f32 {
-        a + (b - a) * self.f32()
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next_u32() as usize) % n
-    }
-    fn unit(&mut self) -> Vec3 {
-        loop {
-            let v = Vec3::new(
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-            );
-            let l = v.length_squared();
-            if l > 1e-4 && l <= 1.0 {
-                return v / l.sqrt();
-            }
-        }
-    }
-    fn in_box(&mut self, lo: Vec3, hi: Vec3) -> Vec3 {
-        Vec3::new(
-            self.range(lo.x, hi.x),
-            self.range(lo.y, hi.y),
-            self.range(lo.z, hi.z),
-        )
-    }
-}
 
 const KINDS: [AccelKind; 3] = [AccelKind::None, AccelKind::Grid, AccelKind::Bvh];
 
@@ -568,7 +519,7 @@ fn closed_mesh_has_no_leaks_through_any_accelerator() {
     ] {
         // A closed mesh: an octahedron subdivided twice onto a sphere, moved off the origin.
         let center = Vec3::new(0.3, -0.7, 0.2) * (offset * scale);
-        let (verts, idx) = octasphere(2, scale);
+        let (verts, idx) = octasphere(2, scale, Vec3::ZERO);
         let verts: Vec<Vec3> = verts.iter().map(|v| *v + center).collect();
         let scene = PrimSet {
             spheres: vec![],
@@ -597,41 +548,4 @@ fn closed_mesh_has_no_leaks_through_any_accelerator() {
             }
         }
     }
-}
-
-fn octasphere(levels: u32, scale: f32) -> (Vec<Vec3>, Vec<[usize; 3]>) {
-    let mut verts: Vec<DVec3> = vec![
-        DVec3::X,
-        DVec3::NEG_X,
-        DVec3::Y,
-        DVec3::NEG_Y,
-        DVec3::Z,
-        DVec3::NEG_Z,
-    ];
-    let mut tris: Vec<[usize; 3]> = vec![
-        [0, 2, 4],
-        [2, 1, 4],
-        [1, 3, 4],
-        [3, 0, 4],
-        [2, 0, 5],
-        [1, 2, 5],
-        [3, 1, 5],
-        [0, 3, 5],
-    ];
-    for _ in 0..levels {
-        let mut mid = std::collections::HashMap::new();
-        let mut next = Vec::new();
-        for [a, b, c] in tris {
-            let mut m = |x: usize, y: usize| {
-                *mid.entry((x.min(y), x.max(y))).or_insert_with(|| {
-                    verts.push(((verts[x] + verts[y]) * 0.5).normalize());
-                    verts.len() - 1
-                })
-            };
-            let (ab, bc, ca) = (m(a, b), m(b, c), m(c, a));
-            next.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
-        }
-        tris = next;
-    }
-    (verts.iter().map(|v| v.as_vec3() * scale).collect(), tris)
 }

@@ -514,6 +514,8 @@ fn builtin_scenes_load_cleanly() {
         ("quiz", 1, 0, 1, 1, 1),
         ("glass", 4, 1, 128 + 128 + 8, 2, 5),
         ("box", 3, 2, 12, 1, 6),
+        ("acne", 5, 3, 2, 1, 3),
+        ("cracks", 1, 0, 128, 1, 1),
     ];
     assert_eq!(builtin::NAMES, expected.map(|e| e.0));
     for (name, objects, spheres, triangles, lights, materials) in expected {
@@ -546,7 +548,7 @@ fn builtin_scenes_load_cleanly() {
     assert_eq!(
         e,
         "there is no built-in scene \"cornell\"; the built-in scenes are \"default\", \"quiz\", \
-         \"glass\" and \"box\"."
+         \"glass\", \"box\", \"acne\" and \"cracks\"."
     );
 }
 

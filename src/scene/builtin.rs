@@ -2,19 +2,23 @@
 //! `assets/models`, loaded through the same TOML loader with a resolver that reads the
 //! embedded text instead of the disk. `default` is Whitted's classic picture (mirror and glass
 //! spheres over a checkerboard), `quiz` is the lecture's closing quiz, `glass` shows refraction
-//! and total internal reflection, `box` is a closed room with a mirror wall.
+//! and total internal reflection, `box` is a closed room with a mirror wall. `acne` and `cracks`
+//! are made to show two failures of the naive methods (`--offset fixed`; `--triangle
+//! moller-trumbore` or `lecture`) that the defaults do not have.
 
 use super::Scene;
 use super::load::{SceneError, load_scene_str_with};
 
 /// The built-in scenes, in the order a menu should show them.
-pub const NAMES: &[&str] = &["default", "quiz", "glass", "box"];
+pub const NAMES: &[&str] = &["default", "quiz", "glass", "box", "acne", "cracks"];
 
 const SCENES: &[(&str, &str)] = &[
     ("default", include_str!("../../assets/scenes/default.toml")),
     ("quiz", include_str!("../../assets/scenes/quiz.toml")),
     ("glass", include_str!("../../assets/scenes/glass.toml")),
     ("box", include_str!("../../assets/scenes/box.toml")),
+    ("acne", include_str!("../../assets/scenes/acne.toml")),
+    ("cracks", include_str!("../../assets/scenes/cracks.toml")),
 ];
 
 /// Embedded model files by their path from the crate root.

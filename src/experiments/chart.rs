@@ -1,0 +1,328 @@
+//! Charts of the sweeps as plain data ([`Chart`]: what the viewer can also plot with
+//! `egui_plot`) and their rendering to SVG and PNG with `plotters`. Text uses the Ubuntu Light
+//! font compiled into `epaint_default_fonts`, registered with plotters' `ab_glyph` backend, so
+//! no system font (fontconfig) is needed and the PNG looks the same on every machine.
+
+use std::path::Path;
+use std::sync::Once;
+
+use plotters::coord::Shift;
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::prelude::*;
+use serde::Serialize;
+
+use crate::export::{ExportError, write_atomically, write_text};
+
+/// Pixel size of the PNG (and the SVG's view box).
+pub const CHART_SIZE: (u32, u32) = (960, 620);
+
+/// How a series is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SeriesStyle {
+    /// Points joined in order.
+    LinePoints,
+    /// Points only (the values of the series have no order, e.g. methods).
+    Points,
+    /// A thick black line over the other series (the Pareto front), points ringed.
+    Front,
+}
+
+/// One named series of `(x, y)` points.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Series {
+    pub name: String,
+    pub points: Vec<(f64, f64)>,
+    pub style: SeriesStyle,
+    /// A text next to each point (empty: none).
+    pub labels: Vec<String>,
+}
+
+impl Series {
+    pub fn new(name: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Self {
+            name: name.into(),
+            points,
+            style: SeriesStyle::LinePoints,
+            labels: Vec::new(),
+        }
+    }
+
+    /// The same series drawn as `style` with `labels` next to its points.
+    pub fn styled(self, style: SeriesStyle, labels: Vec<String>) -> Self {
+        Self {
+            style,
+            labels,
+            ..self
+        }
+    }
+}
+
+/// A 2D chart: axes (linear or log) and series.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Chart {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub x_log: bool,
+    pub y_log: bool,
+    pub series: Vec<Series>,
+}
+
+/// Writes `{stem}.svg` and `{stem}.png`.
+pub fn write_chart(chart: &Chart, stem: &Path) -> Result<(), ExportError> {
+    let svg_path = stem.with_extension("svg");
+    let png_path = stem.with_extension("png");
+    let svg = chart_svg(chart).map_err(|reason| ExportError {
+        path: svg_path.display().to_string(),
+        reason,
+    })?;
+    write_text(&svg_path, &svg)?;
+    let rgb = chart_rgb(chart).map_err(|reason| ExportError {
+        path: png_path.display().to_string(),
+        reason,
+    })?;
+    write_atomically(&png_path, |out| {
+        let mut encoder = png::Encoder::new(out, CHART_SIZE.0, CHART_SIZE.1);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_compression(png::Compression::High);
+        let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+        writer.write_image_data(&rgb).map_err(|e| e.to_string())?;
+        writer.finish().map_err(|e| e.to_string())
+    })
+}
+
+/// The chart as SVG text.
+pub fn chart_svg(chart: &Chart) -> Result<String, String> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, CHART_SIZE).into_drawing_area();
+        draw(&root, chart)?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    Ok(svg)
+}
+
+/// The chart as 8-bit RGB pixels, row-major, [`CHART_SIZE`].
+pub fn chart_rgb(chart: &Chart) -> Result<Vec<u8>, String> {
+    let (w, h) = CHART_SIZE;
+    let mut buf = vec![255u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        draw(&root, chart)?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    Ok(buf)
+}
+
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        // The bytes are a valid TrueType font compiled into the binary; a failure here would
+        // only make text disappear, never fail a chart.
+        let _ = plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            epaint_default_fonts::UBUNTU_LIGHT,
+        );
+    });
+}
+
+/// The data range of the points on one axis (positive values only on a log axis), padded.
+fn axis_range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in values.filter(|v| v.is_finite() && (!log || *v > 0.0)) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if lo > hi {
+        return if log { (0.1, 10.0) } else { (0.0, 1.0) };
+    }
+    if log {
+        // Whole decades: plotters labels a log axis only from its first power of ten up.
+        // Padded a little so the end labels are inside the plot.
+        let lo = 10f64.powf(lo.log10().floor());
+        let hi = 10f64.powf(hi.log10().ceil());
+        let hi = if lo == hi { hi * 10.0 } else { hi };
+        (lo / 1.05, hi * 1.05)
+    } else {
+        let pad = if hi > lo { 0.05 * (hi - lo) } else { 0.5 };
+        let lo = if lo >= 0.0 && lo - pad < 0.0 {
+            0.0
+        } else {
+            lo - pad
+        };
+        (lo, hi + pad)
+    }
+}
+
+/// A tick label: plain for moderate values, `1e-6` style for the rest.
+pub fn format_tick(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 {
+        "0".into()
+    } else if !(1e-2..1e4).contains(&a) {
+        format!("{v:.0e}")
+    } else {
+        let s = format!("{v:.3}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
+
+fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &Chart) -> Result<(), String> {
+    register_font();
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let xs = chart
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.0));
+    let ys = chart
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.1));
+    let (x0, x1) = axis_range(xs, chart.x_log);
+    let (y0, y1) = axis_range(ys, chart.y_log);
+    match (chart.x_log, chart.y_log) {
+        (false, false) => plot(root, chart, x0..x1, y0..y1),
+        (true, false) => plot(root, chart, (x0..x1).log_scale(), y0..y1),
+        (false, true) => plot(root, chart, x0..x1, (y0..y1).log_scale()),
+        (true, true) => plot(root, chart, (x0..x1).log_scale(), (y0..y1).log_scale()),
+    }
+}
+
+fn plot<DB, X, Y>(root: &DrawingArea<DB, Shift>, chart: &Chart, x: X, y: Y) -> Result<(), String>
+where
+    DB: DrawingBackend,
+    X: AsRangedCoord<Value = f64>,
+    Y: AsRangedCoord<Value = f64>,
+    X::CoordDescType: ValueFormatter<f64>,
+    Y::CoordDescType: ValueFormatter<f64>,
+{
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let mut cc = ChartBuilder::on(root)
+        .caption(&chart.title, ("sans-serif", 22))
+        .margin(14)
+        .x_label_area_size(44)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x, y)
+        .map_err(err)?;
+    cc.configure_mesh()
+        .x_desc(chart.x_label.as_str())
+        .y_desc(chart.y_label.as_str())
+        .x_labels(12)
+        .y_labels(12)
+        .x_label_formatter(&|v| format_tick(*v))
+        .y_label_formatter(&|v| format_tick(*v))
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 16))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+        .map_err(err)?;
+    let visible = |p: &&(f64, f64)| {
+        p.0.is_finite()
+            && p.1.is_finite()
+            && (!chart.x_log || p.0 > 0.0)
+            && (!chart.y_log || p.1 > 0.0)
+    };
+    let mut colour_index = 0;
+    for s in &chart.series {
+        let shown: Vec<(usize, (f64, f64))> = s
+            .points
+            .iter()
+            .copied()
+            .enumerate()
+            .filter(|(_, p)| visible(&p))
+            .collect();
+        let points: Vec<(f64, f64)> = shown.iter().map(|(_, p)| *p).collect();
+        let (colour, line_width, ring) = match s.style {
+            SeriesStyle::Front => (BLACK.to_rgba(), 3, true),
+            _ => {
+                colour_index += 1;
+                (Palette99::pick(colour_index - 1).to_rgba(), 2, false)
+            }
+        };
+        let legend = move |(x, y): (i32, i32)| {
+            PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(3))
+        };
+        if s.style == SeriesStyle::Points {
+            cc.draw_series(points.iter().map(|&p| Circle::new(p, 5, colour.filled())))
+                .map_err(err)?
+                .label(s.name.as_str())
+                .legend(legend);
+        } else {
+            cc.draw_series(LineSeries::new(
+                points.clone(),
+                colour.stroke_width(line_width),
+            ))
+            .map_err(err)?
+            .label(s.name.as_str())
+            .legend(legend);
+            cc.draw_series(points.iter().map(|&p| {
+                if ring {
+                    Circle::new(p, 7, colour.stroke_width(2))
+                } else {
+                    Circle::new(p, 3, colour.filled())
+                }
+            }))
+            .map_err(err)?;
+        }
+        let labelled = shown
+            .iter()
+            .filter_map(|(i, p)| s.labels.get(*i).map(|l| (*p, l.as_str())));
+        cc.draw_series(labelled.map(|(p, l)| {
+            EmptyElement::at(p) + Text::new(l.to_string(), (7, -16), ("sans-serif", 12))
+        }))
+        .map_err(err)?;
+    }
+    cc.configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ticks_are_short() {
+        assert_eq!(format_tick(0.0), "0");
+        assert_eq!(format_tick(1e-6), "1e-6");
+        assert_eq!(format_tick(1e6), "1e6");
+        assert_eq!(format_tick(0.25), "0.25");
+        assert_eq!(format_tick(100.0), "100");
+    }
+
+    #[test]
+    fn renders_log_and_linear_charts() {
+        let chart = Chart {
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            x_log: true,
+            y_log: false,
+            series: vec![
+                Series::new("a", vec![(1.0, 0.0), (10.0, 5.0), (0.0, 1.0)]),
+                Series::new("front", vec![(1.0, 0.0), (10.0, 5.0)])
+                    .styled(SeriesStyle::Front, vec!["a".into(), "b".into()]),
+                Series::new("methods", vec![(2.0, 1.0), (3.0, 2.0)])
+                    .styled(SeriesStyle::Points, vec![]),
+            ],
+        };
+        let svg = chart_svg(&chart).expect("svg");
+        assert!(svg.starts_with("<svg") && svg.contains("front"));
+        let rgb = chart_rgb(&chart).expect("bitmap");
+        assert!(rgb.iter().any(|&b| b < 128), "something drawn");
+        let empty = Chart {
+            series: vec![],
+            y_log: true,
+            ..chart
+        };
+        chart_svg(&empty).expect("an empty chart still renders");
+    }
+}
