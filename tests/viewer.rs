@@ -233,3 +233,41 @@ fn window_snapshot() {
     h.mask(status);
     h.snapshot("viewer_default");
 }
+
+#[test]
+fn speed_vs_accuracy_window_runs_the_sweep_and_a_point_applies() {
+    let mut h = harness(small("quiz"));
+    settle(&mut h);
+    h.get_by_role_and_label(Role::Button, "Speed vs accuracy")
+        .click();
+    h.run_steps(3);
+    h.get_by_label_contains("quick").click();
+    h.run_steps(2);
+    h.get_by_role_and_label(Role::Button, "Run the sweep")
+        .click();
+    h.run_steps(2);
+    let deadline = Instant::now() + Duration::from_secs(300);
+    while h.state().sweep.report.is_none() {
+        assert!(Instant::now() < deadline, "the sweep did not finish");
+        h.step();
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let report = h.state().sweep.report.clone().expect("a report");
+    assert!(report.points.iter().any(|p| p.pareto), "no Pareto front");
+    // The plot's click handler picks the nearest point; here, the 4-sample point.
+    let p = report
+        .points
+        .iter()
+        .find(|p| p.knob == raytree::experiments::bench::Knob::Samples && p.settings.samples == 4)
+        .expect("a 4-sample point");
+    let at = [
+        p.secs.max(1e-6).log10(),
+        p.error.mean_flip.max(1e-6).log10(),
+    ];
+    let chosen = raytree::app::sweep::nearest_point(&report, at, [1.0, 1.0]).expect("near");
+    assert_eq!(chosen.samples, 4);
+    assert!(
+        raytree::app::sweep::nearest_point(&report, [at[0] + 0.5, at[1] + 0.5], [1.0, 1.0])
+            .is_none()
+    );
+}

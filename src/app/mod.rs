@@ -8,6 +8,7 @@
 mod file_browser;
 pub mod modes;
 mod panels;
+pub mod sweep;
 pub mod tree_view;
 pub mod viewport;
 
@@ -108,6 +109,8 @@ pub struct ViewerApp {
     hover: Option<(u32, u32)>,
     browser: Option<FileBrowser>,
     show_help: bool,
+    /// The "Speed vs accuracy" window and its background sweep.
+    pub sweep: sweep::SweepWindow,
     /// The largest texture side the GPU allows: the render is never larger on screen.
     max_side: u32,
     last_mode: ImageMode,
@@ -286,6 +289,7 @@ impl ViewerApp {
             hover: None,
             browser: None,
             show_help: false,
+            sweep: sweep::SweepWindow::default(),
             max_side: max_side.max(1),
             last_mode: ImageMode::Render,
             pending: Vec::new(),
@@ -779,6 +783,15 @@ impl eframe::App for ViewerApp {
             }
         }
         panels::help_window(&ctx, &mut self.show_help);
+        if self.sweep.open
+            && let Some(point) = self.sweep.show(&ctx, &self.scene)
+        {
+            // A clicked point: its settings become the viewer's.
+            self.edit.render.max_depth = point.max_depth;
+            self.edit.render.samples = point.samples;
+            self.settings.trace = point.trace;
+            self.pending.push(Command::Rebuild);
+        }
         self.apply();
         self.refresh_if_mode_changed();
         if !self.is_finished() {

@@ -163,6 +163,9 @@ pub fn top_bar(app: &mut ViewerApp, ui: &mut Ui) {
                     ui.radio_value(&mut app.prefs.mode, mode, mode.label());
                 }
             });
+            if ui.button("Speed vs accuracy").clicked() {
+                app.sweep.open = true;
+            }
             if ui.button("Help (F1)").clicked() {
                 app.show_help = true;
             }

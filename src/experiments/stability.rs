@@ -422,7 +422,8 @@ pub fn centroid_misses(
             base + a * (0.5 * edge) + b * (edge / aspect),
         ];
         let normal = (v[1] - v[0]).cross(v[2] - v[0]);
-        if !(normal.length() >= 0.5 * edge * edge / aspect) {
+        let area2 = normal.length();
+        if area2.is_nan() || area2 < 0.5 * edge * edge / aspect {
             continue; // the rounded vertices are too thin to aim at reliably
         }
         let centroid = (v[0] + v[1] + v[2]) / 3.0;
