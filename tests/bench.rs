@@ -82,7 +82,10 @@ fn quick_bench_writes_csv_and_charts() {
         "changed_pixels",
         "pareto",
     ] {
-        assert!(header.iter().any(|h| h == col), "no column {col}: {header:?}");
+        assert!(
+            header.iter().any(|h| h == col),
+            "no column {col}: {header:?}"
+        );
     }
     let knob = |k: &'static str| rows.iter().filter(move |r| r["knob"] == k);
     for k in [
@@ -114,7 +117,10 @@ fn quick_bench_writes_csv_and_charts() {
             num(first, col)
         );
         for w in samples.windows(2) {
-            assert!(num(w[1], col) <= num(w[0], col) * 1.02, "{col} rises: {w:?}");
+            assert!(
+                num(w[1], col) <= num(w[0], col) * 1.02,
+                "{col} rises: {w:?}"
+            );
         }
     }
     // Depth 0 (no reflections or refractions) is far from the reference.
@@ -129,8 +135,18 @@ fn quick_bench_writes_csv_and_charts() {
     assert_chart(dir.path(), "bench");
 
     let (header, rows) = read_csv(&dir.path().join("scaling.csv"));
-    for col in ["triangles", "accel", "build_secs", "render_secs", "memory_bytes", "note"] {
-        assert!(header.iter().any(|h| h == col), "no column {col}: {header:?}");
+    for col in [
+        "triangles",
+        "accel",
+        "build_secs",
+        "render_secs",
+        "memory_bytes",
+        "note",
+    ] {
+        assert!(
+            header.iter().any(|h| h == col),
+            "no column {col}: {header:?}"
+        );
     }
     for accel in ["none", "grid", "bvh"] {
         assert!(rows.iter().any(|r| r["accel"] == accel), "{accel}");
