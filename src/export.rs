@@ -20,7 +20,21 @@ pub struct ExportError {
 fn export_error(path: &Path, reason: impl std::fmt::Display) -> ExportError {
     ExportError {
         path: path.display().to_string(),
-        reason: reason.to_string(),
+        reason: plain_reason(&reason.to_string()),
+    }
+}
+
+/// The OS's reason alone. `tempfile` appends the temporary file's path ("… at path
+/// /dir/.raytree-Xy12.tmp"), a name the user never chose and that no longer exists, and
+/// "(os error N)" is for programs; both would only blur the sentence.
+fn plain_reason(text: &str) -> String {
+    let text = text.split(" at path ").next().unwrap_or(text);
+    match text.find(" (os error") {
+        Some(i) => {
+            let tail = text[i..].split_once(')').map_or("", |(_, t)| t);
+            format!("{}{tail}", &text[..i])
+        }
+        None => text.to_string(),
     }
 }
 
@@ -158,6 +172,19 @@ mod tests {
         // Below the linear segment's end: 12.92 · 0.002 = 0.02584 → 6.59 → 7.
         assert_eq!(to_srgb8(Vec3::splat(0.002)), [7, 7, 7]);
         assert_eq!(to_srgb8(Vec3::splat(f32::NAN)), [0, 0, 0]);
+    }
+
+    #[test]
+    fn reasons_are_plain() {
+        assert_eq!(
+            plain_reason("Not a directory (os error 20) at path \"/d/.raytree-x.tmp\""),
+            "Not a directory"
+        );
+        assert_eq!(
+            plain_reason("IO error: File too large (os error 27)"),
+            "IO error: File too large"
+        );
+        assert_eq!(plain_reason("simulated failure"), "simulated failure");
     }
 
     #[test]

@@ -92,8 +92,9 @@ struct RenderArgs {
     /// Samples per pixel (sample 0 is the pixel centre).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
     samples: Option<u32>,
-    /// Worker threads; 0 uses every core.
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads; 0 uses every core (at most 1024).
+    #[arg(long, default_value_t = 0,
+          value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1024))]
     threads: usize,
     /// No progress bar.
     #[arg(short, long)]
@@ -500,8 +501,39 @@ fn run(cli: Cli) -> Result<()> {
     }
 }
 
+/// Parses the arguments; a usage error becomes one line on stderr (exit code 2), as every
+/// other error is one line. `--help` and `--version` print as clap formats them.
+fn parse_args() -> Result<Cli, ExitCode> {
+    Cli::try_parse().map_err(|e| {
+        if !e.use_stderr() {
+            e.exit();
+        }
+        // clap's message is "error: ...", tips, a usage block and a pointer to --help:
+        // keep the error and its tips, on one line.
+        let text = e.render().to_string();
+        let mut line = String::new();
+        for part in text
+            .lines()
+            .map(str::trim)
+            .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+            .filter(|l| !l.is_empty())
+        {
+            if !line.is_empty() {
+                line += if line.ends_with(':') { " " } else { "; " };
+            }
+            line += part;
+        }
+        let line = line.strip_prefix("error: ").unwrap_or(&line);
+        eprintln!("error: {line} (see `raytree --help`)");
+        ExitCode::from(2)
+    })
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match parse_args() {
+        Ok(cli) => cli,
+        Err(code) => return code,
+    };
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

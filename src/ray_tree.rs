@@ -30,6 +30,13 @@ pub struct HitRecord {
     pub barycentric: Option<[f32; 3]>,
 }
 
+/// A visible light met by a ray.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LightHit {
+    pub name: String,
+    pub t: f32,
+}
+
 /// The local illumination terms at a hit, summed over lights.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LocalRecord {
@@ -48,11 +55,18 @@ pub struct ShadowRecord {
     pub distance: f32,
     /// The first object on the segment to the light, or `None` when lit (or facing away).
     pub blocked_by: Option<String>,
+    /// Distance from the hit point to the blocker along `to_light`.
+    #[serde(default)]
+    pub blocked_at: Option<f32>,
     /// `N·L ≤ 0`: the light is behind the surface, adds nothing and needs no shadow ray.
     pub facing_away: bool,
     pub n_dot_l: f32,
     pub n_dot_h: f32,
     pub r_dot_v: f32,
+    /// Blinn's halfway vector `H = normalize(L + V)`.
+    pub halfway: Vec3,
+    /// Phong's mirrored light direction `R_l = 2(N·L)N − L`.
+    pub mirror: Vec3,
     /// This light's diffuse and specular terms as added (zero when blocked).
     pub diffuse: Vec3,
     pub specular: Vec3,
@@ -68,12 +82,21 @@ pub struct Node {
     /// Product of kr / kt along the path from the root.
     pub weight: Vec3,
     pub end: Option<EndReason>,
+    /// The visible light that ended the ray (`end` = `hit_light`) and the distance to it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub light: Option<LightHit>,
     pub hit: Option<HitRecord>,
     /// `V`, unit vector from the hit towards the ray's origin.
     pub view: Option<Vec3>,
     pub local: Option<LocalRecord>,
     pub shadow_rays: Vec<ShadowRecord>,
     pub total_internal_reflection: bool,
+    /// Weight given to the reflected child: `kr`, plus `kt` on total internal reflection.
+    #[serde(default)]
+    pub kr: Option<Vec3>,
+    /// Weight given to the refracted child (`kt`), zero on total internal reflection.
+    #[serde(default)]
+    pub kt: Option<Vec3>,
     /// `local + kr·reflected.color + kt·refracted.color`.
     pub color: Vec3,
     pub children: Vec<Node>,
@@ -140,11 +163,14 @@ impl Recorder for TreeRecorder<'_> {
             direction: ray.dir,
             weight,
             end: None,
+            light: None,
             hit: None,
             view: None,
             local: None,
             shadow_rays: Vec::new(),
             total_internal_reflection: false,
+            kr: None,
+            kt: None,
             color: Vec3::ZERO,
             children: Vec::new(),
         });
@@ -153,6 +179,16 @@ impl Recorder for TreeRecorder<'_> {
     fn end(&mut self, reason: EndReason) {
         if let Some(node) = self.top() {
             node.end = Some(reason);
+        }
+    }
+
+    fn light(&mut self, light: usize, t: f32) {
+        let scene = self.scene;
+        if let Some(node) = self.top() {
+            node.light = Some(LightHit {
+                name: scene.lights[light].name.clone(),
+                t,
+            });
         }
     }
 
@@ -176,15 +212,23 @@ impl Recorder for TreeRecorder<'_> {
         let scene = self.scene;
         if let Some(node) = self.top() {
             let lit = test.blocked_by.is_none() && test.terms.n_dot_l > 0.0;
+            let (n, v) = match (&node.hit, node.view) {
+                (Some(h), Some(v)) => (h.normal, v),
+                _ => (Vec3::ZERO, Vec3::ZERO),
+            };
+            let l = test.to_light;
             node.shadow_rays.push(ShadowRecord {
                 light: scene.lights[test.light].name.clone(),
                 to_light: test.to_light,
                 distance: test.distance,
                 blocked_by: test.blocked_by.map(|o| scene.object(o).name.clone()),
+                blocked_at: test.blocked_at,
                 facing_away: test.terms.n_dot_l.is_nan() || test.terms.n_dot_l <= 0.0,
                 n_dot_l: test.terms.n_dot_l,
                 n_dot_h: test.terms.n_dot_h,
                 r_dot_v: test.terms.r_dot_v,
+                halfway: crate::shade::halfway(l, v),
+                mirror: crate::shade::reflect(-l, n),
                 diffuse: if lit { test.terms.diffuse } else { Vec3::ZERO },
                 specular: if lit { test.terms.specular } else { Vec3::ZERO },
             });
@@ -205,6 +249,13 @@ impl Recorder for TreeRecorder<'_> {
     fn total_internal_reflection(&mut self) {
         if let Some(node) = self.top() {
             node.total_internal_reflection = true;
+        }
+    }
+
+    fn child_weights(&mut self, reflected: Vec3, refracted: Vec3) {
+        if let Some(node) = self.top() {
+            node.kr = Some(reflected);
+            node.kt = Some(refracted);
         }
     }
 
@@ -306,7 +357,12 @@ fn write_node(out: &mut String, node: &Node, indent: usize) {
         fmt_v(node.direction)
     );
     if let Some(end) = node.end {
-        let _ = writeln!(out, " -> {end:?} => colour {}", fmt_v(node.color));
+        let light = node
+            .light
+            .as_ref()
+            .map(|l| format!(" ({} at t = {:.5})", l.name, l.t))
+            .unwrap_or_default();
+        let _ = writeln!(out, " -> {end:?}{light} => colour {}", fmt_v(node.color));
         return;
     }
     out.push('\n');
@@ -328,7 +384,12 @@ fn write_node(out: &mut String, node: &Node, indent: usize) {
     for s in &node.shadow_rays {
         let verdict = match (&s.blocked_by, s.facing_away) {
             (_, true) => "facing away".to_string(),
-            (Some(b), _) => format!("blocked by {b}"),
+            (Some(b), _) => format!(
+                "blocked by {b}{}",
+                s.blocked_at
+                    .map(|d| format!(" at {d:.4}"))
+                    .unwrap_or_default()
+            ),
             (None, false) => "lit".to_string(),
         };
         let _ = writeln!(
@@ -355,6 +416,16 @@ fn write_node(out: &mut String, node: &Node, indent: usize) {
     }
     if node.total_internal_reflection {
         let _ = writeln!(out, "{pad}  total internal reflection: kt goes to R");
+    }
+    if let (Some(kr), Some(kt)) = (node.kr, node.kt)
+        && !node.children.is_empty()
+    {
+        let _ = writeln!(
+            out,
+            "{pad}  children weighted kr {} and kt {}",
+            fmt_v(kr),
+            fmt_v(kt)
+        );
     }
     for child in &node.children {
         write_node(out, child, indent + 1);

@@ -24,6 +24,12 @@ use crate::geometry::{
 use crate::scene::{MaterialId, ObjectId, Scene};
 use crate::shade::{LightTerms, ambient_term, light_terms, reflect, refract};
 
+/// Rays (shadow rays included) one sample may trace; past it, branches end as
+/// [`EndReason::Cutoff`]. Natural scenes use a few dozen; the budget bounds the work of
+/// pathological ones (a glass ball in a box of mirrors at depth 64 would otherwise trace
+/// millions of rays for one pixel) while the tree and the image still agree exactly.
+pub const MAX_RAYS_PER_SAMPLE: u32 = 1 << 16;
+
 /// What a ray is, in the tree and in the statistics.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -116,6 +122,8 @@ pub struct ShadowTest {
     /// The first object on the segment to the light, if any. `None` also when the light is
     /// behind the surface (`N·L ≤ 0`), where no shadow ray is needed.
     pub blocked_by: Option<ObjectId>,
+    /// Distance along the shadow ray (from its offset origin) to the blocker.
+    pub blocked_at: Option<f32>,
     pub terms: LightTerms,
 }
 
@@ -125,10 +133,14 @@ pub trait Recorder {
     const ENABLED: bool;
     fn enter(&mut self, _kind: RayKind, _depth: u32, _ray: &Ray, _weight: Vec3) {}
     fn end(&mut self, _reason: EndReason) {}
+    /// The ray ended on visible light `light` at distance `t`.
+    fn light(&mut self, _light: usize, _t: f32) {}
     fn hit(&mut self, _hit: &SurfaceHit, _view: Vec3) {}
     fn shadow(&mut self, _test: &ShadowTest) {}
     fn local(&mut self, _ambient: Vec3, _diffuse: Vec3, _specular: Vec3) {}
     fn total_internal_reflection(&mut self) {}
+    /// The weights the children get: `kr` (plus `kt` on total internal reflection) and `kt`.
+    fn child_weights(&mut self, _reflected: Vec3, _refracted: Vec3) {}
     fn leave(&mut self, _color: Vec3) {}
 }
 
@@ -184,7 +196,8 @@ pub struct Tracer {
 
 enum Found {
     Nothing,
-    Light(usize),
+    /// A visible light and the distance to its surface.
+    Light(usize, f32),
     Prim(PrimHit),
 }
 
@@ -231,7 +244,7 @@ impl Tracer {
             if let Some(t) = intersect_sphere(sphere, light.position, light.radius, ray, 0.0, t_max)
             {
                 t_max = t;
-                found = Found::Light(i);
+                found = Found::Light(i, t);
             }
         }
         found
@@ -274,7 +287,9 @@ impl Tracer {
             info.ends |= 1 << EndReason::MaxDepth as u8;
             return background;
         }
-        if weight.max_element() < self.settings.cutoff {
+        // Adaptive depth: a weight below the cutoff, or a sample that has used its ray budget
+        // (glass between mirrors doubles its rays every few levels), ends the branch.
+        if weight.max_element() < self.settings.cutoff || info.rays >= MAX_RAYS_PER_SAMPLE {
             rec.end(EndReason::Cutoff);
             info.ends |= 1 << EndReason::Cutoff as u8;
             return background;
@@ -288,8 +303,9 @@ impl Tracer {
                 info.ends |= 1 << EndReason::NoHit as u8;
                 background
             }
-            Found::Light(i) => {
+            Found::Light(i, t) => {
                 rec.end(EndReason::HitLight);
+                rec.light(i, t);
                 info.ends |= 1 << EndReason::HitLight as u8;
                 self.scene.lights[i].color
             }
@@ -359,6 +375,7 @@ impl Tracer {
             let l = to_light / distance;
             let terms = light_terms(scene.render.shading, material, light.color, n, l, v);
             let mut blocked_by = None;
+            let mut blocked_at = None;
             if terms.n_dot_l > 0.0 {
                 // The shadow ray runs from the offset origin to the light's centre; only
                 // objects count as blockers, never lights.
@@ -373,6 +390,7 @@ impl Tracer {
                         .accel
                         .closest_hit(self.methods(), &shadow_ray, 0.0, length);
                     blocked_by = blocker.map(|b| self.object_of(b.prim));
+                    blocked_at = blocker.map(|b| b.t);
                     blocker.is_some()
                 } else {
                     self.accel
@@ -389,6 +407,7 @@ impl Tracer {
                     to_light: l,
                     distance,
                     blocked_by,
+                    blocked_at,
                     terms,
                 });
             }
@@ -417,6 +436,10 @@ impl Tracer {
                 }
             }
         }
+        rec.child_weights(
+            reflected_weight,
+            if refracted.is_some() { kt } else { Vec3::ZERO },
+        );
         if reflected_weight != Vec3::ZERO {
             let r = reflect(ray.dir, n).normalize();
             let child = Ray::new(offset_ray_origin(offset, p, error, n, r), r);

@@ -1,129 +1,16 @@
 //! The trace against answers derived by hand: the lecture's quiz, reflection and refraction,
 //! max_depth semantics, shadows, and pixels of small scenes (1e-5).
 
-use std::sync::Arc;
+mod common;
 
+use common::{Build, close, floor, looking, mat, wall_z};
 use glam::{DVec3, Vec3};
 use raytree::accel::AccelKind;
 use raytree::geometry::{Ray, TriangleMethod, intersect_triangle, triangle_hit_point};
-use raytree::render::render;
-use raytree::scene::{
-    Camera, Light, Material, MaterialId, Object, ObjectId, ObjectSource, RenderParams, Scene,
-    Shading, Sphere, Triangle,
-};
+use raytree::scene::Shading;
 use raytree::shade::{halfway, light_terms};
-use raytree::trace::{TraceSettings, Tracer};
 
 const S: f32 = std::f32::consts::FRAC_1_SQRT_2;
-
-fn close(a: Vec3, b: Vec3, tol: f32) -> bool {
-    (a - b).abs().max_element() <= tol
-}
-
-/// A scene builder for hand-made test scenes.
-struct Build(Scene);
-
-impl Build {
-    fn new(camera: Camera, width: u32, height: u32) -> Self {
-        Build(Scene {
-            render: RenderParams {
-                width,
-                height,
-                max_depth: 5,
-                samples: 1,
-                background: Vec3::new(0.05, 0.1, 0.15),
-                ambient_light: Vec3::splat(0.5),
-                shading: Shading::BlinnPhong,
-            },
-            camera,
-            ..Scene::default()
-        })
-    }
-
-    fn material(mut self, m: Material) -> Self {
-        self.0.materials.push(m);
-        self
-    }
-
-    fn light(mut self, position: Vec3, color: Vec3) -> Self {
-        let name = format!("light {}", self.0.lights.len() + 1);
-        self.0.lights.push(Light {
-            name,
-            position,
-            color,
-            radius: 0.0,
-        });
-        self
-    }
-
-    fn sphere(mut self, name: &str, center: Vec3, radius: f32, material: u32) -> Self {
-        let object = ObjectId(self.0.objects.len() as u32);
-        self.0.objects.push(Object {
-            name: name.into(),
-            source: ObjectSource::Sphere,
-        });
-        self.0.spheres.push(Sphere {
-            center,
-            radius,
-            material: MaterialId(material),
-            object,
-        });
-        self
-    }
-
-    fn quad(mut self, name: &str, corners: [Vec3; 4], material: u32) -> Self {
-        let object = ObjectId(self.0.objects.len() as u32);
-        self.0.objects.push(Object {
-            name: name.into(),
-            source: ObjectSource::Triangle,
-        });
-        for vertices in [
-            [corners[0], corners[1], corners[2]],
-            [corners[0], corners[2], corners[3]],
-        ] {
-            self.0.triangles.push(Triangle {
-                vertices,
-                material: MaterialId(material),
-                object,
-            });
-        }
-        self
-    }
-
-    fn pixel(&self, x: u32, y: u32, accel: AccelKind) -> Vec3 {
-        let tracer = Tracer::new(
-            Arc::new(self.0.clone()),
-            TraceSettings {
-                accel,
-                ..TraceSettings::default()
-            },
-        );
-        let (image, _) = render(&tracer, 1, 1, &|_, _| {}).expect("render");
-        image.get(x, y)
-    }
-}
-
-fn looking(position: Vec3, look_at: Vec3, fov_y_deg: f32) -> Camera {
-    Camera {
-        position,
-        look_at,
-        up: Vec3::Y,
-        fov_y_deg,
-    }
-}
-
-fn mat(name: &str, ka: Vec3, kd: Vec3, ks: f32, n: f32, kr: f32) -> Material {
-    Material {
-        name: name.into(),
-        ambient: ka,
-        diffuse: kd,
-        specular: Vec3::splat(ks),
-        shininess: n,
-        reflectivity: Vec3::splat(kr),
-        transparency: Vec3::ZERO,
-        ior: 1.5,
-    }
-}
 
 #[test]
 fn lecture_quiz_numbers() {
@@ -220,26 +107,8 @@ fn mirror_and_wall(max_depth: u32) -> Build {
             0.0,
         ))
         .light(Vec3::ZERO, Vec3::ONE)
-        .quad(
-            "mirror",
-            [
-                Vec3::new(-5.0, -5.0, -2.0),
-                Vec3::new(5.0, -5.0, -2.0),
-                Vec3::new(5.0, 5.0, -2.0),
-                Vec3::new(-5.0, 5.0, -2.0),
-            ],
-            0,
-        )
-        .quad(
-            "wall",
-            [
-                Vec3::new(-5.0, -5.0, 2.0),
-                Vec3::new(-5.0, 5.0, 2.0),
-                Vec3::new(5.0, 5.0, 2.0),
-                Vec3::new(5.0, -5.0, 2.0),
-            ],
-            1,
-        );
+        .quad("mirror", wall_z(-2.0, 5.0, true), 0)
+        .quad("wall", wall_z(2.0, 5.0, false), 1);
     b.0.render.max_depth = max_depth;
     b
 }
@@ -273,16 +142,7 @@ fn shadowed_floor_point_is_ambient_only() {
         .material(mat("blocker", Vec3::ONE, Vec3::ONE, 0.0, 1.0, 0.0))
         .light(Vec3::new(0.0, 4.0, -2.0), Vec3::ONE)
         .sphere("blocker", Vec3::new(0.0, 1.0, -2.0), 0.5, 1)
-        .quad(
-            "floor",
-            [
-                Vec3::new(-10.0, -1.0, 10.0),
-                Vec3::new(10.0, -1.0, 10.0),
-                Vec3::new(10.0, -1.0, -20.0),
-                Vec3::new(-10.0, -1.0, -20.0),
-            ],
-            0,
-        );
+        .quad("floor", floor(), 0);
     for accel in [AccelKind::None, AccelKind::Grid, AccelKind::Bvh] {
         let got = b.pixel(2, 2, accel);
         assert!(close(got, floor_ka * 0.5, 1e-6), "{accel:?}: {got}");
@@ -305,16 +165,7 @@ fn phong_uses_mirror_direction_of_the_light() {
     let mut b = Build::new(looking(Vec3::ZERO, Vec3::new(0.0, -1.0, -2.0), 40.0), 5, 5)
         .material(mat("floor", ka, Vec3::splat(0.8), 0.5, 10.0, 0.0))
         .light(Vec3::new(0.0, 4.0, -2.0), Vec3::ONE)
-        .quad(
-            "floor",
-            [
-                Vec3::new(-10.0, -1.0, 10.0),
-                Vec3::new(10.0, -1.0, 10.0),
-                Vec3::new(10.0, -1.0, -20.0),
-                Vec3::new(-10.0, -1.0, -20.0),
-            ],
-            0,
-        );
+        .quad("floor", floor(), 0);
     b.0.render.shading = Shading::Phong;
     let v = DVec3::new(0.0, 1.0, 2.0).normalize();
     let expect = ka.as_dvec3() * 0.5 + DVec3::splat(0.8) + 0.5 * v.y.powf(10.0);

@@ -190,7 +190,38 @@ fn clicking_a_pixel_shows_its_ray_tree() {
         "clicked {x}, {y}"
     );
     h.get_by_label_contains(&format!("Ray tree of ({x}, {y})"));
-    h.get_by_label_contains("primary d0");
+    assert!(h.query_all_by_label_contains("primary d0").count() >= 1);
+    // The diagram shows the same tree, its root labelled with what the primary ray met.
+    h.get_by_label(&format!("ray tree diagram of ({x}, {y})"));
+    let root = match (&tree.root.end, &tree.root.hit) {
+        (_, Some(hit)) => hit.object.clone(),
+        (Some(_), None) => "no hit".to_string(),
+        _ => unreachable!("a root either ends or hits"),
+    };
+    h.get_by_label(&format!("tree node primary: {root}"));
+    // Selecting a child in the diagram shows its numbers in the detail pane.
+    if let Some(child) = tree.root.children.first() {
+        let letter = if child.kind == raytree::trace::RayKind::Reflected {
+            "R"
+        } else {
+            "T"
+        };
+        let label = format!("tree node {letter}:");
+        h.query_all_by_label_contains(&label)
+            .next()
+            .expect("a child node")
+            .click();
+        h.step();
+        h.step();
+        assert_eq!(
+            h.state().tree_state.selected.as_deref(),
+            Some(&[0usize][..])
+        );
+    }
+    // The rays drawn over the image, with the tree panels open.
+    let status = h.get_by_label_contains("Mrays/s").rect();
+    h.mask(status);
+    h.snapshot("viewer_tree");
 }
 
 #[test]

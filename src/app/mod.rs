@@ -8,6 +8,7 @@
 mod file_browser;
 pub mod modes;
 mod panels;
+pub mod tree_view;
 pub mod viewport;
 
 use std::path::{Path, PathBuf};
@@ -102,9 +103,13 @@ pub struct ViewerApp {
     pub selected_material: Option<usize>,
     pub selected_light: Option<usize>,
     pub tree: Option<RayTree>,
+    /// Selection, hover and the pinned tree, shared by the tree's views.
+    pub tree_state: tree_view::TreeState,
     hover: Option<(u32, u32)>,
     browser: Option<FileBrowser>,
     show_help: bool,
+    /// The largest texture side the GPU allows: the render is never larger on screen.
+    max_side: u32,
     last_mode: ImageMode,
     pending: Vec<Command>,
 }
@@ -146,6 +151,85 @@ pub fn run(scene_arg: Option<&str>) -> anyhow::Result<()> {
     })
 }
 
+/// Holds what the panels can change to the loader's rules, so an edit never hands the tracer
+/// what a scene file could not (`geometry`: also check every sphere and triangle).
+fn check_edit(s: &Scene, geometry: bool) -> Result<(), String> {
+    use crate::scene::load::{MAX_COORDINATE, MAX_DEPTH_LIMIT, MAX_IMAGE_SIZE, MAX_SAMPLES};
+    let placed = |v: Vec3| v.is_finite() && v.abs().max_element() <= MAX_COORDINATE;
+    let coefficient = |v: Vec3| v.is_finite() && v.min_element() >= 0.0;
+    let r = &s.render;
+    if !(1..=MAX_IMAGE_SIZE).contains(&r.width) || !(1..=MAX_IMAGE_SIZE).contains(&r.height) {
+        return Err(format!("width and height must be 1 to {MAX_IMAGE_SIZE}"));
+    }
+    if !(1..=MAX_SAMPLES).contains(&r.samples) || r.max_depth > MAX_DEPTH_LIMIT {
+        return Err(format!(
+            "samples must be 1 to {MAX_SAMPLES} and max depth at most {MAX_DEPTH_LIMIT}"
+        ));
+    }
+    if !coefficient(r.background) || !coefficient(r.ambient_light) {
+        return Err("background and ambient light must be finite and not negative".into());
+    }
+    let c = &s.camera;
+    if !placed(c.position) || !placed(c.look_at) || !c.up.is_finite() {
+        return Err("the camera's position, target and up must be finite and within ±1e15".into());
+    }
+    let view = c.look_at - c.position;
+    if view.length_squared() == 0.0 || c.up.cross(view).length_squared() == 0.0 {
+        return Err("the camera's target must differ from its position and its up must not lie along the view".into());
+    }
+    if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
+        return Err("the camera's fov y must be between 0 and 180 degrees".into());
+    }
+    for l in &s.lights {
+        if !(placed(l.position)
+            && coefficient(l.color)
+            && (0.0..=MAX_COORDINATE).contains(&l.radius))
+        {
+            return Err(format!(
+                "light `{}` needs a finite position within ±1e15, a colour not negative and a radius from 0 to 1e15",
+                l.name
+            ));
+        }
+    }
+    for m in &s.materials {
+        let ok = [
+            m.ambient,
+            m.diffuse,
+            m.specular,
+            m.reflectivity,
+            m.transparency,
+        ]
+        .into_iter()
+        .all(coefficient)
+            && m.shininess.is_finite()
+            && m.shininess >= 0.0
+            && m.ior.is_finite()
+            && m.ior > 0.0;
+        if !ok {
+            return Err(format!(
+                "material `{}` needs finite coefficients not negative, shininess ≥ 0 and ior > 0",
+                m.name
+            ));
+        }
+    }
+    if geometry {
+        let spheres = s
+            .spheres
+            .iter()
+            .all(|sp| placed(sp.center) && sp.radius > 0.0 && sp.radius <= MAX_COORDINATE);
+        let triangles = s
+            .triangles
+            .iter()
+            .all(|t| t.vertices.iter().all(|&v| placed(v)));
+        if !spheres || !triangles {
+            return Err(
+                "every sphere and triangle must lie within ±1e15 with a radius above 0".into(),
+            );
+        }
+    }
+    Ok(())
+}
+
 /// A scene file, OBJ, or built-in scene name (a file of that name wins).
 pub fn load_scene_arg(arg: &str) -> Result<Scene, scene::SceneError> {
     let path = Path::new(arg);
@@ -166,11 +250,16 @@ impl ViewerApp {
             "the viewer needs the wgpu renderer and no graphics adapter was found; use `raytree render SCENE -o out.png`".to_string()
         })?;
         GpuDisplay::install(render_state);
-        Self::headless(scene, label)
+        let max_side = render_state.device.limits().max_texture_dimension_2d;
+        Self::with_limit(scene, label, max_side)
     }
 
     /// The viewer's state without a window (the GPU display is installed by [`Self::new`]).
     pub fn headless(scene: Scene, label: String) -> Result<Self, String> {
+        Self::with_limit(scene, label, crate::scene::load::MAX_IMAGE_SIZE)
+    }
+
+    fn with_limit(scene: Scene, label: String, max_side: u32) -> Result<Self, String> {
         let settings = RenderSettings::default();
         let session = Session::new(settings.threads)?;
         let scene = Arc::new(scene);
@@ -193,9 +282,11 @@ impl ViewerApp {
             selected_material: None,
             selected_light: None,
             tree: None,
+            tree_state: tree_view::TreeState::default(),
             hover: None,
             browser: None,
             show_help: false,
+            max_side: max_side.max(1),
             last_mode: ImageMode::Render,
             pending: Vec::new(),
         };
@@ -245,6 +336,37 @@ impl ViewerApp {
     fn restart(&mut self, rebuild: bool) {
         if let Err(e) = self.session.set_threads(self.settings.threads) {
             self.error(e);
+        }
+        // An edit is held to the loader's rules; a bad one is refused and the scene stays.
+        if let Err(e) = check_edit(&self.edit, rebuild) {
+            self.error(format!("{e}; the edit was undone"));
+            self.edit = (*self.scene).clone();
+            if self.generation > 0 {
+                return;
+            }
+        }
+        // The viewer's buffers must fit the GPU's largest texture and the memory budget: a
+        // larger render is shown scaled down (with a message); `raytree render` does full size.
+        let (w, h) = (self.edit.render.width, self.edit.render.height);
+        let limit = crate::render::memory_limit();
+        let per_pixel = crate::render::viewer_memory_estimate(1, 1).max(1);
+        let max_pixels = (limit.bytes / per_pixel).max(1) as f64;
+        let k = (self.max_side as f64 / w.max(h) as f64)
+            .min((max_pixels / (w as f64 * h as f64)).sqrt())
+            .min(1.0);
+        if k < 1.0 {
+            let (nw, nh) = (
+                ((w as f64 * k) as u32).max(1),
+                ((h as f64 * k) as u32).max(1),
+            );
+            self.error(format!(
+                "the viewer shows at most {} pixels across and {:.0} MiB of buffers ({}): showing {w}x{h} at {nw}x{nh}; `raytree render` renders the full size",
+                self.max_side,
+                limit.bytes as f64 / (1 << 20) as f64,
+                limit.source
+            ));
+            self.edit.render.width = nw;
+            self.edit.render.height = nh;
         }
         let scene = Arc::new(self.edit.clone());
         let (w, h) = (scene.render.width, scene.render.height);
@@ -307,7 +429,7 @@ impl ViewerApp {
                             if let Some(aux) = &tile.aux {
                                 self.aux[dst] = aux[src];
                             }
-                            let c = if mode == ImageMode::Render || tile.pass == Pass::Preview {
+                            let c = if mode == ImageMode::Render {
                                 tile.pixels[src]
                             } else {
                                 mode_color(mode, &self.aux[dst], max_depth)
@@ -411,6 +533,7 @@ impl ViewerApp {
                 },
                 Command::Pick(x, y) => {
                     self.tree = pixel_tree(&self.tracer, x, y);
+                    self.tree_state.selected = Some(Vec::new());
                     if let Some(hit) = self.tree.as_ref().and_then(|t| t.root.hit.as_ref()) {
                         self.selected_material = self
                             .scene
@@ -549,11 +672,31 @@ impl ViewerApp {
         let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
         response
             .widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, "render viewport"));
+        // The tree's rays over the image: drawn by shaders/overlay.wgsl with the render
+        // camera's projection, one colour per ray kind, the hovered or selected node in white.
+        let overlay = self.tree.as_ref().map(|tree| {
+            let extent = self
+                .scene
+                .bounds()
+                .map(|(lo, hi)| (hi - lo).length())
+                .unwrap_or(10.0)
+                .max(1e-3);
+            let frame = crate::render::CameraFrame::new(
+                &self.scene.camera,
+                self.scene.render.width,
+                self.scene.render.height,
+            );
+            Arc::new(viewport::Overlay {
+                clip_from_world: frame.clip_from_world(extent * 1e-5, extent * 1e5),
+                vertices: tree_view::overlay_vertices(tree, &self.tree_state, extent),
+            })
+        });
         ui.painter()
             .add(eframe::egui_wgpu::Callback::new_paint_callback(
                 rect,
                 DisplayCallback {
                     shared: self.display.clone(),
+                    overlay,
                 },
             ));
         let to_pixel = |p: egui::Pos2| {
@@ -586,11 +729,6 @@ impl ViewerApp {
                 self.pending.push(Command::Restart);
             }
         }
-        // The tree's rays over the image: primary, reflected and refracted segments and shadow
-        // rays, projected with the camera, one colour per kind.
-        if let Some(tree) = &self.tree {
-            panels::draw_tree_overlay(ui.painter(), rect, scale, &self.scene, tree);
-        }
     }
 }
 
@@ -601,16 +739,26 @@ impl eframe::App for ViewerApp {
         self.shortcuts(&ctx);
         panels::top_bar(self, ui);
         panels::status_bar(self, ui);
+        // Hover is transient: the views set it again while the pointer stays on a node.
+        self.tree_state.hovered = None;
+        let tree = self.tree.clone();
+        if let Some(tree) = &tree {
+            egui::Panel::bottom("diagram")
+                .resizable(true)
+                .default_size(220.0)
+                .show(ui, |ui| tree_view::diagram(ui, tree, &mut self.tree_state));
+        }
         egui::Panel::left("settings")
             .resizable(true)
             .default_size(330.0)
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| panels::side_panel(self, ui));
             });
-        if self.tree.is_some() {
+        if tree.is_some() {
             egui::Panel::right("tree")
                 .resizable(true)
-                .default_size(380.0)
+                .default_size(420.0)
+                .max_size(560.0)
                 .show(ui, |ui| panels::tree_panel(self, ui));
         }
         egui::CentralPanel::default().show(ui, |ui| self.viewport(ui));

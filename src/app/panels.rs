@@ -6,26 +6,11 @@ use glam::Vec3;
 
 use super::file_browser::{BrowseFor, FileBrowser};
 use super::modes::{ImageMode, TERMINATION_LEGEND};
+use super::tree_view;
 use super::{Command, ViewerApp};
 use crate::accel::AccelKind;
 use crate::geometry::{OffsetMethod, SphereMethod, TriangleMethod};
-use crate::ray_tree::{Node, RayTree};
-use crate::render::CameraFrame;
 use crate::scene::{Camera, Light, Material, Scene, Shading, builtin};
-use crate::trace::{EndReason, RayKind};
-
-/// The one palette of ray kinds, shared by the tree panel and the overlay.
-pub fn kind_color(kind: RayKind) -> Color32 {
-    match kind {
-        RayKind::Primary => Color32::from_rgb(240, 240, 240),
-        RayKind::Reflected => Color32::from_rgb(80, 170, 255),
-        RayKind::Refracted => Color32::from_rgb(90, 220, 120),
-        RayKind::Shadow => Color32::from_rgb(255, 200, 60),
-    }
-}
-
-/// Shadow rays that are blocked.
-pub const SHADOW_BLOCKED: Color32 = Color32::from_rgb(200, 60, 60);
 
 // ---- camera moves -------------------------------------------------------------------------
 
@@ -492,19 +477,8 @@ fn material_editor(ui: &mut Ui, m: &mut Material) -> bool {
 
 // ---- the ray tree -------------------------------------------------------------------------
 
-fn fmt3(v: Vec3) -> String {
-    format!("({:.3}, {:.3}, {:.3})", v.x, v.y, v.z)
-}
-
-fn end_label(end: EndReason) -> &'static str {
-    match end {
-        EndReason::NoHit => "no hit -> background",
-        EndReason::HitLight => "hit a light -> its colour",
-        EndReason::MaxDepth => "past max depth -> background",
-        EndReason::Cutoff => "below weight cutoff -> background",
-    }
-}
-
+/// The clicked pixel's tree: the list (or the pinned and current trees side by side, changed
+/// nodes marked), and the numbers of the selected node.
 pub fn tree_panel(app: &mut ViewerApp, ui: &mut Ui) {
     let Some(tree) = app.tree.clone() else {
         return;
@@ -519,148 +493,61 @@ pub fn tree_panel(app: &mut ViewerApp, ui: &mut Ui) {
         }
     });
     ui.label(format!(
-        "colour {} · {} nodes{}",
-        fmt3(tree.color),
+        "colour ({:.4}, {:.4}, {:.4}) · {} nodes{}",
+        tree.color.x,
+        tree.color.y,
+        tree.color.z,
         tree.nodes,
         if tree.truncated { " (truncated)" } else { "" }
     ));
-    if ui.button("Export tree as JSON...").clicked() {
-        let name = format!("tree-{}-{}.json", tree.pixel[0], tree.pixel[1]);
-        app.browser = Some(FileBrowser::new(
-            BrowseFor::ExportTree,
-            app.start_dir(),
-            &name,
-        ));
-    }
-    egui::ScrollArea::vertical().show(ui, |ui| node_ui(ui, &tree.root, "0"));
-}
-
-fn node_ui(ui: &mut Ui, node: &Node, path: &str) {
-    let kind = match node.kind {
-        RayKind::Primary => "primary",
-        RayKind::Reflected => "R",
-        RayKind::Refracted => "T",
-        RayKind::Shadow => "shadow",
-    };
-    let what = match (&node.end, &node.hit) {
-        (Some(end), _) => end_label(*end).to_string(),
-        (None, Some(hit)) => format!("{} ({})", hit.object, hit.material),
-        _ => String::new(),
-    };
-    let title = RichText::new(format!(
-        "{kind} d{} · {what} · {}",
-        node.depth,
-        fmt3(node.color)
-    ))
-    .color(kind_color(node.kind));
-    egui::CollapsingHeader::new(title)
-        .id_salt(path)
-        .default_open(node.depth < 2)
-        .show(ui, |ui| {
-            ui.small(format!("weight {} · dir {}", fmt3(node.weight), fmt3(node.direction)));
-            if let Some(hit) = &node.hit {
-                ui.small(format!(
-                    "t {:.4} · P {} · N {}{}",
-                    hit.t,
-                    fmt3(hit.point),
-                    fmt3(hit.normal),
-                    if hit.front_face { "" } else { " (inside)" }
-                ));
-                if let Some(b) = hit.barycentric {
-                    ui.small(format!("barycentric ({:.3}, {:.3}, {:.3})", b[0], b[1], b[2]));
-                }
+    ui.horizontal(|ui| {
+        if app.tree_state.pinned.is_some() {
+            if ui.button("Unpin").clicked() {
+                app.tree_state.pinned = None;
             }
-            for s in &node.shadow_rays {
-                let (text, color) = match (&s.blocked_by, s.facing_away) {
-                    (_, true) => (format!("{}: facing away (N·L {:.3})", s.light, s.n_dot_l), Color32::GRAY),
-                    (Some(b), _) => (format!("{}: blocked by {b}", s.light), SHADOW_BLOCKED),
-                    (None, false) => (
-                        format!(
-                            "{}: lit · N·L {:.3} · N·H {:.3} · R·V {:.3} · diffuse {} · specular {}",
-                            s.light, s.n_dot_l, s.n_dot_h, s.r_dot_v, fmt3(s.diffuse), fmt3(s.specular)
-                        ),
-                        kind_color(RayKind::Shadow),
-                    ),
-                };
-                ui.colored_label(color, RichText::new(text).small());
+        } else if ui
+            .button("Pin for comparison")
+            .on_hover_text("keep this tree, then change a setting to compare")
+            .clicked()
+        {
+            app.tree_state.pinned = Some(tree.clone());
+        }
+        if ui.button("Export tree as JSON...").clicked() {
+            let name = format!("tree-{}-{}.json", tree.pixel[0], tree.pixel[1]);
+            app.browser = Some(FileBrowser::new(
+                BrowseFor::ExportTree,
+                app.start_dir(),
+                &name,
+            ));
+        }
+    });
+    ui.separator();
+    let state = &mut app.tree_state;
+    egui::ScrollArea::both()
+        .id_salt("tree list")
+        .max_height(ui.available_height() * 0.5)
+        .show(ui, |ui| match state.pinned.clone() {
+            Some(pinned) => {
+                ui.label("changed nodes are marked *");
+                ui.columns(2, |cols| {
+                    cols[0].label(format!(
+                        "pinned: ({}, {}), max depth {}",
+                        pinned.pixel[0], pinned.pixel[1], pinned.settings.max_depth
+                    ));
+                    tree_view::tree_list(&mut cols[0], &pinned, state, Some(&tree), "pinned");
+                    cols[1].label(format!("current: max depth {}", tree.settings.max_depth));
+                    tree_view::tree_list(&mut cols[1], &tree, state, Some(&pinned), "current");
+                });
             }
-            if let Some(l) = &node.local {
-                ui.small(format!(
-                    "local = ambient {} + diffuse {} + specular {} = {}",
-                    fmt3(l.ambient),
-                    fmt3(l.diffuse),
-                    fmt3(l.specular),
-                    fmt3(l.total)
-                ));
-            }
-            if node.total_internal_reflection {
-                ui.small("total internal reflection: kt goes to R");
-            }
-            for (i, child) in node.children.iter().enumerate() {
-                node_ui(ui, child, &format!("{path}.{i}"));
-            }
+            None => tree_view::tree_list(ui, &tree, state, None, "current"),
         });
-}
-
-/// Draws the tree's rays over the image, projected with the render camera.
-pub fn draw_tree_overlay(
-    painter: &egui::Painter,
-    rect: egui::Rect,
-    scale: f32,
-    scene: &Scene,
-    tree: &RayTree,
-) {
-    let frame = CameraFrame::new(&scene.camera, scene.render.width, scene.render.height);
-    let to_screen = |p: Vec3| {
-        frame
-            .project(p)
-            .map(|(x, y)| egui::pos2(rect.min.x + x * scale, rect.min.y + y * scale))
-    };
-    let painter = painter.with_clip_rect(rect);
-    let mut stack = vec![&tree.root];
-    while let Some(node) = stack.pop() {
-        let end = match &node.hit {
-            Some(hit) => hit.point,
-            None => node.origin + node.direction * scene_extent(scene),
-        };
-        if let (Some(a), Some(b)) = (to_screen(node.origin), to_screen(end)) {
-            painter.line_segment([a, b], egui::Stroke::new(2.0, kind_color(node.kind)));
-        }
-        if let Some(hit) = &node.hit {
-            for s in &node.shadow_rays {
-                if s.facing_away {
-                    continue;
-                }
-                let light = hit.point + s.to_light * s.distance;
-                let color = if s.blocked_by.is_some() {
-                    SHADOW_BLOCKED
-                } else {
-                    kind_color(RayKind::Shadow)
-                };
-                if let (Some(a), Some(b)) = (to_screen(hit.point), to_screen(light)) {
-                    painter.line_segment([a, b], egui::Stroke::new(1.0, color));
-                }
-            }
-            if let (Some(a), Some(b)) = (
-                to_screen(hit.point),
-                to_screen(hit.point + hit.normal * scene_extent(scene) * 0.03),
-            ) {
-                painter.line_segment(
-                    [a, b],
-                    egui::Stroke::new(1.5, Color32::from_rgb(255, 0, 255)),
-                );
-            }
-        }
-        stack.extend(node.children.iter());
-    }
-}
-
-fn scene_extent(scene: &Scene) -> f32 {
-    scene
-        .bounds()
-        .map(|(lo, hi)| (hi - lo).length())
-        .unwrap_or(10.0)
-        .max(1e-3)
+    ui.separator();
+    let selected = state.selected.clone().unwrap_or_default();
+    egui::ScrollArea::both()
+        .id_salt("tree detail")
+        .show(ui, |ui| {
+            tree_view::detail(ui, &tree, &selected);
+        });
 }
 
 pub fn help_window(ctx: &egui::Context, open: &mut bool) {

@@ -18,7 +18,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::{CameraFrame, Rect, TILE_SIZE, tiles, trace_sample};
-use crate::trace::{RayCounts, Tracer};
+use crate::trace::{RayCounts, SampleInfo, Tracer};
 
 /// Side of the blocks of the coarse preview pass.
 pub const PREVIEW_BLOCK: u32 = 8;
@@ -33,6 +33,17 @@ pub struct PixelAux {
     pub rays: u32,
     pub ends: u8,
     pub normal: Vec3,
+}
+
+impl From<SampleInfo> for PixelAux {
+    fn from(info: SampleInfo) -> Self {
+        Self {
+            depth_reached: info.depth_reached,
+            rays: info.rays,
+            ends: info.ends,
+            normal: info.normal,
+        }
+    }
 }
 
 /// Which pass a tile belongs to.
@@ -52,7 +63,7 @@ pub struct TileUpdate {
     pub rect: Rect,
     /// Linear colours, row-major within `rect`.
     pub pixels: Vec<Vec3>,
-    /// Image-mode facts, sent with the first full-resolution pass only.
+    /// Image-mode facts, sent with the preview (block-filled) and the first full pass only.
     pub aux: Option<Vec<PixelAux>>,
 }
 
@@ -301,12 +312,7 @@ impl Job {
                             if s == 0
                                 && let Some(aux) = aux.as_mut()
                             {
-                                aux.push(PixelAux {
-                                    depth_reached: info.depth_reached,
-                                    rays: info.rays,
-                                    ends: info.ends,
-                                    normal: info.normal,
-                                });
+                                aux.push(PixelAux::from(info));
                             }
                         }
                     }
@@ -381,22 +387,27 @@ impl Job {
     fn preview_tile(&self, frame: &CameraFrame, rect: Rect) -> (Vec<Vec3>, Option<Vec<PixelAux>>) {
         let scene = &self.tracer.scene;
         let (w, h) = (scene.render.width, scene.render.height);
-        let mut pixels = vec![Vec3::ZERO; (rect.width * rect.height) as usize];
+        let n = (rect.width * rect.height) as usize;
+        let mut pixels = vec![Vec3::ZERO; n];
+        let mut aux = vec![PixelAux::default(); n];
         let mut counts = RayCounts::default();
         for by in (0..rect.height).step_by(PREVIEW_BLOCK as usize) {
             for bx in (0..rect.width).step_by(PREVIEW_BLOCK as usize) {
                 let x = (rect.x + bx + PREVIEW_BLOCK / 2).min(w - 1);
                 let y = (rect.y + by + PREVIEW_BLOCK / 2).min(h - 1);
-                let (c, _) = trace_sample(&self.tracer, frame, x, y, 0, &mut counts);
+                let (c, info) = trace_sample(&self.tracer, frame, x, y, 0, &mut counts);
+                let a = PixelAux::from(info);
                 for j in by..(by + PREVIEW_BLOCK).min(rect.height) {
                     for i in bx..(bx + PREVIEW_BLOCK).min(rect.width) {
                         pixels[(j * rect.width + i) as usize] = c;
+                        aux[(j * rect.width + i) as usize] = a;
                     }
                 }
             }
         }
         self.stats.add(&counts);
-        (pixels, None)
+        // The image modes get the preview too, so a mode view never shows render colours.
+        (pixels, Some(aux))
     }
 }
 

@@ -52,7 +52,12 @@ pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
             )));
         }
     };
-    let text = read_text(path)
+    let max_bytes = if is_obj {
+        MAX_MESH_FILE_BYTES
+    } else {
+        MAX_SCENE_FILE_BYTES
+    };
+    let text = read_text(path, max_bytes)
         .map_err(|reason| SceneError(format!("{file}: cannot read the scene file: {reason}.")))?;
     let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let resolve = fs_resolver(folder);
@@ -94,14 +99,55 @@ pub fn load_scene_str_with(
 
 /// A resolver reading files relative to `folder`.
 pub fn fs_resolver(folder: PathBuf) -> impl Fn(&str) -> Result<String, String> {
-    move |path: &str| read_text(&folder.join(path)).map_err(|reason| format!("{path}: {reason}"))
+    move |path: &str| {
+        read_text(&folder.join(path), MAX_MESH_FILE_BYTES)
+            .map_err(|reason| format!("{}: {reason}", short_path(path)))
+    }
 }
 
-/// Reads a text file, tolerating stray non-UTF-8 bytes (old MTL files carry Latin-1 comments).
-fn read_text(path: &Path) -> Result<String, String> {
-    std::fs::read(path)
-        .map(|bytes| String::from_utf8_lossy(&bytes).into_owned())
-        .map_err(|e| os_reason(&e))
+/// Largest scene (`.toml`) file read. Hand-written and exported scenes are kilobytes; the TOML
+/// tree takes several times the text, so the cap also bounds the parser's memory.
+pub const MAX_SCENE_FILE_BYTES: u64 = 64 << 20;
+
+/// Largest OBJ or MTL file read: about 20 million triangles of OBJ text. The memory a mesh
+/// needs is estimated from its counts before it is parsed (see `obj`); this cap comes first,
+/// so that a huge or endless file is refused before it is read at all.
+pub const MAX_MESH_FILE_BYTES: u64 = 512 << 20;
+
+/// Reads a text file of at most `max_bytes`, tolerating stray non-UTF-8 bytes (old MTL files
+/// carry Latin-1 comments). Only regular files are read: a device such as `/dev/zero` or a
+/// pipe would never end (or block), and a folder is never what was meant.
+fn read_text(path: &Path, max_bytes: u64) -> Result<String, String> {
+    use std::io::Read;
+    let meta = std::fs::metadata(path).map_err(|e| os_reason(&e))?;
+    if meta.is_dir() {
+        return Err("it is a folder, not a file".into());
+    }
+    if !meta.is_file() {
+        return Err("it is not a regular file (a device, a pipe or a socket)".into());
+    }
+    let too_big = |size: u64| {
+        format!(
+            "it is {}, more than the {} a file may have",
+            crate::render::format_bytes(size),
+            crate::render::format_bytes(max_bytes)
+        )
+    };
+    if meta.len() > max_bytes {
+        return Err(too_big(meta.len()));
+    }
+    let file = std::fs::File::open(path).map_err(|e| os_reason(&e))?;
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    // `take` also stops a file that grows while it is read.
+    file.take(max_bytes + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| os_reason(&e))?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(too_big(bytes.len() as u64));
+    }
+    // Valid UTF-8 is taken as it is, without the copy `from_utf8_lossy` would make.
+    Ok(String::from_utf8(bytes)
+        .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned()))
 }
 
 /// The OS's reason without the platform-specific "(os error N)" tail, for stable messages.
@@ -144,8 +190,9 @@ impl Src<'_> {
     }
 
     /// The source text of a value, as the user wrote it, for "got ..." in messages.
-    fn slice(&self, span: &Range<usize>) -> &str {
-        self.text.get(span.clone()).unwrap_or("?")
+    /// At most 40 characters of it, so that a message stays a sentence.
+    fn slice(&self, span: &Range<usize>) -> String {
+        short(self.text.get(span.clone()).unwrap_or("?"))
     }
 }
 
@@ -196,6 +243,16 @@ pub(crate) fn short(text: &str) -> String {
     }
 }
 
+/// A path as written, cut to its last 80 characters: the file name is the part that matters.
+pub(crate) fn short_path(path: &str) -> String {
+    let count = path.chars().count();
+    if count <= 80 {
+        return path.to_string();
+    }
+    let tail: String = path.chars().skip(count - 79).collect();
+    format!("…{tail}")
+}
+
 /// The closest of `known` to `word` if it is a plausible typo, for "did you mean" hints.
 pub(crate) fn suggest<'k>(word: &str, known: impl IntoIterator<Item = &'k str>) -> Option<&'k str> {
     let word = word.to_ascii_lowercase();
@@ -240,6 +297,22 @@ const ANY: Rule = |_| None;
 const NON_NEGATIVE: Rule = |x| (x < 0.0).then_some("must be at least 0");
 const POSITIVE: Rule = |x| (x <= 0.0).then_some("must be greater than 0");
 const NON_ZERO: Rule = |x| (x == 0.0).then_some("must not be 0");
+/// Positions (and radii) must lie within this distance of the origin. The BVH's traversal is
+/// exact only for scenes below about 1e17 in size (`accel/bvh.rs`), its build overflows to NaN
+/// near `f32::MAX` (a mesh moved to x = 3e38 made it panic: `found_bvh_far.toml`), and at 1e15
+/// an `f32` already cannot tell apart points 1e8 apart, so no meaningful scene is larger.
+pub const MAX_COORDINATE: f32 = 1e15;
+const COORDINATE: Rule = |x| {
+    (x.abs() > MAX_COORDINATE).then_some("must be within ±1e15 (raytree's limit on scene size)")
+};
+const RADIUS: Rule = |x| match POSITIVE(x) {
+    Some(problem) => Some(problem),
+    None => COORDINATE(x),
+};
+const LIGHT_RADIUS: Rule = |x| match NON_NEGATIVE(x) {
+    Some(problem) => Some(problem),
+    None => COORDINATE(x),
+};
 const FOV: Rule =
     |x| (x <= 0.0 || x >= 180.0).then_some("must be between 0 and 180 degrees (both excluded)");
 
@@ -278,7 +351,8 @@ impl<'s, 't, 'i> Section<'s, 't, 'i> {
                 return Err(src.error(
                     &key.span(),
                     format!(
-                        "{what} has an unknown field `{key_text}`{hint}; its fields are {}",
+                        "{what} has an unknown field `{}`{hint}; its fields are {}",
+                        short(key_text),
                         list_and(&known)
                     ),
                 ));
@@ -641,9 +715,9 @@ impl SceneBuilder<'_> {
             self.scene.lights.push(Light {
                 name,
                 // Without a position, a headlight: a light at the eye.
-                position: s.vec3("position", self.scene.camera.position, ANY)?,
+                position: s.vec3("position", self.scene.camera.position, COORDINATE)?,
                 color: s.color("color", Vec3::ONE, NON_NEGATIVE)?,
-                radius: s.f32("radius", 0.0, NON_NEGATIVE)?,
+                radius: s.f32("radius", 0.0, LIGHT_RADIUS)?,
             });
         }
 
@@ -729,8 +803,8 @@ impl SceneBuilder<'_> {
         name: String,
         object: ObjectId,
     ) -> Result<(), SceneError> {
-        let center = s.vec3("center", Vec3::ZERO, ANY)?;
-        let radius = s.f32("radius", 1.0, POSITIVE)?;
+        let center = s.vec3("center", Vec3::ZERO, COORDINATE)?;
+        let radius = s.f32("radius", 1.0, RADIUS)?;
         let material = self.material(s, "material")?;
         self.scene.objects.push(Object {
             name,
@@ -764,7 +838,7 @@ impl SceneBuilder<'_> {
         };
         let mut vertices = [Vec3::ZERO; 3];
         for (v, corner) in vertices.iter_mut().zip(corners.iter()) {
-            *v = s.vec3_of("vertices", corner, ANY)?;
+            *v = s.vec3_of("vertices", corner, COORDINATE)?;
         }
         if !obj::is_visible_triangle(&vertices) {
             return Err(s.error(
@@ -790,13 +864,25 @@ impl SceneBuilder<'_> {
         let Some((file, file_span)) = s.string("file")? else {
             return Err(s.missing("file", "an OBJ path relative to the scene file"));
         };
+        // Only OBJ files are meshes: a scene (or anything else) named here would be read as
+        // OBJ text and make no sense, and scenes never include scenes, so there are no cycles.
+        if !obj::is_obj_path(&file) {
+            return Err(s.error(
+                &file_span,
+                "file",
+                format!(
+                    "must name an OBJ file (ending in `.obj`), got \"{}\"",
+                    short_path(&file).escape_debug()
+                ),
+            ));
+        }
         let override_name = s.string("material")?.map(|(n, _)| n);
         let material_override = match override_name {
             Some(_) => Some(self.material(s, "material")?),
             None => None,
         };
         let placement = MeshPlacement {
-            translate: s.vec3("translate", Vec3::ZERO, ANY)?,
+            translate: s.vec3("translate", Vec3::ZERO, COORDINATE)?,
             rotate_deg: s.vec3("rotate", Vec3::ZERO, ANY)?,
             scale: s.scalar_or_vec3(
                 "scale",
@@ -823,7 +909,7 @@ impl SceneBuilder<'_> {
             &obj::MeshRequest {
                 object,
                 object_name: &name,
-                label: &file,
+                label: &short_path(&file),
                 key: &file,
                 text: &text,
                 resolve: self.resolve,
@@ -831,11 +917,12 @@ impl SceneBuilder<'_> {
                 placement: &placement,
             },
         )
-        .map_err(|p| cannot(format!("{file}{}", p.with_line())))?;
+        .map_err(|p| cannot(format!("{}{}", short_path(&file), p.with_line())))?;
         if loaded == 0 {
-            self.scene
-                .warnings
-                .push(format!("{file}: the mesh has no triangles to show."));
+            self.scene.warnings.push(format!(
+                "{}: the mesh has no triangles to show.",
+                short_path(&file)
+            ));
         }
         Ok(())
     }
@@ -930,8 +1017,8 @@ fn parse_render(s: &Section) -> Result<RenderParams, SceneError> {
 fn parse_camera(s: &Section) -> Result<Camera, SceneError> {
     let d = Camera::default();
     let camera = Camera {
-        position: s.vec3("position", d.position, ANY)?,
-        look_at: s.vec3("look_at", d.look_at, ANY)?,
+        position: s.vec3("position", d.position, COORDINATE)?,
+        look_at: s.vec3("look_at", d.look_at, COORDINATE)?,
         up: s.vec3("up", d.up, ANY)?,
         fov_y_deg: s.f32("fov_y", d.fov_y_deg, FOV)?,
     };

@@ -5,15 +5,20 @@
 //! and counted in one warning, so the tracer never meets them. Also opens a bare `.obj` as a
 //! whole scene with a camera framed on it.
 
-use std::cell::RefCell;
+use std::borrow::Cow;
+use std::cell::{Cell, RefCell};
 use std::collections::BTreeSet;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
+use std::sync::Once;
 
 use glam::{Mat3, Vec3};
 
-use super::load::{ResolveFn, SceneError, check_camera, default_material};
+use super::load::{
+    MAX_COORDINATE, ResolveFn, SceneError, check_camera, default_material, short, short_path,
+};
 use super::{Camera, Light, Material, MaterialId, Object, ObjectId, ObjectSource, Scene, Triangle};
+use crate::render::{MemoryLimit, memory_limit, mesh_memory_estimate};
 
 /// Where a mesh goes: `scale` first, then the rotation (degrees about X, then Y, then Z), then
 /// `translate`.
@@ -55,6 +60,14 @@ impl MeshPlacement {
 pub fn is_visible_triangle(v: &[Vec3; 3]) -> bool {
     let cross = (v[1] - v[0]).cross(v[2] - v[0]);
     v.iter().all(|p| p.is_finite()) && cross.is_finite() && cross != Vec3::ZERO
+}
+
+/// True if `path` ends in `.obj`, in any case: the only files a `[[mesh]]` may name.
+pub(crate) fn is_obj_path(path: &str) -> bool {
+    Path::new(path)
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"))
 }
 
 /// The file name without folder and extension (`models/gem.obj` → `gem`).
@@ -119,15 +132,155 @@ fn load_options() -> tobj::LoadOptions {
     }
 }
 
+thread_local! {
+    /// Set while [`quietly`] runs: the panic hook then prints nothing.
+    static QUIET: Cell<bool> = const { Cell::new(false) };
+}
+
+/// Runs `f` with panics caught and not printed. `tobj` is third-party code fed hostile files;
+/// a panic in it must become one error sentence (SPEC §9), not a crash or a second line on
+/// stderr. The panic hook is wrapped once, and stays silent only on this thread and only while
+/// `f` runs, so every other panic is reported as before.
+fn quietly<T>(f: impl FnOnce() -> T) -> Result<T, ()> {
+    static HOOK: Once = Once::new();
+    HOOK.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !QUIET.with(Cell::get) {
+                previous(info);
+            }
+        }));
+    });
+    let was = QUIET.with(|q| q.replace(true));
+    let outcome = catch_unwind(AssertUnwindSafe(f));
+    QUIET.with(|q| q.set(was));
+    outcome.map_err(|_| ())
+}
+
 /// Runs `tobj` with panics caught: hostile files must never take the program down (SPEC §9).
 fn load_obj(
     text: &str,
     load_mtl: impl Fn(&Path) -> tobj::MTLLoadResult,
 ) -> Result<tobj::LoadResult, String> {
-    catch_unwind(AssertUnwindSafe(|| {
-        tobj::load_obj_buf(&mut text.as_bytes(), &load_options(), load_mtl)
-    }))
-    .map_err(|_| "the OBJ reader failed on this file".to_string())
+    quietly(|| tobj::load_obj_buf(&mut text.as_bytes(), &load_options(), load_mtl))
+        .map_err(|()| "the OBJ reader failed on this file".to_string())
+}
+
+/// MTL text as `tobj` can take it, or the line and the reason it cannot. The MTL format lets
+/// `Ka`, `Kd`, `Ks` and `Ke` give one number for all three channels (`Kd 0.8`); tobj 4.0.5
+/// panics on that (and on zero or two numbers), so one number is spelled out three times here
+/// and zero or two are refused with their line.
+fn mtl_for_tobj(text: &str) -> Result<Cow<'_, str>, (usize, String)> {
+    let mut fixed: Option<String> = None;
+    for (i, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() else {
+            if let Some(out) = fixed.as_mut() {
+                out.push_str(line);
+                out.push('\n');
+            }
+            continue;
+        };
+        let values: Vec<&str> = words.collect();
+        let parses = values.iter().all(|v| v.parse::<f32>().is_ok());
+        match values.len() {
+            1 | 2 if !parses => {} // tobj reports the bad number as an error
+            0 | 2 => {
+                return Err((
+                    i + 1,
+                    format!(
+                        "`{key}` needs one number or three (r g b), got {}",
+                        values.len()
+                    ),
+                ));
+            }
+            1 => {
+                let out = fixed.get_or_insert_with(|| {
+                    let mut head = String::with_capacity(text.len() + 64);
+                    for earlier in text.lines().take(i) {
+                        head.push_str(earlier);
+                        head.push('\n');
+                    }
+                    head
+                });
+                let v = values[0];
+                out.push_str(&format!("{key} {v} {v} {v}\n"));
+                continue;
+            }
+            _ => {}
+        }
+        if let Some(out) = fixed.as_mut() {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    Ok(fixed.map_or(Cow::Borrowed(text), Cow::Owned))
+}
+
+/// True for a polyline (`l`) statement.
+fn is_polyline(line: &str) -> bool {
+    line.split_whitespace().next() == Some("l")
+}
+
+/// OBJ text without its polylines, and how many there were. A polyline has no surface to
+/// trace, but tobj reads `l` like `f`, so `l 1 2 3` would be drawn as a triangle; each one
+/// becomes an empty comment, so line numbers in messages stay right.
+fn without_polylines(text: &str) -> (Cow<'_, str>, usize) {
+    if !text.lines().any(is_polyline) {
+        return (Cow::Borrowed(text), 0);
+    }
+    let mut out = String::with_capacity(text.len());
+    let mut count = 0;
+    for line in text.lines() {
+        if is_polyline(line) {
+            out.push('#');
+            count += 1;
+        } else {
+            out.push_str(line);
+        }
+        out.push('\n');
+    }
+    (Cow::Owned(out), count)
+}
+
+/// Vertices (`v`) and triangles (after triangulation; a 1- or 2-corner face counts as one
+/// degenerate triangle, as tobj makes it) of OBJ text, counted without parsing numbers.
+pub(crate) fn obj_counts(text: &str) -> (u64, u64) {
+    let (mut vertices, mut triangles) = (0u64, 0u64);
+    for line in text.lines() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => vertices += 1,
+            Some("f") => triangles += (words.count() as u64).saturating_sub(2).max(1),
+            _ => {}
+        }
+    }
+    (vertices, triangles)
+}
+
+/// Refuses an OBJ whose reading (with the triangles the scene already has) would exceed
+/// `limit`, before tobj allocates anything for it.
+pub(crate) fn check_mesh_memory(
+    scene: &Scene,
+    text: &str,
+    limit: &MemoryLimit,
+) -> Result<(), String> {
+    let (vertices, triangles) = obj_counts(text);
+    let estimate = mesh_memory_estimate(
+        text.len() as u64,
+        vertices,
+        triangles.saturating_add(scene.triangles.len() as u64),
+    );
+    let noun = |n: u64, one: &'static str, many: &'static str| if n == 1 { one } else { many };
+    let mut what = format!(
+        "its {vertices} {} and {triangles} {}",
+        noun(vertices, "vertex", "vertices"),
+        noun(triangles, "triangle", "triangles")
+    );
+    if !scene.triangles.is_empty() {
+        what += &format!(" (with the scene's {} before it)", scene.triangles.len());
+    }
+    limit.check(what, estimate).map_err(|e| e.to_string())
 }
 
 /// The first line at which the OBJ stops loading, found by bisecting prefixes (tobj's errors
@@ -160,18 +313,27 @@ fn error_line(text: &str) -> Option<usize> {
 /// Adds the OBJ's triangles (placed, degenerate ones dropped) and the MTL materials they use
 /// to `scene`; returns how many triangles were added.
 pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, ObjProblem> {
+    check_mesh_memory(scene, req.text, &memory_limit())
+        .map_err(|reason| ObjProblem { line: None, reason })?;
     let mtl_warnings = RefCell::new(Vec::new());
     let load_mtl = |path: &Path| -> tobj::MTLLoadResult {
         if req.material_override.is_some() {
             return Ok(Default::default());
         }
-        let name = path.to_string_lossy();
-        let text = (req.resolve)(&sibling(req.key, &name)).map_err(|reason| {
+        let name = short_path(&path.to_string_lossy());
+        let text = (req.resolve)(&sibling(req.key, &path.to_string_lossy())).map_err(|reason| {
             mtl_warnings.borrow_mut().push(format!(
                 "{}: cannot read the material library `{name}` ({reason}); its faces use the default material.",
                 req.label
             ));
             tobj::LoadError::OpenFileFailed
+        })?;
+        let text = mtl_for_tobj(&text).map_err(|(line, reason)| {
+            mtl_warnings.borrow_mut().push(format!(
+                "{}: cannot read the material library `{name}` (line {line}: {reason}); its faces use the default material.",
+                req.label
+            ));
+            tobj::LoadError::MaterialParseError
         })?;
         tobj::load_mtl_buf(&mut text.as_bytes()).inspect_err(|e| {
             mtl_warnings.borrow_mut().push(format!(
@@ -180,11 +342,12 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
             ));
         })
     };
-    let (models, mtl_materials) = match load_obj(req.text, load_mtl) {
+    let (text, polylines) = without_polylines(req.text);
+    let (models, mtl_materials) = match load_obj(&text, load_mtl) {
         Ok(Ok(loaded)) => loaded,
         Ok(Err(e)) => {
             return Err(ObjProblem {
-                line: error_line(req.text),
+                line: error_line(&text),
                 reason: e.to_string(),
             });
         }
@@ -192,6 +355,13 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     };
     let mtl_materials = mtl_materials.unwrap_or_default();
     let mut warnings = mtl_warnings.into_inner();
+    if polylines > 0 {
+        let s = if polylines == 1 { "" } else { "s" };
+        warnings.push(format!(
+            "{}: ignored {polylines} polyline{s} (`l`): a line has no surface to show.",
+            req.label
+        ));
+    }
     if req.material_override.is_none() && warnings.is_empty() {
         warn_unknown_usemtl(req, &mtl_materials, &mut warnings);
     }
@@ -199,7 +369,7 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     let linear = req.placement.linear();
     let mirrors = req.placement.mirrors();
     let mut mtl_ids: Vec<Option<MaterialId>> = vec![None; mtl_materials.len()];
-    let (mut added, mut dropped) = (0usize, 0usize);
+    let (mut added, mut dropped, mut too_far) = (0usize, 0usize, 0usize);
     for model in &models {
         let mesh = &model.mesh;
         let mut material = None;
@@ -217,6 +387,10 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
             }
             if !is_visible_triangle(&v) {
                 dropped += 1;
+                continue;
+            }
+            if v.iter().any(|p| p.abs().max_element() > MAX_COORDINATE) {
+                too_far += 1;
                 continue;
             }
             // Materials are added on first use, so a scene lists only what it shows.
@@ -245,6 +419,13 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
             req.label
         ));
     }
+    if too_far > 0 {
+        let s = if too_far == 1 { "" } else { "s" };
+        warnings.push(format!(
+            "{}: dropped {too_far} triangle{s} placed beyond ±1e15, raytree's limit on scene size.",
+            req.label
+        ));
+    }
     scene.warnings.extend(warnings);
     Ok(added)
 }
@@ -260,7 +441,15 @@ fn warn_unknown_usemtl(req: &MeshRequest, known: &[tobj::Material], warnings: &m
         .filter(|name| !name.is_empty() && !known.iter().any(|m| m.name == *name))
         .collect();
     if !unknown.is_empty() {
-        let names: Vec<String> = unknown.iter().map(|n| format!("`{n}`")).collect();
+        // A handful of names, so that the warning stays one readable sentence.
+        let mut names: Vec<String> = unknown
+            .iter()
+            .take(5)
+            .map(|n| format!("`{}`", short(n)))
+            .collect();
+        if unknown.len() > 5 {
+            names.push(format!("{} more", unknown.len() - 5));
+        }
         warnings.push(format!(
             "{}: `usemtl` names materials that no material library defines ({}); their faces use the default material.",
             req.label,
@@ -301,7 +490,7 @@ pub fn material_from_mtl(
     let mut invalid = |key: &str, got: String, fallback: String| {
         warnings.push(format!(
             "{label}: material `{}` has an invalid `{key}` {got}; using {fallback}.",
-            m.name
+            short(&m.name)
         ));
     };
     let mut rgb = |value: Option<[f32; 3]>, key: &str, fallback: Vec3| match value {
@@ -326,7 +515,7 @@ pub fn material_from_mtl(
             let fb = fallback.to_string();
             warnings.push(format!(
                 "{label}: material `{}` has an invalid `{key}` {x}; using {fb}.",
-                m.name
+                short(&m.name)
             ));
             None
         }
@@ -465,6 +654,55 @@ mod tests {
     fn error_lines_are_found() {
         let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 x\nf 1 2 3\n";
         assert_eq!(error_line(text), Some(4));
+    }
+
+    #[test]
+    fn mtl_colours_of_one_number_are_spelled_out_and_two_are_refused() {
+        let text = "newmtl a\nKd 0.8\nKs 1 2 3\n";
+        assert_eq!(
+            mtl_for_tobj(text).expect("one number is valid MTL"),
+            "newmtl a\nKd 0.8 0.8 0.8\nKs 1 2 3\n"
+        );
+        assert!(matches!(mtl_for_tobj("Ka 1 2 3\n"), Ok(Cow::Borrowed(_))));
+        let e = mtl_for_tobj("newmtl a\n\nKa 1 2\n").expect_err("two numbers");
+        assert_eq!(
+            e,
+            (3, "`Ka` needs one number or three (r g b), got 2".into())
+        );
+        assert!(mtl_for_tobj("Ke\n").is_err());
+        // Not numbers: tobj's own error, not ours.
+        assert!(mtl_for_tobj("Kd x y\n").is_ok());
+        // tobj itself panics on these; through `mtl_for_tobj` it never sees them.
+        for bad in ["newmtl a\nKd 1 2\n", "newmtl a\nKs\n"] {
+            assert!(quietly(|| tobj::load_mtl_buf(&mut bad.as_bytes())).is_err());
+        }
+    }
+
+    #[test]
+    fn panics_in_quietly_are_caught_and_others_still_reported() {
+        assert_eq!(quietly(|| 7), Ok(7));
+        assert_eq!(quietly(|| -> i32 { panic!("hostile") }), Err(()));
+        assert!(!QUIET.with(Cell::get), "the flag is reset after the panic");
+    }
+
+    #[test]
+    fn meshes_over_the_memory_limit_are_refused_before_reading() {
+        let limit = MemoryLimit {
+            bytes: 1 << 20,
+            source: "a test".into(),
+        };
+        let mut text = String::from("v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+        assert_eq!(obj_counts("f 1 2 3 4 5\nl 1 2\nf 1\nv 1 1 1\n"), (1, 4));
+        let (stripped, n) = without_polylines("v 0 0 0\n l 1 2 3\nf 1 1 1\n");
+        assert_eq!((stripped.as_ref(), n), ("v 0 0 0\n#\nf 1 1 1\n", 1));
+        assert!(check_mesh_memory(&Scene::default(), &text, &limit).is_ok());
+        text += &"f 1 2 3\n".repeat(3000);
+        let e = check_mesh_memory(&Scene::default(), &text, &limit).expect_err("over 1 MiB");
+        assert_eq!(
+            e,
+            "its 3 vertices and 3000 triangles would need about 1.3 MiB, more than the memory \
+             limit of 1.0 MiB (a test)"
+        );
     }
 
     #[test]

@@ -1,0 +1,271 @@
+//! Faults in the viewer (SPEC §9): bursts of edits (hundreds a second) never deadlock and never
+//! leave a stale tile (after the burst, the converged film equals the batch render of the final
+//! scene); a new scene opened mid-render replaces the old one cleanly, a bad one leaves it
+//! rendering; the window survives being 0×0. The logic runs headless
+//! (`ViewerApp::headless`); the window cases drive the real app through egui_kittest on the
+//! wgpu software adapter, like `tests/viewer.rs` (same environment: `XDG_RUNTIME_DIR=/tmp
+//! WGPU_BACKEND=vulkan` where needed).
+
+use std::panic::AssertUnwindSafe;
+use std::path::Path;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use eframe::egui;
+use egui::accesskit::Role;
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use glam::Vec3;
+use raytree::app::{Command, ViewerApp};
+use raytree::render::{Image, render};
+use raytree::scene::Scene;
+use raytree::scene::builtin::{load_builtin, scene_text};
+use raytree::trace::{TraceSettings, Tracer};
+
+fn small(name: &str, width: u32, height: u32, samples: u32) -> Scene {
+    let mut s = load_builtin(name).expect("built-in scene");
+    s.render.width = width;
+    s.render.height = height;
+    s.render.samples = samples;
+    s
+}
+
+fn batch(scene: &Scene, trace: TraceSettings) -> Image {
+    let tracer = Tracer::new(Arc::new(scene.clone()), trace);
+    render(&tracer, scene.render.samples, 0, &|_, _| {})
+        .expect("render")
+        .0
+}
+
+/// Polls until the current generation finishes; a deadlock fails here instead of hanging.
+fn settle(app: &mut ViewerApp) {
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while !app.is_finished() {
+        assert!(Instant::now() < deadline, "the render did not finish");
+        app.poll_session();
+        std::thread::sleep(Duration::from_millis(1));
+    }
+}
+
+fn assert_converged(app: &ViewerApp) {
+    let image = app.image();
+    let scene = app.scene();
+    assert_eq!(
+        (image.width, image.height),
+        (scene.render.width, scene.render.height)
+    );
+    assert!(
+        image == batch(scene, app.settings.trace),
+        "the converged film differs from the batch render of the final scene: a stale tile"
+    );
+}
+
+/// Hundreds of edits a second, of every kind that restarts the render: camera, depth, light
+/// colour, material, image size (so stale tiles of another size are in flight), accelerator
+/// rebuilds. Then the film converges to the final scene exactly.
+#[test]
+fn bursts_of_edits_never_deadlock_or_leave_stale_tiles() {
+    let mut app = ViewerApp::headless(small("default", 48, 36, 4), "burst".into())
+        .expect("the viewer starts");
+    let start = Instant::now();
+    let edits = 400;
+    for i in 0..edits {
+        let e = &mut app.edit;
+        e.camera.position.x += 0.002;
+        e.render.max_depth = i % 7;
+        e.render.width = 40 + i % 17;
+        e.render.height = 30 + i % 11;
+        if let Some(light) = e.lights.first_mut() {
+            light.color = Vec3::splat(0.5 + (i % 5) as f32 * 0.1);
+        }
+        if let Some(m) = e.materials.first_mut() {
+            m.reflectivity = Vec3::splat((i % 3) as f32 * 0.2);
+        }
+        app.command(if i % 25 == 0 {
+            Command::Rebuild
+        } else {
+            Command::Restart
+        });
+        app.apply();
+        app.poll_session();
+    }
+    let per_second = edits as f64 / start.elapsed().as_secs_f64();
+    eprintln!("{edits} edits at {per_second:.0} a second");
+    assert!(per_second > 100.0, "only {per_second:.0} edits a second");
+    settle(&mut app);
+    assert_eq!(app.scene().render.width, 40 + (edits - 1) % 17);
+    assert_converged(&app);
+    assert!(
+        app.messages.iter().all(|(error, _)| !error),
+        "{:?}",
+        app.messages
+    );
+}
+
+/// Opening another scene while a render runs: the new scene (another size) replaces the old,
+/// whose tiles still in flight are dropped; a bad file instead leaves the old scene rendering
+/// to the end.
+#[test]
+fn opening_a_scene_mid_render() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut app = ViewerApp::headless(small("default", 160, 120, 8), "default".into())
+        .expect("the viewer starts");
+    app.poll_session();
+
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "[render]\nwidth = 0\n").expect("write");
+    app.command(Command::OpenFile(bad.clone()));
+    app.apply();
+    let (error, message) = app.messages.last().cloned().expect("a message");
+    assert!(error, "{message}");
+    assert!(
+        message.starts_with(&format!("{}:2:9: render field `width`", bad.display())),
+        "{message}"
+    );
+    assert_eq!(app.scene().render.width, 160, "the old scene stays");
+    settle(&mut app);
+    assert_converged(&app);
+
+    // Restart a long render, then open a scene of another size in the middle of it.
+    app.edit.camera.position.y += 0.1;
+    app.command(Command::Restart);
+    app.apply();
+    app.poll_session();
+    let text = scene_text("glass")
+        .expect("glass")
+        .replace("width = 640", "width = 50")
+        .replace("height = 480", "height = 30")
+        .replace("../models/", "");
+    let good = dir.path().join("glass.toml");
+    std::fs::write(&good, text).expect("write");
+    for model in ["checker_floor.obj", "checker_floor.mtl", "prism.obj"] {
+        std::fs::copy(
+            Path::new("assets/models").join(model),
+            dir.path().join(model),
+        )
+        .expect("copy model");
+    }
+    app.command(Command::OpenFile(good.clone()));
+    app.apply();
+    assert_eq!(app.scene().source.as_deref(), Some(good.as_path()));
+    settle(&mut app);
+    assert_eq!(
+        (app.scene().render.width, app.scene().render.height),
+        (50, 30)
+    );
+    assert_converged(&app);
+}
+
+fn harness(scene: Scene, size: egui::Vec2) -> Harness<'static, ViewerApp> {
+    let renderer =
+        std::panic::catch_unwind(AssertUnwindSafe(egui_kittest::wgpu::WgpuTestRenderer::new))
+            .unwrap_or_else(|_| panic!("no wgpu adapter: see tests/viewer.rs"));
+    Harness::builder()
+        .with_size(size)
+        .renderer(renderer)
+        .build_eframe(|cc| ViewerApp::new(cc, scene, "faults".into()).expect("the viewer starts"))
+}
+
+/// A window of no area, or of one pixel, and shrinking to nothing mid-render: frames still run,
+/// the render still finishes, and growing the window back shows it.
+#[test]
+fn zero_and_tiny_windows_survive() {
+    for size in [
+        egui::vec2(0.0, 0.0),
+        egui::vec2(1.0, 1.0),
+        egui::vec2(3.0, 2.0),
+    ] {
+        let mut h = harness(small("quiz", 40, 30, 2), size);
+        for _ in 0..5 {
+            h.step();
+        }
+        let deadline = Instant::now() + Duration::from_secs(60);
+        while !h.state().is_finished() {
+            assert!(
+                Instant::now() < deadline,
+                "no progress in a {size:?} window"
+            );
+            h.step();
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+    let mut h = harness(small("quiz", 40, 30, 2), egui::vec2(800.0, 500.0));
+    h.step();
+    h.set_size(egui::vec2(0.0, 0.0));
+    for _ in 0..5 {
+        h.step();
+    }
+    h.set_size(egui::vec2(800.0, 500.0));
+    h.step();
+    h.step();
+    h.get_by_label("render viewport");
+}
+
+/// Edits through the real window as fast as frames go: the max-depth slider moved every frame.
+#[test]
+fn slider_bursts_through_the_window() {
+    let mut h = harness(small("default", 48, 36, 2), egui::vec2(1000.0, 700.0));
+    h.step();
+    let start = Instant::now();
+    let edits = 120;
+    for i in 0..edits {
+        h.get_by_role_and_label(Role::Slider, "max depth")
+            .set_value_accesskit(f64::from(i % 9));
+        h.step();
+    }
+    eprintln!(
+        "{edits} slider edits through the window in {:.2} s",
+        start.elapsed().as_secs_f64()
+    );
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while !h.state().is_finished() {
+        assert!(Instant::now() < deadline, "the render did not finish");
+        h.step();
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    assert_eq!(h.state().scene().render.max_depth, (edits - 1) % 9);
+    assert_converged(h.state());
+}
+
+/// A scene wider than the largest texture eframe's device allows (8192: egui-wgpu asks for
+/// exactly that limit) is shown scaled down to it, with a message.
+#[test]
+fn a_scene_wider_than_the_largest_texture_is_refused() {
+    // The device eframe asks for in the real window (textures up to 8192), not kittest's.
+    let mut setup = egui_kittest::wgpu::default_wgpu_setup();
+    if let eframe::egui_wgpu::WgpuSetup::CreateNew(new) = &mut setup {
+        new.device_descriptor =
+            eframe::egui_wgpu::WgpuSetupCreateNew::without_display_handle().device_descriptor;
+    }
+    let renderer = egui_kittest::wgpu::WgpuTestRenderer::from_setup(setup);
+    let scene = small("quiz", 9000, 4, 1);
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(800.0, 500.0))
+        .renderer(renderer)
+        .build_eframe(|cc| ViewerApp::new(cc, scene, "wide".into()).expect("the viewer starts"));
+    for _ in 0..5 {
+        h.step();
+    }
+    // Drawing runs the paint callback, which creates the texture.
+    h.render().expect("the window draws");
+    assert!(
+        h.state().messages.iter().any(|(error, _)| *error),
+        "no message about the size"
+    );
+}
+
+/// Edits are held to the loader's ±1e15 bound (a BVH build over a primitive near f32::MAX
+/// panics in obvhs): the far spheres are refused and the scene stays.
+#[test]
+fn an_edit_far_beyond_the_scene_size_limit_does_not_panic() {
+    let mut app =
+        ViewerApp::headless(small("default", 32, 24, 1), "far".into()).expect("the viewer starts");
+    let mut far = app.edit.spheres[0];
+    far.center = Vec3::new(3e38, 0.0, 0.0);
+    for _ in 0..8 {
+        app.edit.spheres.push(far);
+    }
+    app.command(Command::Rebuild);
+    app.apply();
+    settle(&mut app);
+}
