@@ -422,7 +422,8 @@ pub fn centroid_misses(
             base + a * (0.5 * edge) + b * (edge / aspect),
         ];
         let normal = (v[1] - v[0]).cross(v[2] - v[0]);
-        if !(normal.length() >= 0.5 * edge * edge / aspect) {
+        let thin = normal.length() < 0.5 * edge * edge / aspect;
+        if thin || !normal.is_finite() {
             continue; // the rounded vertices are too thin to aim at reliably
         }
         let centroid = (v[0] + v[1] + v[2]) / 3.0;
