@@ -120,10 +120,10 @@ struct BenchArgs {
     /// A small image, one run per point and smaller meshes: seconds instead of minutes.
     #[arg(long)]
     quick: bool,
-    /// Image width of the sweep (default: the scene's; --quick: 96).
+    /// Image width of the sweep (default 320; --quick: 96).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     width: Option<u32>,
-    /// Image height of the sweep (default: the scene's; --quick: 72).
+    /// Image height of the sweep (default 240; --quick: 72).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     height: Option<u32>,
     /// Worker threads; 0 uses every core.
@@ -132,6 +132,9 @@ struct BenchArgs {
     /// Skip the accelerator scaling sweep.
     #[arg(long)]
     no_scaling: bool,
+    /// Skip the speed/accuracy sweep (only the scaling sweep, which does not use SCENE).
+    #[arg(long, conflicts_with = "no_scaling")]
+    no_sweep: bool,
 }
 
 #[derive(Args, Debug)]
@@ -343,6 +346,15 @@ fn sweep_bar() -> indicatif::ProgressBar {
     bar
 }
 
+/// A progress callback that moves `bar`.
+fn show_on(bar: &indicatif::ProgressBar) -> impl Fn(&bench::BenchProgress) + '_ {
+    move |p| {
+        bar.set_length(p.steps as u64);
+        bar.set_position(p.step as u64);
+        bar.set_message(p.what.clone());
+    }
+}
+
 fn run_bench(args: &BenchArgs) -> Result<()> {
     let scene = load_scene(&args.scene)?;
     print_warnings(&scene);
@@ -361,45 +373,40 @@ fn run_bench(args: &BenchArgs) -> Result<()> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let cancel = AtomicBool::new(false);
-    let bar = sweep_bar();
-    let show = |p: &bench::BenchProgress| {
-        bar.set_length(p.steps as u64);
-        bar.set_position(p.step as u64);
-        bar.set_message(p.what.clone());
-    };
-    let report = bench::run_sweep(&scene, &opts, &show, &cancel)?;
-    bar.finish_and_clear();
-    bench::write_bench(&args.out, &report, &args.scene)?;
-    println!(
-        "wrote {} and bench.svg/.png ({} points, reference {}x{} at {} spp, depth {}, {:.1} s)",
-        args.out.join("bench.csv").display(),
-        report.points.len(),
-        report.reference.width,
-        report.reference.height,
-        report.reference.samples,
-        report.reference.max_depth,
-        report.reference.secs
-    );
-    println!("Pareto-optimal settings (time against mean FLIP):");
-    for line in bench::pareto_lines(&report) {
-        println!("  {line}");
-    }
-    let changed: Vec<String> = bench::accel_changes(&report)
-        .iter()
-        .filter(|(_, n)| *n > 0)
-        .map(|(k, n)| format!("{} changed {n} pixels", bench::value_name(k)))
-        .collect();
-    if changed.is_empty() {
-        println!("accelerators: none, grid and bvh give the identical image (0 differing pixels)");
+    let mut changed: Vec<String> = Vec::new();
+    if !args.no_sweep {
+        let bar = sweep_bar();
+        let report = bench::run_sweep(&scene, &opts, &show_on(&bar), &cancel)?;
+        bar.finish_and_clear();
+        bench::write_bench(&args.out, &report, &args.scene)?;
+        println!(
+            "wrote {} and bench.svg/.png ({} points, reference {}x{} at {} spp, depth {}, {:.1} s)",
+            args.out.join("bench.csv").display(),
+            report.points.len(),
+            report.reference.width,
+            report.reference.height,
+            report.reference.samples,
+            report.reference.max_depth,
+            report.reference.secs
+        );
+        println!("Pareto-optimal settings (time against mean FLIP):");
+        for line in bench::pareto_lines(&report) {
+            println!("  {line}");
+        }
+        changed = bench::accel_changes(&report)
+            .iter()
+            .filter(|(_, n)| *n > 0)
+            .map(|(k, n)| format!("{} changed {n} pixels", bench::value_name(k)))
+            .collect();
+        if changed.is_empty() {
+            println!(
+                "accelerators: none, grid and bvh give the identical image (0 differing pixels)"
+            );
+        }
     }
     if !args.no_scaling {
         let bar = sweep_bar();
-        let show = |p: &bench::BenchProgress| {
-            bar.set_length(p.steps as u64);
-            bar.set_position(p.step as u64);
-            bar.set_message(p.what.clone());
-        };
-        let points = bench::run_scaling(&scaling, &show, &cancel)?;
+        let points = bench::run_scaling(&scaling, &show_on(&bar), &cancel)?;
         bar.finish_and_clear();
         bench::write_scaling(&args.out, &points, &scaling)?;
         println!(

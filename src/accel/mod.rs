@@ -58,12 +58,39 @@ pub struct PrimHit {
     pub b2: f32,
 }
 
-/// `Auto` uses no accelerator below this many (valid) primitives and the BVH from here on.
+/// `Auto` tests every primitive (no accelerator) below this many valid primitives, and builds
+/// the BVH from here on (up to [`AUTO_MIN_GRID_PRIMS`]).
 ///
-/// A first guess: with a handful of primitives, testing them all is cheaper than any
-/// traversal. Issue 5 measures the real crossover points (none / grid / BVH against scene size
-/// and distribution) and replaces this rule with the measured one.
-pub const AUTO_MIN_BVH_PRIMS: usize = 8;
+/// Measured with `raytree bench default --no-sweep --out DIR` (the scaling sweep of
+/// `experiments::bench`: a tessellated sphere filling a 640×480 image, one sample, primary and
+/// shadow rays, build + render, median of 3 runs, 2 shared cores): no accelerator is faster at
+/// 1, 2 and 4 triangles (32 / 39 / 43 ms against the BVH's 48 / 43 / 68 ms), the BVH from 8 on
+/// (72 ms against 93 ms; 84 ms against 260 ms at 32). The crossover interpolates to about 6.
+pub const AUTO_MIN_BVH_PRIMS: usize = 6;
+
+/// `Auto` builds the uniform grid from this many valid primitives on.
+///
+/// Same measurement: the grid and the BVH tie from 128 to 2048 triangles, the BVH is faster
+/// from 8k to 1M (0.25 s against 0.37 s at 131k), and the grid from about 1.1M on, because the
+/// BVH's build then outweighs its faster traversal: at 2.1M triangles the grid builds in 0.61 s
+/// against 2.0 s and renders the frame in 0.62 s against 0.34 s (1.23 s against 2.33 s in
+/// all), in 54 bytes per triangle against 128. A viewer that renders more than about five
+/// frames of such a scene without rebuilding would do better with `--accel bvh`; so would a
+/// very uneven scene, where a uniform grid's cells fill unevenly (the sweep's sphere is the
+/// grid's good case).
+pub const AUTO_MIN_GRID_PRIMS: usize = 1_100_000;
+
+/// The accelerator `Auto` builds for `valid_prims` primitives (see [`AUTO_MIN_BVH_PRIMS`] and
+/// [`AUTO_MIN_GRID_PRIMS`] for the measurements behind the rule).
+pub fn auto_kind(valid_prims: usize) -> AccelKind {
+    if valid_prims < AUTO_MIN_BVH_PRIMS {
+        AccelKind::None
+    } else if valid_prims < AUTO_MIN_GRID_PRIMS {
+        AccelKind::Bvh
+    } else {
+        AccelKind::Grid
+    }
+}
 
 /// The shape of one primitive, as the accelerators store it.
 #[derive(Clone, Copy, Debug)]
@@ -229,7 +256,7 @@ impl std::fmt::Debug for Accel {
 
 impl Accel {
     /// Build the accelerator `kind` over `prims` (copied; invalid primitives dropped and
-    /// counted). `Auto` resolves to a concrete kind, see [`AUTO_MIN_BVH_PRIMS`].
+    /// counted). `Auto` resolves to a concrete kind, see [`auto_kind`].
     pub fn build(kind: AccelKind, prims: &PrimSet) -> Accel {
         let mut list = Vec::with_capacity(prims.spheres.len() + prims.triangles.len());
         let mut skipped = 0;
@@ -259,8 +286,7 @@ impl Accel {
             id += 1;
         }
         let kind = match kind {
-            AccelKind::Auto if list.len() < AUTO_MIN_BVH_PRIMS => AccelKind::None,
-            AccelKind::Auto => AccelKind::Bvh,
+            AccelKind::Auto => auto_kind(list.len()),
             k => k,
         };
         let prim_count = list.len();
