@@ -26,7 +26,9 @@ mod grid;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::{Methods, Ray, intersect_sphere, intersect_triangle, next_float_up};
+use crate::geometry::{
+    Methods, Ray, Shear, TriangleMethod, intersect_sphere, intersect_triangle, next_float_up,
+};
 
 /// Which accelerator to build. `Auto` picks from the scene's size.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
@@ -80,17 +82,27 @@ struct Prim {
 }
 
 impl Prim {
-    /// The shared intersection call: `(t, b1, b2)` (barycentrics are 0 for spheres).
+    /// The shared intersection call: `(t, b1, b2)` (barycentrics are 0 for spheres). `shear`
+    /// is the ray's [`Shear`], computed once per query (the watertight method's per-ray part).
     #[inline(always)]
-    fn intersect(&self, m: &Methods, ray: &Ray, t_min: f32, t_max: f32) -> Option<(f32, f32, f32)> {
+    fn intersect(
+        &self,
+        m: &Methods,
+        ray: &Ray,
+        shear: &Option<Shear>,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<(f32, f32, f32)> {
         match &self.shape {
             Shape::Sphere { center, radius } => {
                 intersect_sphere(m.sphere, *center, *radius, ray, t_min, t_max)
                     .map(|t| (t, 0.0, 0.0))
             }
-            Shape::Triangle(v) => {
-                intersect_triangle(m.triangle, v, ray, t_min, t_max).map(|h| (h.t, h.b1, h.b2))
+            Shape::Triangle(v) => match m.triangle {
+                TriangleMethod::Watertight => shear.as_ref()?.intersect(v, ray, t_min, t_max),
+                method => intersect_triangle(method, v, ray, t_min, t_max),
             }
+            .map(|h| (h.t, h.b1, h.b2)),
         }
     }
 
@@ -109,6 +121,9 @@ impl Prim {
 
 /// What a traversal does with each primitive it reaches; generic so the loops monomorphise.
 trait Visitor {
+    /// Whether the BVH should visit nearer children first (closest hit) or may take any
+    /// order (occlusion).
+    const ORDERED: bool = true;
     /// The farthest `t` still of interest (boxes and cells entered beyond it are skipped).
     fn limit(&self) -> f32;
     /// Test one primitive; `true` stops the traversal.
@@ -119,6 +134,7 @@ trait Visitor {
 struct Closest<'a> {
     m: &'a Methods,
     ray: &'a Ray,
+    shear: Option<Shear>,
     t_min: f32,
     t: f32,
     prim: u32,
@@ -131,6 +147,7 @@ impl<'a> Closest<'a> {
         Self {
             m,
             ray,
+            shear: Shear::new(ray.dir),
             t_min,
             t: t_max,
             prim: u32::MAX,
@@ -164,7 +181,7 @@ impl Visitor for Closest<'_> {
         } else {
             next_float_up(self.t)
         };
-        if let Some((t, b1, b2)) = prim.intersect(self.m, self.ray, self.t_min, limit)
+        if let Some((t, b1, b2)) = prim.intersect(self.m, self.ray, &self.shear, self.t_min, limit)
             && (t < self.t || (t == self.t && prim.id < self.prim))
         {
             self.t = t;
@@ -180,12 +197,15 @@ impl Visitor for Closest<'_> {
 struct AnyHit<'a> {
     m: &'a Methods,
     ray: &'a Ray,
+    shear: Option<Shear>,
     t_min: f32,
     t_max: f32,
     hit: bool,
 }
 
 impl Visitor for AnyHit<'_> {
+    const ORDERED: bool = false;
+
     #[inline(always)]
     fn limit(&self) -> f32 {
         self.t_max
@@ -194,7 +214,7 @@ impl Visitor for AnyHit<'_> {
     #[inline(always)]
     fn visit(&mut self, prim: &Prim) -> bool {
         self.hit = prim
-            .intersect(self.m, self.ray, self.t_min, self.t_max)
+            .intersect(self.m, self.ray, &self.shear, self.t_min, self.t_max)
             .is_some();
         self.hit
     }
@@ -331,6 +351,7 @@ impl Accel {
         let mut v = AnyHit {
             m,
             ray,
+            shear: Shear::new(ray.dir),
             t_min,
             t_max,
             hit: false,

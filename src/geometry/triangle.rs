@@ -150,76 +150,122 @@ fn max_component_index(a: Vec3) -> usize {
 /// `t_max·det`) so the answer is a pure function of the triangle and the ray: the accelerators
 /// rely on that to agree bit for bit.
 fn watertight(v: &[Vec3; 3], ray: &Ray, t_min: f32, t_max: f32) -> Option<TriHit> {
-    let d = ray.dir;
-    let kz = max_component_index(d.abs());
-    let kx = if kz == 2 { 0 } else { kz + 1 };
-    let ky = if kx == 2 { 0 } else { kx + 1 };
-    let dz = d[kz];
-    if dz == 0.0 || dz.is_nan() {
-        return None;
-    }
-    let sx = -d[kx] / dz;
-    let sy = -d[ky] / dz;
-    let sz = 1.0 / dz;
+    Shear::new(ray.dir)?.intersect(v, ray, t_min, t_max)
+}
 
-    let p0 = v[0] - ray.origin;
-    let p1 = v[1] - ray.origin;
-    let p2 = v[2] - ray.origin;
-    // Permute and shear x, y.
-    let (p0x, p0y, p0z) = (p0[kx] + sx * p0[kz], p0[ky] + sy * p0[kz], p0[kz]);
-    let (p1x, p1y, p1z) = (p1[kx] + sx * p1[kz], p1[ky] + sy * p1[kz], p1[kz]);
-    let (p2x, p2y, p2z) = (p2[kx] + sx * p2[kz], p2[ky] + sy * p2[kz], p2[kz]);
+/// The per-ray part of the watertight test (steps 2 and 3: the permutation and the shear),
+/// computed once per ray rather than once per triangle. [`Shear::intersect`] then does the
+/// per-triangle steps with exactly the arithmetic of [`intersect_triangle`]'s watertight
+/// method, so the results are identical bit for bit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shear {
+    /// The axis that becomes `z` (the direction's largest `|component|`).
+    kz: u8,
+    sx: f32,
+    sy: f32,
+    sz: f32,
+}
 
-    let mut e0 = p1x * p2y - p1y * p2x;
-    let mut e1 = p2x * p0y - p2y * p0x;
-    let mut e2 = p0x * p1y - p0y * p1x;
-    if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
-        // The products of two f32 are exact in f64; only the difference rounds, once.
-        let f = |ax: f32, by: f32, ay: f32, bx: f32| {
-            (f64::from(ax) * f64::from(by) - f64::from(ay) * f64::from(bx)) as f32
-        };
-        e0 = f(p1x, p2y, p1y, p2x);
-        e1 = f(p2x, p0y, p2y, p0x);
-        e2 = f(p0x, p1y, p0y, p1x);
+impl Shear {
+    /// `None` when the direction has no usable largest component (zero or NaN): such a ray
+    /// hits no triangle.
+    #[inline]
+    pub fn new(d: Vec3) -> Option<Shear> {
+        let kz = max_component_index(d.abs());
+        let kx = if kz == 2 { 0 } else { kz + 1 };
+        let ky = if kx == 2 { 0 } else { kx + 1 };
+        let dz = d[kz];
+        if dz == 0.0 || dz.is_nan() {
+            return None;
+        }
+        Some(Shear {
+            kz: kz as u8,
+            sx: -d[kx] / dz,
+            sy: -d[ky] / dz,
+            sz: 1.0 / dz,
+        })
     }
-    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
-        return None;
+
+    /// Nearest hit in `(t_min, t_max)` of `ray` (whose direction made this shear) with
+    /// triangle `v`, both faces.
+    #[inline(always)]
+    pub fn intersect(&self, v: &[Vec3; 3], ray: &Ray, t_min: f32, t_max: f32) -> Option<TriHit> {
+        // One copy of the test per axis, so the permutation is constant indices.
+        match self.kz {
+            0 => self.intersect_k::<1, 2, 0>(v, ray, t_min, t_max),
+            1 => self.intersect_k::<2, 0, 1>(v, ray, t_min, t_max),
+            _ => self.intersect_k::<0, 1, 2>(v, ray, t_min, t_max),
+        }
     }
-    let det = e0 + e1 + e2;
-    if det == 0.0 || det.is_nan() {
-        return None;
+
+    #[inline(always)]
+    fn intersect_k<const KX: usize, const KY: usize, const KZ: usize>(
+        &self,
+        v: &[Vec3; 3],
+        ray: &Ray,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<TriHit> {
+        let Shear { sx, sy, sz, .. } = *self;
+        let p0 = v[0] - ray.origin;
+        let p1 = v[1] - ray.origin;
+        let p2 = v[2] - ray.origin;
+        // Permute and shear x, y.
+        let (p0x, p0y, p0z) = (p0[KX] + sx * p0[KZ], p0[KY] + sy * p0[KZ], p0[KZ]);
+        let (p1x, p1y, p1z) = (p1[KX] + sx * p1[KZ], p1[KY] + sy * p1[KZ], p1[KZ]);
+        let (p2x, p2y, p2z) = (p2[KX] + sx * p2[KZ], p2[KY] + sy * p2[KZ], p2[KZ]);
+
+        let mut e0 = p1x * p2y - p1y * p2x;
+        let mut e1 = p2x * p0y - p2y * p0x;
+        let mut e2 = p0x * p1y - p0y * p1x;
+        if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
+            // The products of two f32 are exact in f64; only the difference rounds, once.
+            let f = |ax: f32, by: f32, ay: f32, bx: f32| {
+                (f64::from(ax) * f64::from(by) - f64::from(ay) * f64::from(bx)) as f32
+            };
+            e0 = f(p1x, p2y, p1y, p2x);
+            e1 = f(p2x, p0y, p2y, p0x);
+            e2 = f(p0x, p1y, p0y, p1x);
+        }
+        if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+            return None;
+        }
+        let det = e0 + e1 + e2;
+        if det == 0.0 || det.is_nan() {
+            return None;
+        }
+        let t_scaled = e0 * (sz * p0z) + e1 * (sz * p1z) + e2 * (sz * p2z);
+        if t_scaled.is_nan() || (det < 0.0 && t_scaled >= 0.0) || (det > 0.0 && t_scaled <= 0.0) {
+            return None;
+        }
+        let inv_det = 1.0 / det;
+        let t = t_scaled * inv_det;
+        if !(t > t_min && t < t_max) {
+            return None;
+        }
+        // pbrt-v4: accept only a t conservatively greater than zero. A ray that starts on the
+        // triangle's plane (an offset origin of a flat, axis-aligned floor has a zero error
+        // bound along the normal) can otherwise compute a tiny positive t and shadow itself.
+        let (z0, z1, z2) = ((sz * p0z).abs(), (sz * p1z).abs(), (sz * p2z).abs());
+        let max_z = z0.max(z1).max(z2);
+        let max_x = p0x.abs().max(p1x.abs()).max(p2x.abs());
+        let max_y = p0y.abs().max(p1y.abs()).max(p2y.abs());
+        let delta_z = gamma(3) * max_z;
+        let delta_x = gamma(5) * (max_x + max_z);
+        let delta_y = gamma(5) * (max_y + max_z);
+        let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+        let max_e = e0.abs().max(e1.abs()).max(e2.abs());
+        let delta_t =
+            3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs();
+        if t <= delta_t {
+            return None;
+        }
+        Some(TriHit {
+            t,
+            b1: e1 * inv_det,
+            b2: e2 * inv_det,
+        })
     }
-    let t_scaled = e0 * (sz * p0z) + e1 * (sz * p1z) + e2 * (sz * p2z);
-    if t_scaled.is_nan() || (det < 0.0 && t_scaled >= 0.0) || (det > 0.0 && t_scaled <= 0.0) {
-        return None;
-    }
-    let inv_det = 1.0 / det;
-    let t = t_scaled * inv_det;
-    if !(t > t_min && t < t_max) {
-        return None;
-    }
-    // pbrt-v4: accept only a t conservatively greater than zero. A ray that starts on the
-    // triangle's plane (an offset origin of a flat, axis-aligned floor has a zero error bound
-    // along the normal) can otherwise compute a tiny positive t and shadow itself.
-    let (z0, z1, z2) = ((sz * p0z).abs(), (sz * p1z).abs(), (sz * p2z).abs());
-    let max_z = z0.max(z1).max(z2);
-    let max_x = p0x.abs().max(p1x.abs()).max(p2x.abs());
-    let max_y = p0y.abs().max(p1y.abs()).max(p2y.abs());
-    let delta_z = gamma(3) * max_z;
-    let delta_x = gamma(5) * (max_x + max_z);
-    let delta_y = gamma(5) * (max_y + max_z);
-    let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
-    let max_e = e0.abs().max(e1.abs()).max(e2.abs());
-    let delta_t =
-        3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs();
-    if t <= delta_t {
-        return None;
-    }
-    Some(TriHit {
-        t,
-        b1: e1 * inv_det,
-        b2: e2 * inv_det,
-    })
 }
 
 /// The point with barycentric weights `(1 − b1 − b2, b1, b2)` and a per-axis bound on its
