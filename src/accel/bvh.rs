@@ -53,8 +53,8 @@ use obvhs::{
     ploc::PlocBuilder,
 };
 
-use super::{Prim, Visitor, box_t_slack};
-use crate::geometry::Ray;
+use super::{Prim, Shape, Visitor, box_t_slack};
+use crate::geometry::{Ray, Triangles4};
 
 /// Padding of child boxes in every axis, relative to the largest coordinate magnitude of the
 /// box: a primitive's computed hit point is off by a few ulp of its largest coordinate in
@@ -74,19 +74,29 @@ pub const MAX_BVH2_DEPTH: usize = 96;
 /// tree of up to 2²⁸ primitives needs at most 3 per level for about 13 levels.
 pub const STACK_SIZE: usize = 64;
 
-/// Most primitives in one leaf (the cost model decides below that; 1..=8).
+/// Most triangles in one leaf: one four-lane test. A leaf holds triangles or one sphere.
 pub const MAX_LEAF: usize = 4;
 
-/// Cost of a primitive test relative to a node visit (four box tests), for the leaf decision.
-const PRIM_COST: f32 = 1.0;
-const NODE_COST: f32 = 1.2;
+/// Costs of a visit relative to each other, for the surface-area leaf decision: a node (four
+/// box tests), a leaf of up to four triangles (one four-lane test), a sphere.
+const NODE_COST: f32 = 1.0;
+const PACKET_COST: f32 = 1.5;
+const SPHERE_COST: f32 = 1.0;
 
-/// A child word with this bit is a leaf: `LEAF | first << 3 | (count − 1)`; otherwise it is a
-/// node index.
+/// A child word with this bit is a leaf, otherwise a node index. A triangle leaf is
+/// `LEAF | packet << 2 | (count − 1)`, a sphere leaf `LEAF | SPHERE | index`.
 const LEAF: u32 = 0x8000_0000;
+const SPHERE: u32 = 0x4000_0000;
 
-/// Most primitives a leaf word can address (28 bits of first index).
+/// Most primitives the leaf words can address (2²⁸ packets of up to four triangles).
 pub const MAX_PRIMS: usize = 1 << 28;
+
+/// Up to four triangles of a leaf, one per lane, and their primitive ids.
+#[derive(Clone, Copy, Debug)]
+struct Packet {
+    tris: Triangles4,
+    ids: [u32; 4],
+}
 
 /// One node of the 4-wide tree: two cache lines.
 #[derive(Clone, Copy, Debug)]
@@ -103,8 +113,10 @@ struct Node {
 
 pub(super) struct Bvh {
     nodes: Vec<Node>,
-    /// Primitives in leaf order.
-    prims: Vec<Prim>,
+    /// Triangle leaves, in tree order.
+    packets: Vec<Packet>,
+    /// Sphere leaves.
+    spheres: Vec<Prim>,
     depth: usize,
 }
 
@@ -142,7 +154,8 @@ impl Bvh {
         let bvh = built.unwrap_or_else(|| {
             let b = collapse(&median_bvh2(&boxes), &prims).unwrap_or_else(|| Bvh {
                 nodes: Vec::new(),
-                prims: Vec::new(),
+                packets: Vec::new(),
+                spheres: Vec::new(),
                 depth: 0,
             });
             // A balanced binary tree of 2²⁸ leaves has depth 29; its 4-wide collapse needs
@@ -154,7 +167,9 @@ impl Bvh {
     }
 
     pub(super) fn memory_bytes(&self) -> usize {
-        self.nodes.capacity() * size_of::<Node>() + self.prims.capacity() * size_of::<Prim>()
+        self.nodes.capacity() * size_of::<Node>()
+            + self.packets.capacity() * size_of::<Packet>()
+            + self.spheres.capacity() * size_of::<Prim>()
     }
 
     pub(super) fn depth(&self) -> usize {
@@ -184,12 +199,14 @@ impl Bvh {
         let mut word = 0u32;
         loop {
             if word & LEAF != 0 {
-                let first = ((word & !LEAF) >> 3) as usize;
-                let count = (word & 7) as usize + 1;
-                for prim in &self.prims[first..first + count] {
-                    if v.visit(prim) {
-                        return;
-                    }
+                let stop = if word & SPHERE != 0 {
+                    v.visit(&self.spheres[(word & !(LEAF | SPHERE)) as usize])
+                } else {
+                    let packet = &self.packets[((word & !LEAF) >> 2) as usize];
+                    v.visit_triangles(&packet.tris, &packet.ids, (word & 3) as usize + 1)
+                };
+                if stop {
+                    return;
                 }
             } else {
                 let node = &self.nodes[word as usize];
@@ -307,7 +324,9 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
     }
     // Bottom up: primitives under each node and the surface-area cost of its best subtree;
     // `leaf[i]` when the node's subtree is cheaper as one leaf.
+    let is_sphere = |i: usize| matches!(prims[i].shape, Shape::Sphere { .. });
     let mut count = vec![0u32; n];
+    let mut spheres = vec![0u32; n];
     let mut cost = vec![0f32; n];
     let mut leaf = vec![false; n];
     for &i in order.iter().rev() {
@@ -315,15 +334,18 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
         let area = node.aabb.half_area().max(0.0);
         if node.prim_count > 0 {
             assert!(node.prim_count == 1, "binary leaves hold one primitive");
+            let sphere = is_sphere(bvh2.primitive_indices[node.first_index as usize] as usize);
             count[i] = 1;
-            cost[i] = PRIM_COST * area;
+            spheres[i] = u32::from(sphere);
+            cost[i] = if sphere { SPHERE_COST } else { PACKET_COST } * area;
             leaf[i] = true;
         } else {
             let (l, r) = (node.first_index as usize, node.first_index as usize + 1);
             count[i] = count[l] + count[r];
+            spheres[i] = spheres[l] + spheres[r];
             let split = NODE_COST * area + cost[l] + cost[r];
-            let as_leaf = PRIM_COST * area * count[i] as f32;
-            if count[i] as usize <= MAX_LEAF && as_leaf <= split {
+            let as_leaf = PACKET_COST * area;
+            if spheres[i] == 0 && count[i] as usize <= MAX_LEAF && as_leaf <= split {
                 cost[i] = as_leaf;
                 leaf[i] = true;
             } else {
@@ -332,8 +354,11 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
         }
     }
 
-    let mut nodes: Vec<Node> = Vec::with_capacity(n / 3 + 1);
-    let mut ordered: Vec<Prim> = Vec::with_capacity(prims.len());
+    let mut nodes: Vec<Node> = Vec::new();
+    let mut packets: Vec<Packet> = Vec::new();
+    let mut sphere_leaves: Vec<Prim> = Vec::new();
+    let mut leaf_tris: Vec<[Vec3; 3]> = Vec::with_capacity(MAX_LEAF);
+    let mut leaf_ids = [0u32; 4];
     let mut depth = 0;
     // (binary node, wide node to fill, its depth); the root's slots are the root's children,
     // or the root itself when it is a leaf.
@@ -381,23 +406,37 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
                 node.planes[2 * axis + 1][slot] = h;
             }
             node.valid |= 1 << slot;
-            if leaf[s] {
-                // The subtree's primitives, left to right.
-                let first = ordered.len();
+            if leaf[s] && spheres[s] == 1 {
+                let id = bvh2.primitive_indices[bvh2.nodes[s].first_index as usize] as usize;
+                node.child[slot] = LEAF | SPHERE | sphere_leaves.len() as u32;
+                sphere_leaves.push(prims[id]);
+            } else if leaf[s] {
+                // The subtree's triangles, left to right, as one packet.
+                leaf_tris.clear();
                 under.clear();
                 under.push(s);
                 while let Some(u) = under.pop() {
                     let un = &bvh2.nodes[u];
                     if un.prim_count > 0 {
                         let id = bvh2.primitive_indices[un.first_index as usize] as usize;
-                        ordered.push(prims[id]);
+                        if let Shape::Triangle(v) = prims[id].shape {
+                            leaf_ids[leaf_tris.len()] = prims[id].id;
+                            leaf_tris.push(v);
+                        }
                     } else {
                         under.push(un.first_index as usize + 1);
                         under.push(un.first_index as usize);
                     }
                 }
-                let c = ordered.len() - first;
-                node.child[slot] = LEAF | ((first as u32) << 3) | (c as u32 - 1);
+                let c = leaf_tris.len();
+                for k in c..4 {
+                    leaf_ids[k] = leaf_ids[0];
+                }
+                node.child[slot] = LEAF | ((packets.len() as u32) << 2) | (c as u32 - 1);
+                packets.push(Packet {
+                    tris: Triangles4::new(&leaf_tris),
+                    ids: leaf_ids,
+                });
             } else {
                 let index = nodes.len() as u32;
                 nodes.push(empty_node());
@@ -407,9 +446,12 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
         }
         nodes[w as usize] = node;
     }
+    nodes.shrink_to_fit();
+    packets.shrink_to_fit();
     Some(Bvh {
         nodes,
-        prims: ordered,
+        packets,
+        spheres: sphere_leaves,
         depth,
     })
 }

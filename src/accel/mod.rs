@@ -27,7 +27,8 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use crate::geometry::{
-    Methods, Ray, Shear, TriangleMethod, intersect_sphere, intersect_triangle, next_float_up,
+    Methods, Ray, Shear, TriangleMethod, Triangles4, intersect_sphere, intersect_triangle,
+    intersect_triangles4, next_float_up,
 };
 
 /// Which accelerator to build. `Auto` picks from the scene's size.
@@ -128,6 +129,9 @@ trait Visitor {
     fn limit(&self) -> f32;
     /// Test one primitive; `true` stops the traversal.
     fn visit(&mut self, prim: &Prim) -> bool;
+    /// Test the triangles in lanes `0..count` of `tris` (ids `ids`), in lane order, with one
+    /// four-lane test; the same answer as visiting them one by one. `true` stops.
+    fn visit_triangles(&mut self, tris: &Triangles4, ids: &[u32; 4], count: usize) -> bool;
 }
 
 /// Closest hit with the id tie-break.
@@ -191,6 +195,42 @@ impl Visitor for Closest<'_> {
         }
         false
     }
+
+    #[inline(always)]
+    fn visit_triangles(&mut self, tris: &Triangles4, ids: &[u32; 4], count: usize) -> bool {
+        let limit = |s: &Self| {
+            if s.prim == u32::MAX {
+                s.t
+            } else {
+                next_float_up(s.t)
+            }
+        };
+        // Each lane's t does not depend on the limit, and the limit only shrinks from lane to
+        // lane, so testing all lanes against the first limit and then re-checking each
+        // candidate against the current one in lane order is what `visit` one by one does.
+        let hits = intersect_triangles4(
+            self.m.triangle,
+            self.shear.as_ref(),
+            tris,
+            count,
+            self.ray,
+            self.t_min,
+            limit(self),
+        );
+        let mut mask = hits.mask;
+        while mask != 0 {
+            let lane = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let (t, id) = (hits.t[lane], ids[lane]);
+            if t < limit(self) && (t < self.t || (t == self.t && id < self.prim)) {
+                self.t = t;
+                self.prim = id;
+                self.b1 = hits.b1[lane];
+                self.b2 = hits.b2[lane];
+            }
+        }
+        false
+    }
 }
 
 /// Any hit in `(t_min, t_max)`: stops at the first.
@@ -216,6 +256,21 @@ impl Visitor for AnyHit<'_> {
         self.hit = prim
             .intersect(self.m, self.ray, &self.shear, self.t_min, self.t_max)
             .is_some();
+        self.hit
+    }
+
+    #[inline(always)]
+    fn visit_triangles(&mut self, tris: &Triangles4, _ids: &[u32; 4], count: usize) -> bool {
+        let hits = intersect_triangles4(
+            self.m.triangle,
+            self.shear.as_ref(),
+            tris,
+            count,
+            self.ray,
+            self.t_min,
+            self.t_max,
+        );
+        self.hit = hits.mask != 0;
         self.hit
     }
 }

@@ -11,7 +11,10 @@ use serde::{Deserialize, Serialize};
 
 pub use offset::{OffsetMethod, offset_ray_origin};
 pub use sphere::{SphereMethod, intersect_sphere, sphere_hit_point};
-pub use triangle::{Shear, TriHit, TriangleMethod, intersect_triangle, triangle_hit_point};
+pub use triangle::{
+    Shear, TriHit, TriHits4, TriangleMethod, Triangles4, intersect_triangle, intersect_triangles4,
+    triangle_hit_point,
+};
 
 /// `P = origin + s·dir`, `dir` unit length, `s ≥ 0` (lecture: "Ray equation").
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
