@@ -282,16 +282,12 @@ impl Bvh {
 /// box offsets, and the clamp keeps those products finite for any scene below about `1e17` in
 /// size, so no `0·∞` NaN can appear. Treating `|d| < 2⁻⁶⁰` as `2⁻⁶⁰` is harmless: child boxes
 /// are padded, so an origin on an unpadded face is strictly inside.
+#[inline(always)]
 fn trav_inv(d: Vec3) -> Vec3A {
-    let f = |x: f32| {
-        let i = 1.0 / x;
-        if i.abs() < INV_DIR_CLAMP {
-            i
-        } else {
-            INV_DIR_CLAMP.copysign(x)
-        }
-    };
-    Vec3A::new(f(d.x), f(d.y), f(d.z))
+    let d = Vec3A::from(d);
+    let i = Vec3A::ONE / d;
+    let clamp = Vec3A::splat(INV_DIR_CLAMP);
+    Vec3A::select(i.abs().cmplt(clamp), i, clamp.copysign(d))
 }
 
 /// Bound of `|1/d|` in [`trav_inv`].

@@ -14,7 +14,7 @@
 //! altogether. The watertight test shears the triangle into a ray-aligned space where the three
 //! edge functions of a shared edge are computed from the same numbers in both triangles, so
 //! their signs agree exactly and no ray slips between; it rejects only `det == 0`.
-use glam::{DVec3, Vec3, Vec4};
+use glam::{DVec3, Vec3, Vec3A, Vec4};
 use serde::{Deserialize, Serialize};
 
 use super::{Ray, gamma};
@@ -178,11 +178,13 @@ impl Shear {
         if dz == 0.0 || dz.is_nan() {
             return None;
         }
+        // One vector division for the three quotients (each lane rounds as a scalar `/`).
+        let q = Vec3A::new(-d[kx], -d[ky], 1.0) / Vec3A::splat(dz);
         Some(Shear {
             kz: kz as u8,
-            sx: -d[kx] / dz,
-            sy: -d[ky] / dz,
-            sz: 1.0 / dz,
+            sx: q.x,
+            sy: q.y,
+            sz: q.z,
         })
     }
 
