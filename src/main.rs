@@ -219,7 +219,9 @@ fn print_warnings(scene: &Scene) {
 }
 
 fn run_render(args: &RenderArgs) -> Result<()> {
+    let load_start = std::time::Instant::now();
     let mut scene = load_scene(&args.scene)?;
+    let load_secs = load_start.elapsed().as_secs_f64();
     print_warnings(&scene);
     let trace = apply_overrides(&mut scene, &args.overrides);
     if !(0.0..1.0).contains(&trace.cutoff) {
@@ -281,9 +283,11 @@ fn run_render(args: &RenderArgs) -> Result<()> {
     ];
     export::write_image(&args.output, &image, &text)?;
     if let Some(path) = &args.stats_json {
+        let memory = raytree::render::MemoryStats::of(&tracer);
         let json = serde_json::to_string_pretty(&serde_json::json!({
             "stats": stats, "mrays_per_sec": stats.mrays_per_sec(),
             "triangles": scene.triangles.len(), "spheres": scene.spheres.len(),
+            "load_secs": load_secs, "memory": memory,
         }))
         .context("cannot encode the statistics")?;
         export::write_text(path, &json)?;
@@ -308,7 +312,8 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         r.total()
     );
     println!(
-        "time: build {:.3} s, render {:.3} s, {:.2} Mrays/s",
+        "time: load {:.3} s, build {:.3} s, render {:.3} s, {:.2} Mrays/s",
+        load_secs,
         stats.build_secs,
         stats.render_secs,
         stats.mrays_per_sec()

@@ -8,6 +8,7 @@ use glam::Vec3;
 use crate::scene::{Material, Shading};
 
 /// Mirror direction of the unit incoming direction `u` about the unit normal `n`.
+#[inline]
 pub fn reflect(u: Vec3, n: Vec3) -> Vec3 {
     u - 2.0 * u.dot(n) * n
 }
@@ -15,6 +16,7 @@ pub fn reflect(u: Vec3, n: Vec3) -> Vec3 {
 /// Refracted direction of the unit incoming direction `u` through a surface with unit normal `n`
 /// facing the incoming side (`u·n ≤ 0`), where `eta = ηi/ηr`. `None` on total internal
 /// reflection, i.e. when `1 − eta²(1 − cos²θi) < 0`.
+#[inline]
 pub fn refract(u: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
     let cos_i = (-u.dot(n)).clamp(0.0, 1.0);
     let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
@@ -28,6 +30,7 @@ pub fn refract(u: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
 
 /// Blinn's halfway vector `H = normalize(L + V)`. `L = −V` has no halfway vector; `N·H` is then
 /// taken as 0 by returning the zero vector.
+#[inline]
 pub fn halfway(l: Vec3, v: Vec3) -> Vec3 {
     (l + v).normalize_or_zero()
 }
@@ -49,6 +52,7 @@ pub struct LightTerms {
 /// The diffuse and specular terms of one light of colour `color` for unit normal `n`, unit
 /// direction to the light `l` and unit direction to the viewer `v`. A light behind the surface
 /// (`N·L ≤ 0`) adds nothing, its specular included.
+#[inline]
 pub fn light_terms(
     shading: Shading,
     material: &Material,
@@ -86,6 +90,7 @@ pub fn light_terms(
 }
 
 /// `ka ⊙ A`.
+#[inline]
 pub fn ambient_term(material: &Material, ambient_light: Vec3) -> Vec3 {
     material.ambient * ambient_light
 }

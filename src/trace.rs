@@ -373,10 +373,15 @@ impl Tracer {
             let to_light = light.position - p;
             let distance = to_light.length();
             let l = to_light / distance;
-            let terms = light_terms(scene.render.shading, material, light.color, n, l, v);
+            // The recorder shows every light's terms; tiles need them only for lights that
+            // are not blocked, so they compute them after the shadow ray (N·L is the same
+            // product `light_terms` forms, so the answer is unchanged).
+            let terms = R::ENABLED
+                .then(|| light_terms(scene.render.shading, material, light.color, n, l, v));
+            let n_dot_l = n.dot(l);
             let mut blocked_by = None;
             let mut blocked_at = None;
-            if terms.n_dot_l > 0.0 {
+            if n_dot_l > 0.0 {
                 // The shadow ray runs from the offset origin to the light's centre; only
                 // objects count as blockers, never lights.
                 let origin = offset_ray_origin(offset, p, error, n, l);
@@ -397,11 +402,14 @@ impl Tracer {
                         .occluded(self.methods(), &shadow_ray, 0.0, length)
                 };
                 if !blocked {
+                    let terms = terms.unwrap_or_else(|| {
+                        light_terms(scene.render.shading, material, light.color, n, l, v)
+                    });
                     diffuse += terms.diffuse;
                     specular += terms.specular;
                 }
             }
-            if R::ENABLED {
+            if let Some(terms) = terms {
                 rec.shadow(&ShadowTest {
                     light: i,
                     to_light: l,

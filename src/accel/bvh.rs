@@ -1,63 +1,64 @@
-//! BVH (the lecture's "Bounding Volume Hierarchy") built with `obvhs`: a compressed wide BVH8
-//! (Ylitie et al. 2017) over spheres and triangles in one tree.
+//! BVH (the lecture's "Bounding Volume Hierarchy"): a 4-wide BVH with `f32` child boxes over
+//! spheres and triangles in one tree, built from a binary BVH made with `obvhs`.
 //!
-//! Build: the steps of `obvhs::cwbvh::builder::build_cwbvh` with preset
-//! [`BvhBuildParams::medium_build`] (PLOC, reinsertion, `bvh2_to_cwbvh` with up to 3
-//! primitives per leaf), done one by one so pathological input can be caught in between; then
-//! the primitive copy is reordered by `primitive_indices` so leaves read it sequentially, each
-//! entry keeping its original id.
+//! Build: `obvhs`' PLOC with the parameters of [`BvhBuildParams::medium_build`], then its
+//! reinsertion optimiser (Meister et al. 2021, Meister & Bittner 2018), then our own collapse
+//! to four children per node: a surface-area cost decides, bottom up, which subtrees of at
+//! most [`MAX_LEAF`] primitives become leaves, and each node of the wide tree takes the two
+//! children of its binary node and keeps opening the largest inner child until it has four
+//! (the way Embree and Wald et al. 2008 collapse). The primitives are then copied in leaf
+//! order, each keeping its original id, so a leaf reads a contiguous run.
+//!
+//! Why not `obvhs`' compressed wide BVH (CWBVH, Ylitie et al. 2017), which this module used
+//! first: its child boxes are quantised to 8 bits, so every node visit decodes 48 bytes to
+//! floats before the slab test (a third of the render's instructions went there), its stock
+//! traversal has the pitfalls listed below, and its build converts with an `O(n·k²)` cost
+//! table. Four `f32` boxes are one SSE slab test of six loads, six subtractions and six
+//! multiplications; the node is 128 bytes (two cache lines) against CWBVH's 80, for
+//! about a third as many nodes as leaves.
 //!
 //! Pathological input (STABILITY B2). PLOC pairs neighbours whose union is cheapest and breaks
 //! equal costs one way, so regular input (many identical boxes, boxes in a row, nested boxes
-//! with one centre) merges only one pair per pass: the tree becomes a chain, the build is
-//! quadratic (16k identical triangles: 9 s) and the BVH8 is deeper than `obvhs`' 32-entry
-//! traversal stack (which then silently drops nodes). We therefore
+//! with one centre) merges only one pair per pass: the tree becomes a chain and the build is
+//! quadratic (16k identical triangles: 9 s). We therefore
 //! - grow every box by a pseudo-random `< 2⁻¹²` of its size ([`jitter`]; still conservative)
 //!   so equal costs become distinct;
 //! - build a balanced median-split tree ourselves ([`median_bvh2`]) when more than
 //!   [`MAX_STACKED`] primitives share one box centre, or when PLOC's tree is deeper than
-//!   [`MAX_BVH2_DEPTH`] anyway.
+//!   [`MAX_BVH2_DEPTH`], or when its wide tree could need more than [`STACK_SIZE`] traversal
+//!   stack entries.
 //!
-//! Traversal is our own loop, a transcription of `obvhs::traverse!` (same node order, same
-//! child/primitive bit masks) with our own node test, because the stock one does not suit a
-//! renderer that must agree exactly with brute force:
-//! - `CwBvhNode::intersect_ray` clamps every box's entry `t` to `obvhs`' absolute `EPSILON =
-//!   1e-4` and ignores `ray.tmin`: boxes that end within `1e-4` of the origin are culled, so
-//!   at scene scales of `1e-3` and below (and for any occluder closer than `1e-4`) the BVH
-//!   misses hits that brute force finds.
-//! - `Ray::new` replaces direction components with `|d| ≤ f32::EPSILON` by `±1/EPSILON`, which
-//!   narrows the slab intervals of nearly axis-parallel rays (not conservative).
-//! - `CwBvh::ray_traverse` accepts a primitive only if `t < tmax` of the best so far, so a
-//!   tie-break by id would need extra state anyway; `ray_traverse_anyhit` is not an occlusion
-//!   query (it calls the closure for every primitive reached and never stops early;
-//!   `ray_traverse_miss` is the one that stops at the first `t < tmax`).
-//! - The fixed traversal stack (`StackStack<_, 32>`) silently overwrites its top entry when
-//!   full; ours is a plain array and the build guarantees the tree fits it.
+//! Traversal, and what it must guarantee (the accelerators agree bit for bit with brute
+//! force): child boxes are padded by a few ulp of their magnitude in every axis
+//! ([`NODE_PAD_REL`]), slab `t` values use `1/d` clamped to `±2⁶⁰` (no NaN), both ends of the
+//! interval are widened by `2γ(3)` of their magnitude (pbrt-v4 widens the far end; the near
+//! end too so that a primitive whose computed `t` is an ulp before its box's computed entry
+//! is not culled), and the interval is clipped to the caller's `(t_min, best t]`, inclusive so
+//! an equal `t` with a lower id is still found. Closest-hit queries visit the hit children
+//! nearest first and keep each pushed child's entry `t`, so a child is skipped when it is
+//! popped behind the best hit found since; occlusion queries push in any order and stop at
+//! the first hit. The stack is a plain array that the build guarantees is deep enough.
 //!
-//! Our node test: child boxes are decoded to world space and padded by a few ulp of the node's
-//! magnitude ([`NODE_PAD_REL`], covering the 8-bit quantisation's rounding), slab `t` values
-//! use `1/d` clamped to `±2⁶⁰` (no NaN), both ends of the interval are widened by `2γ(3)` of
-//! their magnitude (pbrt-v4 widens the far end; the near end too so that a primitive whose
-//! computed `t` is an ulp before its box's computed entry is not culled), and the interval is
-//! clipped to the caller's `(t_min, best t]`, inclusive so equal `t` with a lower id is still
-//! found.
-use glam::{UVec2, Vec3, Vec3A, Vec4, uvec2, vec3a};
+//! Pitfalls of `obvhs`' stock traversals that this avoids (found while this module used them):
+//! `CwBvhNode::intersect_ray` clamps every box's entry `t` to an absolute `1e-4` and ignores
+//! `ray.tmin` (misses at scene scales of `1e-3` and below); `Ray::new` replaces small direction
+//! components by `±1/EPSILON` (not conservative); `ray_traverse` accepts only `t < tmax` (no
+//! tie-break by id); `ray_traverse_anyhit` never stops early; the fixed traversal stack
+//! (`StackStack<_, 32>`) silently overwrites its top entry when full.
+use glam::{Vec3, Vec3A, Vec4};
 use obvhs::{
     BvhBuildParams,
     aabb::Aabb,
     bvh2::{Bvh2, node::Bvh2Node, reinsertion::ReinsertionOptimizer},
-    cwbvh::{
-        CwBvh, bvh2_to_cwbvh::bvh2_to_cwbvh, firstbithigh, node::CwBvhNode, node::extract_byte64,
-    },
     ploc::PlocBuilder,
 };
 
-use super::{Prim, Visitor, box_t_slack};
-use crate::geometry::Ray;
+use super::{Prim, Shape, Visitor, box_t_slack};
+use crate::geometry::{Ray, Triangles4};
 
-/// Padding of decoded child boxes, relative to `|node origin| + node extent` (per axis): the
-/// decode `p + e·q` and the builder's `floor/ceil((b − p)/e)` each round by at most a few ulp
-/// of that magnitude.
+/// Padding of child boxes in every axis, relative to the largest coordinate magnitude of the
+/// box: a primitive's computed hit point is off by a few ulp of its largest coordinate in
+/// *every* axis, even along an axis where the box is flat (a plane at z = 0).
 pub const NODE_PAD_REL: f32 = 8.0 * f32::EPSILON;
 
 /// More primitives than this with exactly the same box centre (duplicates, concentric spheres)
@@ -65,22 +66,64 @@ pub const NODE_PAD_REL: f32 = 8.0 * f32::EPSILON;
 pub const MAX_STACKED: usize = 64;
 
 /// A binary tree deeper than this is replaced by the median-split one. Real scenes stay far
-/// below (PLOC gives about `1.5·log2(N)`: 24 for 1e5 random boxes); the conversion to BVH8
-/// recurses this deep, and the BVH8 (depth about a third of it) must fit [`STACK_SIZE`].
+/// below (PLOC gives about `1.5·log2(N)`: 24 for 1e5 random boxes).
 pub const MAX_BVH2_DEPTH: usize = 96;
 
-/// Traversal stack capacity: at least the BVH8's depth, which the build guarantees.
-const STACK_SIZE: usize = 64;
+/// Traversal stack capacity in entries. The build checks the worst case of the tree (on any
+/// root-to-leaf path, the sum of each node's children but one) against it; the median-split
+/// tree of up to 2²⁸ primitives needs at most 3 per level for about 13 levels.
+pub const STACK_SIZE: usize = 64;
+
+/// Most triangles in one leaf: one four-lane test. A leaf holds triangles or one sphere.
+pub const MAX_LEAF: usize = 4;
+
+/// Costs of a visit relative to each other, for the surface-area leaf decision: a node (four
+/// box tests), a leaf of up to four triangles (one four-lane test), a sphere.
+const NODE_COST: f32 = 1.0;
+const PACKET_COST: f32 = 1.5;
+const SPHERE_COST: f32 = 1.0;
+
+/// A child word with this bit is a leaf, otherwise a node index. A triangle leaf is
+/// `LEAF | packet << 2 | (count − 1)`, a sphere leaf `LEAF | SPHERE | index`.
+const LEAF: u32 = 0x8000_0000;
+const SPHERE: u32 = 0x4000_0000;
+
+/// Most primitives the leaf words can address (2²⁸ packets of up to four triangles).
+pub const MAX_PRIMS: usize = 1 << 28;
+
+/// Up to four triangles of a leaf, one per lane, and their primitive ids.
+#[derive(Clone, Copy, Debug)]
+struct Packet {
+    tris: Triangles4,
+    ids: [u32; 4],
+}
+
+/// One node of the 4-wide tree: two cache lines.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct Node {
+    /// Child boxes by plane, one lane per child: min x, max x, min y, max y, min z, max z.
+    /// Padded by [`NODE_PAD_REL`]; empty slots hold zeros and are masked by `valid`.
+    planes: [Vec4; 6],
+    /// Child words (see [`LEAF`]).
+    child: [u32; 4],
+    /// Bit `i` set when slot `i` holds a child.
+    valid: u32,
+}
 
 pub(super) struct Bvh {
-    cw: CwBvh,
-    /// Primitives in `cw.primitive_indices` order.
-    prims: Vec<Prim>,
+    nodes: Vec<Node>,
+    /// Triangle leaves, in tree order.
+    packets: Vec<Packet>,
+    /// Sphere leaves.
+    spheres: Vec<Prim>,
     depth: usize,
 }
 
 impl Bvh {
     pub(super) fn build(prims: Vec<Prim>) -> Bvh {
+        // `Accel` refuses to build this far (see there); ids would not fit a leaf word.
+        assert!(prims.len() <= MAX_PRIMS, "more than 2^28 primitives");
         let boxes: Vec<Aabb> = prims
             .iter()
             .map(|p| {
@@ -89,8 +132,7 @@ impl Bvh {
             })
             .collect();
         let params = BvhBuildParams::medium_build();
-        let max_leaf = params.max_prims_per_leaf.clamp(1, 3);
-        let mut cw = None;
+        let mut built = None;
         if max_stacked(&boxes) <= MAX_STACKED {
             let jittered: Vec<Aabb> = boxes
                 .iter()
@@ -106,212 +148,337 @@ impl Bvh {
             );
             ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
             if bvh2_depth(&bvh2) <= MAX_BVH2_DEPTH {
-                let tree = bvh2_to_cwbvh(&bvh2, max_leaf, true, false);
-                if tree_depth(&tree) < STACK_SIZE {
-                    cw = Some(tree);
-                }
+                built = collapse(&bvh2, &prims).filter(|b| stack_need(&b.nodes) <= STACK_SIZE);
             }
         }
-        let cw = cw.unwrap_or_else(|| bvh2_to_cwbvh(&median_bvh2(&boxes), max_leaf, true, false));
-        let depth = tree_depth(&cw);
-        // A balanced binary tree of 2³² leaves has depth 33, its BVH8 far less.
-        debug_assert!(depth < STACK_SIZE);
-        let ordered = cw
-            .primitive_indices
-            .iter()
-            .map(|&i| prims[i as usize])
-            .collect();
-        Bvh {
-            cw,
-            prims: ordered,
-            depth,
-        }
+        let bvh = built.unwrap_or_else(|| {
+            let b = collapse(&median_bvh2(&boxes), &prims).unwrap_or_else(|| Bvh {
+                nodes: Vec::new(),
+                packets: Vec::new(),
+                spheres: Vec::new(),
+                depth: 0,
+            });
+            // A balanced binary tree of 2²⁸ leaves has depth 29; its 4-wide collapse needs
+            // fewer than 3·15 stack entries.
+            debug_assert!(stack_need(&b.nodes) <= STACK_SIZE);
+            b
+        });
+        bvh
     }
 
     pub(super) fn memory_bytes(&self) -> usize {
-        self.cw.nodes.capacity() * size_of::<CwBvhNode>()
-            + self.cw.primitive_indices.capacity() * 4
-            + self.prims.capacity() * size_of::<Prim>()
+        self.nodes.capacity() * size_of::<Node>()
+            + self.packets.capacity() * size_of::<Packet>()
+            + self.spheres.capacity() * size_of::<Prim>()
     }
 
     pub(super) fn depth(&self) -> usize {
         self.depth
     }
 
-    /// `obvhs::traverse!`, transcribed, with [`intersect_node`] as the node test.
+    /// Visits every primitive whose padded box the ray's `(t_min, v.limit()]` interval meets;
+    /// nearest child first when [`Visitor::ORDERED`].
+    #[inline]
     pub(super) fn walk<V: Visitor>(&self, ray: &Ray, t_min: f32, v: &mut V) {
-        if self.cw.nodes.is_empty() {
+        if self.nodes.is_empty() {
             return;
         }
-        let r = TravRay {
-            origin: ray.origin.into(),
-            inv: trav_inv(ray.dir),
-            oct_inv4: octant_inv4(ray.dir.into()),
-            t_min,
-        };
-        let mut stack = [UVec2::ZERO; STACK_SIZE];
+        let inv = trav_inv(ray.dir);
+        let o = ray.origin;
+        let (ox, oy, oz) = (Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z));
+        let (ix, iy, iz) = (Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z));
+        // For a negative direction the max plane is entered first.
+        let near = |i: f32, axis: usize| 2 * axis + usize::from(i < 0.0);
+        let (nx, ny, nz) = (near(inv.x, 0), near(inv.y, 1), near(inv.z, 2));
+        let (fx, fy, fz) = (nx ^ 1, ny ^ 1, nz ^ 1);
+        let slack = Vec4::splat(box_t_slack());
+        let t_min4 = Vec4::splat(t_min);
+
+        let mut stack = [(0u32, 0f32); STACK_SIZE];
         let mut sp = 0usize;
-        let mut current_group = uvec2(0, 0x8000_0000);
-        let mut primitive_group = UVec2::ZERO;
+        let mut word = 0u32;
         loop {
-            while primitive_group.y != 0 {
-                let local = firstbithigh(primitive_group.y);
-                primitive_group.y &= !(1u32 << local);
-                let index = (primitive_group.x + local) as usize;
-                if v.visit(&self.prims[index]) {
+            if word & LEAF != 0 {
+                let stop = if word & SPHERE != 0 {
+                    v.visit(&self.spheres[(word & !(LEAF | SPHERE)) as usize])
+                } else {
+                    let packet = &self.packets[((word & !LEAF) >> 2) as usize];
+                    v.visit_triangles(&packet.tris, &packet.ids, (word & 3) as usize + 1)
+                };
+                if stop {
                     return;
                 }
-            }
-            if current_group.y & 0xff00_0000 != 0 {
-                let hits_imask = current_group.y;
-                let child_index_offset = firstbithigh(hits_imask);
-                let child_index_base = current_group.x;
-                current_group.y &= !(1u32 << child_index_offset);
-                if current_group.y & 0xff00_0000 != 0 {
-                    stack[sp] = current_group;
-                    sp += 1;
-                }
-                let slot_index = (child_index_offset - 24) ^ (r.oct_inv4 & 0xff);
-                let relative_index = (hits_imask & !(0xffff_ffffu32 << slot_index)).count_ones();
-                let node = &self.cw.nodes[(child_index_base + relative_index) as usize];
-                let hitmask = intersect_node(node, &r, v.limit());
-                current_group = uvec2(
-                    node.child_base_idx,
-                    (hitmask & 0xff00_0000) | node.imask as u32,
-                );
-                primitive_group = uvec2(node.primitive_base_idx, hitmask & 0x00ff_ffff);
             } else {
-                current_group = UVec2::ZERO;
+                let node = &self.nodes[word as usize];
+                let p = &node.planes;
+                let t_near = ((p[nx] - ox) * ix)
+                    .max((p[ny] - oy) * iy)
+                    .max((p[nz] - oz) * iz);
+                let t_far = ((p[fx] - ox) * ix)
+                    .min((p[fy] - oy) * iy)
+                    .min((p[fz] - oz) * iz);
+                // Widen both ends by the rounding of the slab arithmetic *and* of the
+                // primitives' own t: a tie (equal t, lower id) in a flat box must not be
+                // culled by an ulp.
+                let t_near = (t_near - t_near.abs() * slack).max(t_min4);
+                let t_far = (t_far + t_far.abs() * slack).min(Vec4::splat(v.limit()));
+                let mut mask = t_near.cmple(t_far).bitmask() & node.valid;
+                if mask != 0 {
+                    if mask & (mask - 1) == 0 {
+                        word = node.child[mask.trailing_zeros() as usize];
+                        continue;
+                    }
+                    let t = t_near.to_array();
+                    if V::ORDERED {
+                        // Up to four hits, sorted farthest first; all but the nearest are
+                        // pushed with their entry t.
+                        let mut hits = [(0u32, 0f32); 4];
+                        let mut k = 0;
+                        while mask != 0 {
+                            let i = mask.trailing_zeros() as usize;
+                            mask &= mask - 1;
+                            let mut j = k;
+                            while j > 0 && hits[j - 1].1 < t[i] {
+                                hits[j] = hits[j - 1];
+                                j -= 1;
+                            }
+                            hits[j] = (node.child[i], t[i]);
+                            k += 1;
+                        }
+                        stack[sp..sp + k - 1].copy_from_slice(&hits[..k - 1]);
+                        sp += k - 1;
+                        word = hits[k - 1].0;
+                    } else {
+                        let i = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        word = node.child[i];
+                        while mask != 0 {
+                            let j = mask.trailing_zeros() as usize;
+                            mask &= mask - 1;
+                            stack[sp] = (node.child[j], t[j]);
+                            sp += 1;
+                        }
+                    }
+                    continue;
+                }
             }
-            if primitive_group.y == 0 && current_group.y & 0xff00_0000 == 0 {
+            // Pop the next child whose entry is not behind the best hit found since.
+            loop {
                 if sp == 0 {
                     return;
                 }
                 sp -= 1;
-                current_group = stack[sp];
+                let (w, t) = stack[sp];
+                if t <= v.limit() {
+                    word = w;
+                    break;
+                }
             }
         }
     }
 }
 
-struct TravRay {
-    origin: Vec3A,
-    /// `1/d`, clamped to `±2⁶⁰` (zero components keep their sign): the node test multiplies it
-    /// by extents and box offsets, and the clamp keeps those products finite for any scene
-    /// below about `1e17` in size, so no `0·∞` NaN can appear. Treating `|d| < 2⁻⁶⁰` as `2⁻⁶⁰`
-    /// is harmless: child boxes are padded, so an origin on an unpadded face is strictly inside.
-    inv: Vec3A,
-    oct_inv4: u32,
-    t_min: f32,
+/// `1/d`, clamped to `±2⁶⁰` (zero components keep their sign): the node test multiplies it by
+/// box offsets, and the clamp keeps those products finite for any scene below about `1e17` in
+/// size, so no `0·∞` NaN can appear. Treating `|d| < 2⁻⁶⁰` as `2⁻⁶⁰` is harmless: child boxes
+/// are padded, so an origin on an unpadded face is strictly inside.
+#[inline(always)]
+fn trav_inv(d: Vec3) -> Vec3A {
+    let d = Vec3A::from(d);
+    let i = Vec3A::ONE / d;
+    let clamp = Vec3A::splat(INV_DIR_CLAMP);
+    Vec3A::select(i.abs().cmplt(clamp), i, clamp.copysign(d))
 }
 
-/// Bound of `|1/d|` in [`TravRay::inv`].
+/// Bound of `|1/d|` in [`trav_inv`].
 const INV_DIR_CLAMP: f32 = (1u64 << 60) as f32;
 
-fn trav_inv(d: Vec3) -> Vec3A {
-    let f = |x: f32| {
-        let i = 1.0 / x;
-        if i.abs() < INV_DIR_CLAMP {
-            i
+/// The box of a binary node, padded by [`NODE_PAD_REL`] of its largest magnitude.
+fn padded(b: &Aabb) -> (Vec3A, Vec3A) {
+    let magnitude = b.min.abs().max(b.max.abs()).max_element();
+    let pad = Vec3A::splat((magnitude * NODE_PAD_REL).max(f32::MIN_POSITIVE));
+    (b.min - pad, b.max + pad)
+}
+
+/// The 4-wide tree of a binary BVH whose leaves hold one primitive each (PLOC's and
+/// [`median_bvh2`]'s do); `None` for an empty tree.
+fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
+    if bvh2.nodes.is_empty() {
+        return None;
+    }
+    let n = bvh2.nodes.len();
+    // Pre-order, so that reversed it is bottom-up.
+    let mut order = Vec::with_capacity(n);
+    let mut todo = vec![0usize];
+    while let Some(i) = todo.pop() {
+        order.push(i);
+        let node = &bvh2.nodes[i];
+        if node.prim_count == 0 {
+            todo.push(node.first_index as usize);
+            todo.push(node.first_index as usize + 1);
+        }
+    }
+    // Bottom up: primitives under each node and the surface-area cost of its best subtree;
+    // `leaf[i]` when the node's subtree is cheaper as one leaf.
+    let is_sphere = |i: usize| matches!(prims[i].shape, Shape::Sphere { .. });
+    let mut count = vec![0u32; n];
+    let mut spheres = vec![0u32; n];
+    let mut cost = vec![0f32; n];
+    let mut leaf = vec![false; n];
+    for &i in order.iter().rev() {
+        let node = &bvh2.nodes[i];
+        let area = node.aabb.half_area().max(0.0);
+        if node.prim_count > 0 {
+            assert!(node.prim_count == 1, "binary leaves hold one primitive");
+            let sphere = is_sphere(bvh2.primitive_indices[node.first_index as usize] as usize);
+            count[i] = 1;
+            spheres[i] = u32::from(sphere);
+            cost[i] = if sphere { SPHERE_COST } else { PACKET_COST } * area;
+            leaf[i] = true;
         } else {
-            INV_DIR_CLAMP.copysign(x)
-        }
-    };
-    vec3a(f(d.x), f(d.y), f(d.z))
-}
-
-/// `obvhs`' private `ray_get_octant_inv4`: which child order to use for this direction.
-#[inline(always)]
-fn octant_inv4(dir: Vec3A) -> u32 {
-    (if dir.x < 0.0 { 0 } else { 0x0404_0404 })
-        | (if dir.y < 0.0 { 0 } else { 0x0202_0202 })
-        | (if dir.z < 0.0 { 0 } else { 0x0101_0101 })
-}
-
-#[inline(always)]
-fn quad(q: &[u8; 8], half: usize) -> Vec4 {
-    let i = 4 * half;
-    Vec4::new(
-        q[i] as f32,
-        q[i + 1] as f32,
-        q[i + 2] as f32,
-        q[i + 3] as f32,
-    )
-}
-
-/// Conservative ray/child-box test of one CWBVH node, four children at a time (glam's `Vec4`
-/// is SSE on x86); returns `obvhs`' hit mask layout (internal children in the top byte, leaf
-/// primitives in the low 24 bits).
-///
-/// Per axis the slab `t` of a child face `p ± pad + e·q` is `q·(e/d) + (p ± pad − o)/d`; the
-/// rounding of this form is a few ulp of `|p − o| + 255·e` (in distance), covered by the pad
-/// (`|p| + 256·e` part) and the `2γ(3)` widening of both ends of the interval (the `|o|`
-/// part, and the relative error of the primitives' own `t`).
-#[inline(always)]
-fn intersect_node(node: &CwBvhNode, r: &TravRay, t_max: f32) -> u32 {
-    let e = node.compute_extent();
-    let p = Vec3A::from(node.p);
-    // Isotropic: a primitive's computed hit point is off by a few ulp of its largest
-    // coordinate in *every* axis, even along an axis where the box is flat (a plane at z = 0).
-    let pad = Vec3A::splat((p.abs() + e * 256.0).max_element() * NODE_PAD_REL);
-    let scale = e * r.inv;
-    let base_lo = (p - pad - r.origin) * r.inv;
-    let base_hi = (p + pad - r.origin) * r.inv;
-    let slack = box_t_slack();
-    let (child_bits8, bit_index8) = node.get_child_and_index_bits(r.oct_inv4);
-    let mut hit_mask = 0;
-    for half in 0..2 {
-        let mut t_near = Vec4::splat(f32::NEG_INFINITY);
-        let mut t_far = Vec4::splat(f32::INFINITY);
-        let axes = [
-            (&node.child_min_x, &node.child_max_x),
-            (&node.child_min_y, &node.child_max_y),
-            (&node.child_min_z, &node.child_max_z),
-        ];
-        for (axis, (q_min, q_max)) in axes.into_iter().enumerate() {
-            let lo = quad(q_min, half) * scale[axis] + Vec4::splat(base_lo[axis]);
-            let hi = quad(q_max, half) * scale[axis] + Vec4::splat(base_hi[axis]);
-            // For a negative direction the max face is entered first.
-            let (near, far) = if r.inv[axis] >= 0.0 {
-                (lo, hi)
+            let (l, r) = (node.first_index as usize, node.first_index as usize + 1);
+            count[i] = count[l] + count[r];
+            spheres[i] = spheres[l] + spheres[r];
+            let split = NODE_COST * area + cost[l] + cost[r];
+            let as_leaf = PACKET_COST * area;
+            if spheres[i] == 0 && count[i] as usize <= MAX_LEAF && as_leaf <= split {
+                cost[i] = as_leaf;
+                leaf[i] = true;
             } else {
-                (hi, lo)
-            };
-            t_near = t_near.max(near);
-            t_far = t_far.min(far);
-        }
-        // Widen both ends by the rounding of the slab arithmetic *and* of the primitives' own
-        // t: a tie (equal t, lower id) in a flat box must not be culled by an ulp.
-        let t_near = (t_near - t_near.abs() * slack).max(Vec4::splat(r.t_min));
-        let t_far = (t_far + t_far.abs() * slack).min(Vec4::splat(t_max));
-        let mask = t_near.cmple(t_far).bitmask();
-        for j in 0..4 {
-            if mask & (1 << j) != 0 {
-                let child = 4 * half + j;
-                hit_mask |= extract_byte64(child_bits8, child) << extract_byte64(bit_index8, child);
+                cost[i] = split;
             }
         }
     }
-    hit_mask
+
+    let mut nodes: Vec<Node> = Vec::new();
+    let mut packets: Vec<Packet> = Vec::new();
+    let mut sphere_leaves: Vec<Prim> = Vec::new();
+    let mut leaf_tris: Vec<[Vec3; 3]> = Vec::with_capacity(MAX_LEAF);
+    let mut leaf_ids = [0u32; 4];
+    let mut depth = 0;
+    // (binary node, wide node to fill, its depth); the root's slots are the root's children,
+    // or the root itself when it is a leaf.
+    let mut todo = vec![(0usize, 0u32, 1usize)];
+    nodes.push(empty_node());
+    let mut under = Vec::new();
+    while let Some((b, w, d)) = todo.pop() {
+        depth = depth.max(d);
+        // (binary node, how many times opened); a tie in area opens the shallower child, so
+        // equal boxes (a median-split tree of duplicates) collapse evenly.
+        let mut slots: Vec<(usize, u32)> = if leaf[b] {
+            vec![(b, 0)]
+        } else {
+            let f = bvh2.nodes[b].first_index as usize;
+            vec![(f, 0), (f + 1, 0)]
+        };
+        // Open the largest inner child until there are four.
+        while slots.len() < 4 {
+            let area = |s: usize| bvh2.nodes[s].aabb.half_area();
+            let best = slots
+                .iter()
+                .enumerate()
+                .filter(|&(_, &(s, _))| !leaf[s])
+                .max_by(|(i, (a, la)), (j, (b, lb))| {
+                    area(*a)
+                        .total_cmp(&area(*b))
+                        .then(lb.cmp(la))
+                        .then(j.cmp(i))
+                })
+                .map(|(k, _)| k);
+            let Some(k) = best else { break };
+            let (s, level) = slots[k];
+            let f = bvh2.nodes[s].first_index as usize;
+            slots[k] = (f, level + 1);
+            slots.insert(k + 1, (f + 1, level + 1));
+        }
+        let mut node = empty_node();
+        for (slot, &(s, _)) in slots.iter().enumerate() {
+            let (lo, hi) = padded(&bvh2.nodes[s].aabb);
+            for (axis, (l, h)) in [(lo.x, hi.x), (lo.y, hi.y), (lo.z, hi.z)]
+                .into_iter()
+                .enumerate()
+            {
+                node.planes[2 * axis][slot] = l;
+                node.planes[2 * axis + 1][slot] = h;
+            }
+            node.valid |= 1 << slot;
+            if leaf[s] && spheres[s] == 1 {
+                let id = bvh2.primitive_indices[bvh2.nodes[s].first_index as usize] as usize;
+                node.child[slot] = LEAF | SPHERE | sphere_leaves.len() as u32;
+                sphere_leaves.push(prims[id]);
+            } else if leaf[s] {
+                // The subtree's triangles, left to right, as one packet.
+                leaf_tris.clear();
+                under.clear();
+                under.push(s);
+                while let Some(u) = under.pop() {
+                    let un = &bvh2.nodes[u];
+                    if un.prim_count > 0 {
+                        let id = bvh2.primitive_indices[un.first_index as usize] as usize;
+                        if let Shape::Triangle(v) = prims[id].shape {
+                            leaf_ids[leaf_tris.len()] = prims[id].id;
+                            leaf_tris.push(v);
+                        }
+                    } else {
+                        under.push(un.first_index as usize + 1);
+                        under.push(un.first_index as usize);
+                    }
+                }
+                let c = leaf_tris.len();
+                for k in c..4 {
+                    leaf_ids[k] = leaf_ids[0];
+                }
+                node.child[slot] = LEAF | ((packets.len() as u32) << 2) | (c as u32 - 1);
+                packets.push(Packet {
+                    tris: Triangles4::new(&leaf_tris),
+                    ids: leaf_ids,
+                });
+            } else {
+                let index = nodes.len() as u32;
+                nodes.push(empty_node());
+                node.child[slot] = index;
+                todo.push((s, index, d + 1));
+            }
+        }
+        nodes[w as usize] = node;
+    }
+    nodes.shrink_to_fit();
+    packets.shrink_to_fit();
+    Some(Bvh {
+        nodes,
+        packets,
+        spheres: sphere_leaves,
+        depth,
+    })
 }
 
-/// Depth of the CWBVH (root = 1): the most stack entries a traversal can need.
-fn tree_depth(cw: &CwBvh) -> usize {
-    if cw.nodes.is_empty() {
+fn empty_node() -> Node {
+    Node {
+        planes: [Vec4::ZERO; 6],
+        child: [0; 4],
+        valid: 0,
+    }
+}
+
+/// The most stack entries a traversal of `nodes` can need: on the worst root-to-leaf path,
+/// each node pushes all its children but one.
+fn stack_need(nodes: &[Node]) -> usize {
+    if nodes.is_empty() {
         return 0;
     }
-    let mut max = 0;
-    let mut todo = vec![(0u32, 1usize)];
-    while let Some((i, d)) = todo.pop() {
-        max = max.max(d);
-        let node = &cw.nodes[i as usize];
-        for child in 0..8 {
-            if !node.is_leaf(child) && !node.is_child_empty(child) {
-                todo.push((node.child_node_index(child), d + 1));
+    let mut worst = 0;
+    let mut todo = vec![(0u32, 0usize)];
+    while let Some((i, above)) = todo.pop() {
+        let node = &nodes[i as usize];
+        let here = above + (node.valid.count_ones() as usize).saturating_sub(1);
+        worst = worst.max(here);
+        for slot in 0..4 {
+            if node.valid & (1 << slot) != 0 && node.child[slot] & LEAF == 0 {
+                todo.push((node.child[slot], here));
             }
         }
     }
-    max
+    worst
 }
 
 /// Depth of a binary BVH (root = 1), iteratively.

@@ -26,7 +26,10 @@ mod grid;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::{Methods, Ray, intersect_sphere, intersect_triangle, next_float_up};
+use crate::geometry::{
+    Methods, Ray, Shear, TriangleMethod, Triangles4, intersect_sphere, intersect_triangle,
+    intersect_triangles4, next_float_up,
+};
 
 /// Which accelerator to build. `Auto` picks from the scene's size.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
@@ -107,17 +110,27 @@ struct Prim {
 }
 
 impl Prim {
-    /// The shared intersection call: `(t, b1, b2)` (barycentrics are 0 for spheres).
+    /// The shared intersection call: `(t, b1, b2)` (barycentrics are 0 for spheres). `shear`
+    /// is the ray's [`Shear`], computed once per query (the watertight method's per-ray part).
     #[inline(always)]
-    fn intersect(&self, m: &Methods, ray: &Ray, t_min: f32, t_max: f32) -> Option<(f32, f32, f32)> {
+    fn intersect(
+        &self,
+        m: &Methods,
+        ray: &Ray,
+        shear: &Option<Shear>,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<(f32, f32, f32)> {
         match &self.shape {
             Shape::Sphere { center, radius } => {
                 intersect_sphere(m.sphere, *center, *radius, ray, t_min, t_max)
                     .map(|t| (t, 0.0, 0.0))
             }
-            Shape::Triangle(v) => {
-                intersect_triangle(m.triangle, v, ray, t_min, t_max).map(|h| (h.t, h.b1, h.b2))
+            Shape::Triangle(v) => match m.triangle {
+                TriangleMethod::Watertight => shear.as_ref()?.intersect(v, ray, t_min, t_max),
+                method => intersect_triangle(method, v, ray, t_min, t_max),
             }
+            .map(|h| (h.t, h.b1, h.b2)),
         }
     }
 
@@ -136,16 +149,23 @@ impl Prim {
 
 /// What a traversal does with each primitive it reaches; generic so the loops monomorphise.
 trait Visitor {
+    /// Whether the BVH should visit nearer children first (closest hit) or may take any
+    /// order (occlusion).
+    const ORDERED: bool = true;
     /// The farthest `t` still of interest (boxes and cells entered beyond it are skipped).
     fn limit(&self) -> f32;
     /// Test one primitive; `true` stops the traversal.
     fn visit(&mut self, prim: &Prim) -> bool;
+    /// Test the triangles in lanes `0..count` of `tris` (ids `ids`), in lane order, with one
+    /// four-lane test; the same answer as visiting them one by one. `true` stops.
+    fn visit_triangles(&mut self, tris: &Triangles4, ids: &[u32; 4], count: usize) -> bool;
 }
 
 /// Closest hit with the id tie-break.
 struct Closest<'a> {
     m: &'a Methods,
     ray: &'a Ray,
+    shear: Option<Shear>,
     t_min: f32,
     t: f32,
     prim: u32,
@@ -158,6 +178,7 @@ impl<'a> Closest<'a> {
         Self {
             m,
             ray,
+            shear: Shear::new(ray.dir),
             t_min,
             t: t_max,
             prim: u32::MAX,
@@ -191,7 +212,7 @@ impl Visitor for Closest<'_> {
         } else {
             next_float_up(self.t)
         };
-        if let Some((t, b1, b2)) = prim.intersect(self.m, self.ray, self.t_min, limit)
+        if let Some((t, b1, b2)) = prim.intersect(self.m, self.ray, &self.shear, self.t_min, limit)
             && (t < self.t || (t == self.t && prim.id < self.prim))
         {
             self.t = t;
@@ -201,18 +222,57 @@ impl Visitor for Closest<'_> {
         }
         false
     }
+
+    #[inline(always)]
+    fn visit_triangles(&mut self, tris: &Triangles4, ids: &[u32; 4], count: usize) -> bool {
+        let limit = |s: &Self| {
+            if s.prim == u32::MAX {
+                s.t
+            } else {
+                next_float_up(s.t)
+            }
+        };
+        // Each lane's t does not depend on the limit, and the limit only shrinks from lane to
+        // lane, so testing all lanes against the first limit and then re-checking each
+        // candidate against the current one in lane order is what `visit` one by one does.
+        let hits = intersect_triangles4(
+            self.m.triangle,
+            self.shear.as_ref(),
+            tris,
+            count,
+            self.ray,
+            self.t_min,
+            limit(self),
+        );
+        let mut mask = hits.mask;
+        while mask != 0 {
+            let lane = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let (t, id) = (hits.t[lane], ids[lane]);
+            if t < limit(self) && (t < self.t || (t == self.t && id < self.prim)) {
+                self.t = t;
+                self.prim = id;
+                self.b1 = hits.b1[lane];
+                self.b2 = hits.b2[lane];
+            }
+        }
+        false
+    }
 }
 
 /// Any hit in `(t_min, t_max)`: stops at the first.
 struct AnyHit<'a> {
     m: &'a Methods,
     ray: &'a Ray,
+    shear: Option<Shear>,
     t_min: f32,
     t_max: f32,
     hit: bool,
 }
 
 impl Visitor for AnyHit<'_> {
+    const ORDERED: bool = false;
+
     #[inline(always)]
     fn limit(&self) -> f32 {
         self.t_max
@@ -221,8 +281,23 @@ impl Visitor for AnyHit<'_> {
     #[inline(always)]
     fn visit(&mut self, prim: &Prim) -> bool {
         self.hit = prim
-            .intersect(self.m, self.ray, self.t_min, self.t_max)
+            .intersect(self.m, self.ray, &self.shear, self.t_min, self.t_max)
             .is_some();
+        self.hit
+    }
+
+    #[inline(always)]
+    fn visit_triangles(&mut self, tris: &Triangles4, _ids: &[u32; 4], count: usize) -> bool {
+        let hits = intersect_triangles4(
+            self.m.triangle,
+            self.shear.as_ref(),
+            tris,
+            count,
+            self.ray,
+            self.t_min,
+            self.t_max,
+        );
+        self.hit = hits.mask != 0;
         self.hit
     }
 }
@@ -357,6 +432,7 @@ impl Accel {
         let mut v = AnyHit {
             m,
             ray,
+            shear: Shear::new(ray.dir),
             t_min,
             t_max,
             hit: false,

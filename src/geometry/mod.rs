@@ -11,7 +11,10 @@ use serde::{Deserialize, Serialize};
 
 pub use offset::{OffsetMethod, offset_ray_origin};
 pub use sphere::{SphereMethod, intersect_sphere, sphere_hit_point};
-pub use triangle::{TriHit, TriangleMethod, intersect_triangle, triangle_hit_point};
+pub use triangle::{
+    Shear, TriHit, TriHits4, TriangleMethod, Triangles4, intersect_triangle, intersect_triangles4,
+    triangle_hit_point,
+};
 
 /// `P = origin + s·dir`, `dir` unit length, `s ≥ 0` (lecture: "Ray equation").
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -40,6 +43,7 @@ pub struct Methods {
 
 /// `γ(n) = n·u / (1 − n·u)` with `u` the f32 unit roundoff: bounds the relative error of `n`
 /// chained f32 operations (pbrt-v4, "Floating-point arithmetic").
+#[inline]
 pub fn gamma(n: u32) -> f32 {
     let u = f32::EPSILON * 0.5;
     let nu = n as f32 * u;
@@ -48,6 +52,7 @@ pub fn gamma(n: u32) -> f32 {
 
 /// The next representable `f32` above `v` (pbrt-v4 `NextFloatUp`): `+∞` and NaN stay put, `−0`
 /// counts as `+0`, so the result is always strictly greater for finite input.
+#[inline]
 pub fn next_float_up(v: f32) -> f32 {
     if v.is_nan() || v == f32::INFINITY {
         return v;
@@ -61,6 +66,7 @@ pub fn next_float_up(v: f32) -> f32 {
 
 /// The next representable `f32` below `v` (pbrt-v4 `NextFloatDown`): `−∞` and NaN stay put,
 /// `+0` counts as `−0`, so the result is always strictly smaller for finite input.
+#[inline]
 pub fn next_float_down(v: f32) -> f32 {
     if v.is_nan() || v == f32::NEG_INFINITY {
         return v;

@@ -32,6 +32,7 @@ pub enum SphereMethod {
 /// The near root is taken when it lies above `t_min`; otherwise the far root (the ray starts
 /// inside the sphere, e.g. after refraction). The result never depends on `t_max` other than
 /// through the final range check, so accelerators that shrink `t_max` see the same `t`.
+#[inline]
 pub fn intersect_sphere(
     method: SphereMethod,
     center: Vec3,
@@ -111,6 +112,7 @@ fn pick_root(t0: f32, t1: f32, t_min: f32, t_max: f32) -> Option<f32> {
 ///   `C + r·(P − C)/|P − C|` (pbrt-v4; evaluated in `f64`, rounded once), with pbrt's error
 ///   bound `γ(5)·|P − C| + γ(1)·|P|` per axis (the re-projection plus the rounding of adding
 ///   `C`), which is conservative for the `f64` evaluation.
+#[inline]
 pub fn sphere_hit_point(
     method: SphereMethod,
     center: Vec3,

@@ -6,6 +6,7 @@
 pub mod builtin;
 pub mod load;
 pub mod obj;
+pub mod procedural;
 pub mod save;
 
 use std::path::PathBuf;

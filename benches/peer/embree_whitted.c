@@ -1,0 +1,509 @@
+/* embree_whitted.c: the peer of raytree's issue-7 benchmark. A Whitted ray tracer over
+ * Embree 3 (single rays: rtcIntersect1 for camera, reflected and refracted rays, rtcOccluded1
+ * for shadow rays) that renders the scene `benches/peer.rs` hands it with the same camera,
+ * materials, recursion and ray-origin offsets as raytree's `src/trace.rs`, on N pthreads over
+ * 32x32 tiles taken from an atomic counter.
+ *
+ * Usage: embree_whitted SCENE.bin THREADS [IMAGE.f32]
+ * Prints `key value` lines (load/build/render seconds, rays by kind, Mrays/s, memory); writes
+ * the linear RGB image as raw little-endian f32 when IMAGE is given.
+ *
+ * Spheres are analytic in both renderers: here an Embree user geometry whose intersection is
+ * raytree's robust (Ray Tracing Gems ch. 7) root pair, because Embree's built-in sphere points
+ * solve the quadratic with the cancellation-prone formula and let offset rays re-hit the
+ * sphere they leave. Triangles use Embree's own triangle intersector and BVH (default build
+ * quality), which is the point of the comparison.
+ *
+ * Build: cc -O2 -ffp-contract=off embree_whitted.c -lembree3 -lpthread -lm */
+#include <embree3/rtcore.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+typedef struct { float x, y, z; } vec3;
+
+static inline vec3 v3(float x, float y, float z) { vec3 r = {x, y, z}; return r; }
+static inline vec3 add(vec3 a, vec3 b) { return v3(a.x + b.x, a.y + b.y, a.z + b.z); }
+static inline vec3 sub(vec3 a, vec3 b) { return v3(a.x - b.x, a.y - b.y, a.z - b.z); }
+static inline vec3 mul(vec3 a, vec3 b) { return v3(a.x * b.x, a.y * b.y, a.z * b.z); }
+static inline vec3 scale(float s, vec3 a) { return v3(s * a.x, s * a.y, s * a.z); }
+static inline vec3 neg(vec3 a) { return v3(-a.x, -a.y, -a.z); }
+static inline vec3 vabs(vec3 a) { return v3(fabsf(a.x), fabsf(a.y), fabsf(a.z)); }
+static inline float dot(vec3 a, vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline vec3 cross(vec3 a, vec3 b) {
+    return v3(a.y * b.z - b.y * a.z, a.z * b.x - b.z * a.x, a.x * b.y - b.x * a.y);
+}
+static inline float length(vec3 a) { return sqrtf(dot(a, a)); }
+/* As glam: multiply by the reciprocal of the length. */
+static inline vec3 normalize(vec3 a) { return scale(1.0f / length(a), a); }
+static inline vec3 normalize_or_zero(vec3 a) {
+    float r = 1.0f / length(a);
+    return (isfinite(r) && r > 0.0f) ? scale(r, a) : v3(0, 0, 0);
+}
+static inline int is_zero(vec3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
+static inline float comp(vec3 a, int i) { return i == 0 ? a.x : (i == 1 ? a.y : a.z); }
+
+/* pbrt's gamma(n) in f32, as raytree's geometry::gamma. */
+static float gamma_f(int n) {
+    float nu = (float)n * (0x1p-23f * 0.5f);
+    return nu / (1.0f - nu);
+}
+
+/* ---- scene, as written by benches/peer.rs ---- */
+typedef struct {
+    vec3 ambient, diffuse, specular;
+    float shininess;
+    vec3 reflectivity, transparency;
+    float ior;
+} Material;
+typedef struct { vec3 position, color; } Light;
+typedef struct { vec3 center; float radius; uint32_t material; } Sphere;
+
+static struct {
+    uint32_t width, height, max_depth, blinn;
+    vec3 cam_pos, look_at, up;
+    float fov_y_deg;
+    vec3 background, ambient_light;
+    uint32_t n_materials, n_lights, n_spheres, n_triangles;
+    Material *materials;
+    Light *lights;
+    Sphere *spheres;
+    float *vertices; /* 9 floats a triangle, plus padding Embree may read */
+    uint32_t *tri_material;
+} S;
+
+static void die(const char *what) { fprintf(stderr, "embree_whitted: %s\n", what); exit(2); }
+
+static void read_exact(FILE *f, void *dst, size_t bytes) {
+    if (fread(dst, 1, bytes, f) != bytes) die("the scene file is truncated");
+}
+static uint32_t read_u32(FILE *f) { uint32_t v; read_exact(f, &v, 4); return v; }
+static vec3 read_vec3(FILE *f) { float v[3]; read_exact(f, v, 12); return v3(v[0], v[1], v[2]); }
+static float read_f32(FILE *f) { float v; read_exact(f, &v, 4); return v; }
+
+static void *alloc(size_t bytes) {
+    void *p = calloc(1, bytes ? bytes : 1);
+    if (!p) die("out of memory");
+    return p;
+}
+
+static void load_scene(const char *path) {
+    FILE *f = fopen(path, "rb");
+    if (!f) die("cannot open the scene file");
+    char magic[8];
+    read_exact(f, magic, 8);
+    if (memcmp(magic, "RTPEER01", 8) != 0) die("not a raytree peer scene (magic RTPEER01)");
+    S.width = read_u32(f);
+    S.height = read_u32(f);
+    S.max_depth = read_u32(f);
+    S.blinn = read_u32(f);
+    S.cam_pos = read_vec3(f);
+    S.look_at = read_vec3(f);
+    S.up = read_vec3(f);
+    S.fov_y_deg = read_f32(f);
+    S.background = read_vec3(f);
+    S.ambient_light = read_vec3(f);
+    S.n_materials = read_u32(f);
+    S.materials = alloc(sizeof(Material) * S.n_materials);
+    for (uint32_t i = 0; i < S.n_materials; i++) {
+        Material *m = &S.materials[i];
+        m->ambient = read_vec3(f);
+        m->diffuse = read_vec3(f);
+        m->specular = read_vec3(f);
+        m->shininess = read_f32(f);
+        m->reflectivity = read_vec3(f);
+        m->transparency = read_vec3(f);
+        m->ior = read_f32(f);
+    }
+    S.n_lights = read_u32(f);
+    S.lights = alloc(sizeof(Light) * S.n_lights);
+    for (uint32_t i = 0; i < S.n_lights; i++) {
+        S.lights[i].position = read_vec3(f);
+        S.lights[i].color = read_vec3(f);
+    }
+    S.n_spheres = read_u32(f);
+    S.spheres = alloc(sizeof(Sphere) * S.n_spheres);
+    for (uint32_t i = 0; i < S.n_spheres; i++) {
+        S.spheres[i].center = read_vec3(f);
+        S.spheres[i].radius = read_f32(f);
+        S.spheres[i].material = read_u32(f);
+    }
+    S.n_triangles = read_u32(f);
+    S.vertices = alloc(sizeof(float) * (9 * (size_t)S.n_triangles + 4));
+    read_exact(f, S.vertices, sizeof(float) * 9 * (size_t)S.n_triangles);
+    S.tri_material = alloc(sizeof(uint32_t) * S.n_triangles);
+    read_exact(f, S.tri_material, sizeof(uint32_t) * S.n_triangles);
+    fclose(f);
+}
+
+/* ---- analytic spheres as an Embree user geometry ---- */
+
+/* raytree's robust_roots + pick_root: nearest t in (tmin, tmax) or NAN. */
+static float sphere_t(const Sphere *s, vec3 o, vec3 u, float tmin, float tmax) {
+    vec3 f = sub(o, s->center);
+    float a = dot(u, u);
+    float bp = -dot(f, u);
+    float r2 = s->radius * s->radius;
+    vec3 l = add(f, scale(bp / a, u));
+    float disc = r2 - dot(l, l);
+    if (isnan(disc) || disc < 0.0f) return NAN;
+    float c = dot(f, f) - r2;
+    float q = bp + copysignf(sqrtf(a * disc), bp);
+    float t0, t1;
+    if (q == 0.0f) {
+        t0 = t1 = 0.0f;
+    } else {
+        t0 = c / q;
+        t1 = q / a;
+        if (t0 > t1) { float t = t0; t0 = t1; t1 = t; }
+    }
+    if (t0 > tmin) return t0 < tmax ? t0 : NAN;
+    if (t1 > tmin && t1 < tmax) return t1;
+    return NAN;
+}
+
+static void sphere_bounds(const struct RTCBoundsFunctionArguments *args) {
+    const Sphere *s = &((const Sphere *)args->geometryUserPtr)[args->primID];
+    float pad = 4.0f * 0x1p-23f * (fabsf(s->center.x) + fabsf(s->center.y) + fabsf(s->center.z) + s->radius);
+    float r = s->radius + pad;
+    args->bounds_o->lower_x = s->center.x - r;
+    args->bounds_o->lower_y = s->center.y - r;
+    args->bounds_o->lower_z = s->center.z - r;
+    args->bounds_o->upper_x = s->center.x + r;
+    args->bounds_o->upper_y = s->center.y + r;
+    args->bounds_o->upper_z = s->center.z + r;
+}
+
+/* Only rtcIntersect1/rtcOccluded1 are used, so N is 1. */
+static void sphere_intersect(const struct RTCIntersectFunctionNArguments *args) {
+    if (!args->valid[0]) return;
+    struct RTCRayHit *rh = (struct RTCRayHit *)args->rayhit;
+    const Sphere *s = &((const Sphere *)args->geometryUserPtr)[args->primID];
+    vec3 o = v3(rh->ray.org_x, rh->ray.org_y, rh->ray.org_z);
+    vec3 d = v3(rh->ray.dir_x, rh->ray.dir_y, rh->ray.dir_z);
+    float t = sphere_t(s, o, d, rh->ray.tnear, rh->ray.tfar);
+    if (isnan(t)) return;
+    rh->ray.tfar = t;
+    rh->hit.u = rh->hit.v = 0.0f;
+    rh->hit.Ng_x = rh->hit.Ng_y = rh->hit.Ng_z = 0.0f; /* the shader computes it */
+    rh->hit.primID = args->primID;
+    rh->hit.geomID = args->geomID;
+    rh->hit.instID[0] = args->context->instID[0];
+}
+
+static void sphere_occluded(const struct RTCOccludedFunctionNArguments *args) {
+    if (!args->valid[0]) return;
+    struct RTCRay *ray = (struct RTCRay *)args->ray;
+    const Sphere *s = &((const Sphere *)args->geometryUserPtr)[args->primID];
+    vec3 o = v3(ray->org_x, ray->org_y, ray->org_z);
+    vec3 d = v3(ray->dir_x, ray->dir_y, ray->dir_z);
+    if (!isnan(sphere_t(s, o, d, ray->tnear, ray->tfar))) ray->tfar = -INFINITY;
+}
+
+/* ---- memory accounting ---- */
+static _Atomic long long embree_bytes, embree_peak;
+static bool memory_monitor(void *ptr, ssize_t bytes, bool post) {
+    (void)ptr;
+    (void)post;
+    long long now = atomic_fetch_add(&embree_bytes, (long long)bytes) + bytes;
+    long long peak = atomic_load(&embree_peak);
+    while (now > peak && !atomic_compare_exchange_weak(&embree_peak, &peak, now)) {}
+    return true;
+}
+
+static long peak_rss_kb(void) {
+    FILE *f = fopen("/proc/self/status", "r");
+    if (!f) return -1;
+    char line[256];
+    long kb = -1;
+    while (fgets(line, sizeof line, f))
+        if (strncmp(line, "VmHWM:", 6) == 0) kb = strtol(line + 6, NULL, 10);
+    fclose(f);
+    return kb;
+}
+
+static double now_secs(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ---- the Whitted trace, as raytree's src/trace.rs ---- */
+static RTCScene scene;
+enum { GEOM_TRIANGLES = 0, GEOM_SPHERES = 1 };
+
+typedef struct { uint64_t primary, reflected, refracted, shadow; } Counts;
+typedef enum { PRIMARY, REFLECTED, REFRACTED } Kind;
+
+/* pbrt-v4 OffsetRayOrigin (raytree's OffsetMethod::ErrorBound). */
+static vec3 offset_origin(vec3 p, vec3 err, vec3 n, vec3 dir) {
+    vec3 n_out = dot(dir, n) < 0.0f ? neg(n) : n;
+    float d = dot(vabs(n), err);
+    vec3 off = scale(d, n_out);
+    vec3 po = add(p, off);
+    float *c = &po.x, *o = &off.x;
+    for (int i = 0; i < 3; i++) {
+        if (o[i] > 0.0f) c[i] = nextafterf(c[i], INFINITY);
+        else if (o[i] < 0.0f) c[i] = nextafterf(c[i], -INFINITY);
+    }
+    return po;
+}
+
+static vec3 reflect(vec3 u, vec3 n) { return sub(u, scale(2.0f * dot(u, n), n)); }
+
+static int refract(vec3 u, vec3 n, float eta, vec3 *out) {
+    float cos_i = fminf(fmaxf(-dot(u, n), 0.0f), 1.0f);
+    float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
+    if (k < 0.0f) return 0;
+    float cos_r = sqrtf(k);
+    *out = normalize(sub(scale(eta, u), scale(cos_r - eta * cos_i, n)));
+    return 1;
+}
+
+static vec3 trace(vec3 o, vec3 d, Kind kind, uint32_t depth, Counts *counts,
+                  struct RTCIntersectContext *ctx) {
+    if (depth > S.max_depth) return S.background;
+    if (kind == PRIMARY) counts->primary++;
+    else if (kind == REFLECTED) counts->reflected++;
+    else counts->refracted++;
+
+    struct RTCRayHit rh;
+    rh.ray.org_x = o.x; rh.ray.org_y = o.y; rh.ray.org_z = o.z;
+    rh.ray.dir_x = d.x; rh.ray.dir_y = d.y; rh.ray.dir_z = d.z;
+    rh.ray.tnear = 0.0f;
+    rh.ray.tfar = INFINITY;
+    rh.ray.time = 0.0f;
+    rh.ray.mask = 0xffffffffu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scene, ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return S.background;
+
+    /* Hit point, its error bound and the geometric normal, as raytree's Tracer::surface. */
+    vec3 p, err, n;
+    const Material *m;
+    if (rh.hit.geomID == GEOM_SPHERES) {
+        const Sphere *s = &S.spheres[rh.hit.primID];
+        float t = rh.ray.tfar;
+        vec3 at = add(o, scale(t, d));
+        double vx = (double)at.x - s->center.x, vy = (double)at.y - s->center.y,
+               vz = (double)at.z - s->center.z;
+        double len = sqrt(vx * vx + vy * vy + vz * vz);
+        if (len > 0.0 && isfinite(len)) {
+            double k = (double)s->radius / len;
+            vx *= k; vy *= k; vz *= k;
+        }
+        p = v3((float)(s->center.x + vx), (float)(s->center.y + vy), (float)(s->center.z + vz));
+        vec3 local = v3((float)vx, (float)vy, (float)vz);
+        err = add(scale(gamma_f(5), vabs(local)), scale(gamma_f(1), vabs(p)));
+        n = normalize(scale(1.0f / s->radius, sub(p, s->center)));
+        m = &S.materials[s->material];
+    } else {
+        const float *v = &S.vertices[9 * (size_t)rh.hit.primID];
+        vec3 a = v3(v[0], v[1], v[2]), b = v3(v[3], v[4], v[5]), c = v3(v[6], v[7], v[8]);
+        float b1 = rh.hit.u, b2 = rh.hit.v, b0 = 1.0f - b1 - b2;
+        vec3 w0 = scale(b0, a), w1 = scale(b1, b), w2 = scale(b2, c);
+        p = add(add(w0, w1), w2);
+        err = scale(gamma_f(7), add(add(vabs(w0), vabs(w1)), vabs(w2)));
+        n = normalize(cross(sub(b, a), sub(c, a)));
+        m = &S.materials[S.tri_material[rh.hit.primID]];
+    }
+    int front = dot(d, n) < 0.0f;
+    if (!front) n = neg(n);
+    vec3 view = neg(d);
+
+    vec3 diffuse = v3(0, 0, 0), specular = v3(0, 0, 0);
+    for (uint32_t i = 0; i < S.n_lights; i++) {
+        const Light *light = &S.lights[i];
+        vec3 to_light = sub(light->position, p);
+        float dist = length(to_light);
+        vec3 l = scale(1.0f / dist, to_light);
+        float n_dot_l = dot(n, l);
+        if (!(n_dot_l > 0.0f)) continue;
+        vec3 origin = offset_origin(p, err, n, l);
+        vec3 seg = sub(light->position, origin);
+        float seg_len = length(seg);
+        vec3 sd = scale(1.0f / seg_len, seg);
+        counts->shadow++;
+        struct RTCRay sr;
+        sr.org_x = origin.x; sr.org_y = origin.y; sr.org_z = origin.z;
+        sr.dir_x = sd.x; sr.dir_y = sd.y; sr.dir_z = sd.z;
+        sr.tnear = 0.0f;
+        sr.tfar = seg_len;
+        sr.time = 0.0f;
+        sr.mask = 0xffffffffu;
+        sr.id = 0;
+        sr.flags = 0;
+        rtcOccluded1(scene, ctx, &sr);
+        if (sr.tfar < 0.0f) continue; /* blocked */
+        float cos_spec;
+        if (S.blinn) {
+            cos_spec = dot(n, normalize_or_zero(add(l, view)));
+        } else {
+            cos_spec = dot(reflect(neg(l), n), view);
+        }
+        float spec = powf(fmaxf(cos_spec, 0.0f), m->shininess);
+        diffuse = add(diffuse, scale(n_dot_l, mul(light->color, m->diffuse)));
+        specular = add(specular, scale(spec, mul(light->color, m->specular)));
+    }
+    vec3 color = add(add(mul(m->ambient, S.ambient_light), diffuse), specular);
+
+    vec3 kr = m->reflectivity, kt = m->transparency;
+    vec3 refl_w = kr, tdir;
+    int refracted = 0;
+    if (!is_zero(kt)) {
+        float eta = front ? 1.0f / m->ior : m->ior;
+        refracted = refract(d, n, eta, &tdir);
+        if (!refracted) refl_w = add(refl_w, kt); /* total internal reflection */
+    }
+    if (!is_zero(refl_w)) {
+        vec3 r = normalize(reflect(d, n));
+        vec3 c = trace(offset_origin(p, err, n, r), r, REFLECTED, depth + 1, counts, ctx);
+        color = add(color, mul(refl_w, c));
+    }
+    if (refracted) {
+        vec3 c = trace(offset_origin(p, err, n, tdir), tdir, REFRACTED, depth + 1, counts, ctx);
+        color = add(color, mul(kt, c));
+    }
+    return color;
+}
+
+/* ---- camera (raytree's CameraFrame) and tiles ---- */
+static vec3 cam_right, cam_up, cam_back;
+static float tan_half, aspect;
+static float *image;
+enum { TILE = 32 };
+static uint32_t tiles_x, tiles_y;
+static atomic_uint next_tile;
+
+typedef struct { Counts counts; } Worker;
+
+static void *worker(void *arg) {
+    Worker *w = arg;
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    float fw = (float)S.width, fh = (float)S.height;
+    for (;;) {
+        unsigned tile = atomic_fetch_add(&next_tile, 1);
+        if (tile >= tiles_x * tiles_y) break;
+        uint32_t x0 = (tile % tiles_x) * TILE, y0 = (tile / tiles_x) * TILE;
+        for (uint32_t y = y0; y < y0 + TILE && y < S.height; y++) {
+            for (uint32_t x = x0; x < x0 + TILE && x < S.width; x++) {
+                float px = (float)x + 0.5f, py = (float)y + 0.5f;
+                float cx = (2.0f * px / fw - 1.0f) * aspect * tan_half;
+                float cy = (1.0f - 2.0f * py / fh) * tan_half;
+                vec3 d = normalize(sub(add(scale(cx, cam_right), scale(cy, cam_up)), cam_back));
+                vec3 c = trace(S.cam_pos, d, PRIMARY, 0, &w->counts, &ctx);
+                float *out = &image[3 * ((size_t)y * S.width + x)];
+                out[0] = c.x; out[1] = c.y; out[2] = c.z;
+            }
+        }
+    }
+    return NULL;
+}
+
+static void rtc_error(void *user, enum RTCError code, const char *str) {
+    (void)user;
+    fprintf(stderr, "embree_whitted: Embree error %d: %s\n", (int)code, str ? str : "");
+    exit(2);
+}
+
+int main(int argc, char **argv) {
+    if (argc < 3) die("usage: embree_whitted SCENE.bin THREADS [IMAGE.f32]");
+    int threads = atoi(argv[2]);
+    if (threads < 1 || threads > 256) die("THREADS must be 1..256");
+
+    double t0 = now_secs();
+    load_scene(argv[1]);
+    char config[64];
+    snprintf(config, sizeof config, "threads=%d", threads);
+    RTCDevice device = rtcNewDevice(config);
+    if (!device) die("rtcNewDevice failed");
+    rtcSetDeviceErrorFunction(device, rtc_error, NULL);
+    rtcSetDeviceMemoryMonitorFunction(device, memory_monitor, NULL);
+    scene = rtcNewScene(device);
+
+    uint32_t *indices = alloc(sizeof(uint32_t) * 3 * (size_t)S.n_triangles);
+    for (uint32_t i = 0; i < 3 * S.n_triangles; i++) indices[i] = i;
+    if (S.n_triangles > 0) {
+        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, S.vertices, 0,
+                                   12, 3 * (size_t)S.n_triangles);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, indices, 0, 12,
+                                   S.n_triangles);
+        rtcCommitGeometry(g);
+        if (rtcAttachGeometry(scene, g) != GEOM_TRIANGLES) die("unexpected geometry id");
+        rtcReleaseGeometry(g);
+    }
+    if (S.n_spheres > 0) {
+        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
+        rtcSetGeometryUserPrimitiveCount(g, S.n_spheres);
+        rtcSetGeometryUserData(g, S.spheres);
+        rtcSetGeometryBoundsFunction(g, sphere_bounds, NULL);
+        rtcSetGeometryIntersectFunction(g, sphere_intersect);
+        rtcSetGeometryOccludedFunction(g, sphere_occluded);
+        rtcCommitGeometry(g);
+        rtcAttachGeometryByID(scene, g, GEOM_SPHERES);
+        rtcReleaseGeometry(g);
+    }
+    double t1 = now_secs();
+    rtcCommitScene(scene);
+    double t2 = now_secs();
+
+    cam_back = normalize(sub(S.cam_pos, S.look_at));
+    cam_right = normalize(cross(S.up, cam_back));
+    cam_up = cross(cam_back, cam_right);
+    float deg_to_rad = 3.14159265358979323846f / 180.0f;
+    tan_half = tanf(S.fov_y_deg * deg_to_rad * 0.5f);
+    aspect = (float)S.width / (float)S.height;
+    image = alloc(sizeof(float) * 3 * (size_t)S.width * S.height);
+    tiles_x = (S.width + TILE - 1) / TILE;
+    tiles_y = (S.height + TILE - 1) / TILE;
+
+    Worker *workers = alloc(sizeof(Worker) * threads);
+    pthread_t *ids = alloc(sizeof(pthread_t) * threads);
+    double t3 = now_secs();
+    for (int i = 0; i < threads; i++)
+        if (pthread_create(&ids[i], NULL, worker, &workers[i]) != 0) die("pthread_create failed");
+    for (int i = 0; i < threads; i++) pthread_join(ids[i], NULL);
+    double t4 = now_secs();
+
+    Counts total = {0, 0, 0, 0};
+    for (int i = 0; i < threads; i++) {
+        total.primary += workers[i].counts.primary;
+        total.reflected += workers[i].counts.reflected;
+        total.refracted += workers[i].counts.refracted;
+        total.shadow += workers[i].counts.shadow;
+    }
+    uint64_t rays = total.primary + total.reflected + total.refracted + total.shadow;
+    double render = t4 - t3;
+    printf("embree_version %d.%d.%d\n", RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH);
+    printf("threads %d\n", threads);
+    printf("triangles %u\nspheres %u\n", S.n_triangles, S.n_spheres);
+    printf("load_secs %.6f\nbuild_secs %.6f\nrender_secs %.6f\n", t1 - t0, t2 - t1, render);
+    printf("primary %llu\nreflected %llu\nrefracted %llu\nshadow %llu\n",
+           (unsigned long long)total.primary, (unsigned long long)total.reflected,
+           (unsigned long long)total.refracted, (unsigned long long)total.shadow);
+    printf("mrays_per_sec %.4f\n", (double)rays / render / 1e6);
+    printf("embree_peak_bytes %lld\n", (long long)atomic_load(&embree_peak));
+    printf("geometry_bytes %llu\n",
+           (unsigned long long)(S.n_triangles * (36ull + 12ull) + S.n_spheres * sizeof(Sphere)));
+    printf("peak_rss_kb %ld\n", peak_rss_kb());
+
+    if (argc > 3) {
+        FILE *f = fopen(argv[3], "wb");
+        if (!f) die("cannot write the image");
+        fwrite(image, sizeof(float), 3 * (size_t)S.width * S.height, f);
+        fclose(f);
+    }
+    rtcReleaseScene(scene);
+    rtcReleaseDevice(device);
+    return 0;
+}
