@@ -151,7 +151,7 @@ impl Bvh {
                 built = collapse(&bvh2, &prims).filter(|b| stack_need(&b.nodes) <= STACK_SIZE);
             }
         }
-        let bvh = built.unwrap_or_else(|| {
+        built.unwrap_or_else(|| {
             let b = collapse(&median_bvh2(&boxes), &prims).unwrap_or_else(|| Bvh {
                 nodes: Vec::new(),
                 packets: Vec::new(),
@@ -162,8 +162,7 @@ impl Bvh {
             // fewer than 3·15 stack entries.
             debug_assert!(stack_need(&b.nodes) <= STACK_SIZE);
             b
-        });
-        bvh
+        })
     }
 
     pub(super) fn memory_bytes(&self) -> usize {
