@@ -114,7 +114,7 @@ pub fn render_tiny(scene: &Scene) {
     let mut scene = scene.clone();
     scene.render.width = scene.render.width.min(6);
     scene.render.height = scene.render.height.min(4);
-    // Deep glass between mirrors can cost 2^depth rays a pixel (see docs/reliability.md);
+    // Deep glass between mirrors can cost 2^depth rays a pixel (see the README, Reliability);
     // depth is not what this checks.
     scene.render.max_depth = scene.render.max_depth.min(6);
     let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());
