@@ -92,18 +92,19 @@ fn s3_plane_ground_is_exact_where_a_huge_sphere_is_not() {
     }
 }
 
-/// S4: the hit/miss verdict is monotone in the distance of the ray from the centre, and right
-/// while |ρ − r| ≥ 1e-5·r from up to 20 radii; the lecture's is neither.
+/// S4: the hit/miss verdict is monotone in the distance ρ of the ray from the centre (outside
+/// the 4·ε·D band no f32 test can decide), and right while |ρ − r| ≥ 1e-5·r from up to 20
+/// radii; the lecture's is neither.
 #[test]
 fn s4_grazing_verdicts_are_monotone() {
     let mut rng = Pcg::new(4);
     assert_eq!(
-        grazing_non_monotone(SphereMethod::Robust, 1e-7, 100, 30, &mut rng),
+        grazing_non_monotone(SphereMethod::Robust, 1e-5, 100, 100, &mut rng),
         0,
         "robust verdicts not monotone in ρ"
     );
     assert!(
-        grazing_non_monotone(SphereMethod::Lecture, 1e-7, 100, 30, &mut rng) > 0,
+        grazing_non_monotone(SphereMethod::Lecture, 1e-5, 100, 30, &mut rng) > 0,
         "lecture expected to flicker near ρ = r"
     );
     for k in 1..=5 {
@@ -360,8 +361,9 @@ fn r1_refraction_is_guarded_and_reversible() {
             }
         }
     }
-    // η = 1 leaves the direction alone up to the cancellation in 1 − (1 − cos²).
-    assert!(refract_identity_err(2000, &mut rng) <= 1e-4);
+    // η = 1 leaves the direction alone up to the cancellation in 1 − (1 − cos²): near grazing
+    // cos θt = sqrt(k) turns the ε/2 rounding of k into up to sqrt(ε/2) ≈ 2.4e-4.
+    assert!(refract_identity_err(2000, &mut rng) <= 2.0 * f32::EPSILON.sqrt() as f64);
 }
 
 /// B2: pathological builds terminate with a bounded depth and answer like brute force

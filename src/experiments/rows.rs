@@ -371,7 +371,7 @@ fn row_s4(o: &StabilityOptions, rng: &mut Pcg) -> Row {
         }
     }
     let families = (o.rays / 100).max(20);
-    let non_monotone = methods.map(|m| grazing_non_monotone(m, 1e-7, 100, families, rng));
+    let non_monotone = methods.map(|m| grazing_non_monotone(m, 1e-5, 100, families, rng));
     let first = |v: &[f64]| {
         v.iter()
             .position(|&p| p > 0.0)
@@ -393,19 +393,20 @@ fn row_s4(o: &StabilityOptions, rng: &mut Pcg) -> Row {
         robust_method: "robust quadratic",
         sweep: format!(
             "ρ/r = 1 ± 10⁻ᵏ from D/r = 2…20 and inside depth r·10⁻ᵏ, k = 1…7, {} rays; \
-             {families} families of 201 rays stepping ρ by 1e-7·r",
+             {families} families of 201 rays from D/r = 50…200 stepping ρ by 1e-5·r",
             o.rays
         ),
         naive: format!(
             "grazing verdict wrong from {}; inside origin wrong root from {}; {} of {families} \
-             families not monotone in ρ",
+             families not monotone in ρ (outside 4·ε·D of the surface)",
             first(&graze[0]),
             first(&inside[0]),
             non_monotone[0]
         ),
         robust: format!(
             "grazing wrong from {} (|ρ − r| within a few ε·D); inside origin wrong from {} \
-             (10⁻⁷ r is below one ulp of r); {} of {families} families not monotone in ρ",
+             (10⁻⁷ r is below one ulp of r); {} of {families} families not monotone in ρ \
+             (outside 4·ε·D of the surface)",
             first(&graze[1]),
             first(&inside[1]),
             non_monotone[1]
@@ -719,7 +720,7 @@ fn row_t5(o: &StabilityOptions, rng: &mut Pcg) -> Row {
             .points
             .iter()
             .find(|p| p.1 > 0.0)
-            .map(|p| format!("{} ({:.1}%)", fmt_g(p.0), p.1))
+            .map(|p| format!("{} ({:.2}%)", fmt_g(p.0), p.1))
             .unwrap_or_else(|| "never".into())
     };
     let at = |i: usize, d: f64| {
