@@ -31,6 +31,15 @@ fn read_csv(path: &Path) -> (Vec<String>, Vec<HashMap<String, String>>) {
     (header, rows)
 }
 
+fn assert_columns(header: &[String], cols: &[&str]) {
+    for col in cols {
+        assert!(
+            header.iter().any(|h| h == col),
+            "no column {col}: {header:?}"
+        );
+    }
+}
+
 fn num(row: &HashMap<String, String>, col: &str) -> f64 {
     row[col]
         .parse()
@@ -45,14 +54,19 @@ fn assert_chart(dir: &Path, stem: &str) {
     assert!(png.len() < 300_000, "{stem}.png is {} bytes", png.len());
 }
 
+/// `raytree bench SCENE --quick --out DIR`.
+fn quick_bench(scene: &str, dir: &Path) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_raytree"))
+        .args(["bench", scene, "--quick", "--out"])
+        .arg(dir)
+        .output()
+        .expect("run")
+}
+
 #[test]
 fn quick_bench_writes_csv_and_charts() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let out = Command::new(env!("CARGO_BIN_EXE_raytree"))
-        .args(["bench", "default", "--quick", "--out"])
-        .arg(dir.path())
-        .output()
-        .expect("run");
+    let out = quick_bench("default", dir.path());
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         out.status.success(),
@@ -63,9 +77,8 @@ fn quick_bench_writes_csv_and_charts() {
     assert!(stdout.contains("0 differing pixels"), "{stdout}");
 
     let (header, rows) = read_csv(&dir.path().join("bench.csv"));
-    for col in [
-        "knob",
-        "value",
+    // Each knob is a column of its own too (the value every point was rendered with).
+    const KNOBS: [&str; 7] = [
         "max_depth",
         "samples",
         "cutoff",
@@ -73,30 +86,25 @@ fn quick_bench_writes_csv_and_charts() {
         "triangle",
         "offset",
         "accel",
-        "secs",
-        "rays",
-        "mean_flip",
-        "rmse",
-        "psnr_db",
-        "differing_share",
-        "changed_pixels",
-        "pareto",
-    ] {
-        assert!(
-            header.iter().any(|h| h == col),
-            "no column {col}: {header:?}"
-        );
-    }
+    ];
+    assert_columns(&header, &KNOBS);
+    assert_columns(
+        &header,
+        &[
+            "knob",
+            "value",
+            "secs",
+            "rays",
+            "mean_flip",
+            "rmse",
+            "psnr_db",
+            "differing_share",
+            "changed_pixels",
+            "pareto",
+        ],
+    );
     let knob = |k: &'static str| rows.iter().filter(move |r| r["knob"] == k);
-    for k in [
-        "max_depth",
-        "samples",
-        "cutoff",
-        "sphere",
-        "triangle",
-        "offset",
-        "accel",
-    ] {
+    for k in KNOBS {
         assert!(knob(k).count() >= 2, "knob {k}");
     }
     assert_eq!(knob("max_depth").count(), 13, "max depth 0 to 12");
@@ -135,19 +143,17 @@ fn quick_bench_writes_csv_and_charts() {
     assert_chart(dir.path(), "bench");
 
     let (header, rows) = read_csv(&dir.path().join("scaling.csv"));
-    for col in [
-        "triangles",
-        "accel",
-        "build_secs",
-        "render_secs",
-        "memory_bytes",
-        "note",
-    ] {
-        assert!(
-            header.iter().any(|h| h == col),
-            "no column {col}: {header:?}"
-        );
-    }
+    assert_columns(
+        &header,
+        &[
+            "triangles",
+            "accel",
+            "build_secs",
+            "render_secs",
+            "memory_bytes",
+            "note",
+        ],
+    );
     for accel in ["none", "grid", "bvh"] {
         assert!(rows.iter().any(|r| r["accel"] == accel), "{accel}");
     }
@@ -158,11 +164,7 @@ fn quick_bench_writes_csv_and_charts() {
 #[test]
 fn bench_refuses_a_missing_scene() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let out = Command::new(env!("CARGO_BIN_EXE_raytree"))
-        .args(["bench", "no-such-scene.toml", "--quick", "--out"])
-        .arg(dir.path())
-        .output()
-        .expect("run");
+    let out = quick_bench("no-such-scene.toml", dir.path());
     assert!(!out.status.success());
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.starts_with("error: "), "{stderr}");

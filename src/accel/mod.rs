@@ -66,22 +66,25 @@ pub struct PrimHit {
 ///
 /// Measured with `raytree bench default --no-sweep --out DIR` (the scaling sweep of
 /// `experiments::bench`: a tessellated sphere filling a 640×480 image, one sample, primary and
-/// shadow rays, build + render, median of 3 runs, 2 shared cores): no accelerator is faster at
-/// 1, 2 and 4 triangles (32 / 39 / 43 ms against the BVH's 48 / 43 / 68 ms), the BVH from 8 on
-/// (72 ms against 93 ms; 84 ms against 260 ms at 32). The crossover interpolates to about 6.
+/// shadow rays, build + render, median of 3 runs, 2 shared cores): at 1–4 triangles the three
+/// kinds are within noise of each other (15–68 ms), from 8 on the BVH is faster than none
+/// (44–72 ms against 61–93 ms; 84–92 ms against 230–260 ms at 32). Three runs put the
+/// crossover at about 4, 6 and 7.
 pub const AUTO_MIN_BVH_PRIMS: usize = 6;
 
 /// `Auto` builds the uniform grid from this many valid primitives on.
 ///
 /// Same measurement: the grid and the BVH tie from 128 to 2048 triangles, the BVH is faster
-/// from 8k to 1M (0.25 s against 0.37 s at 131k), and the grid from about 1.1M on, because the
-/// BVH's build then outweighs its faster traversal: at 2.1M triangles the grid builds in 0.61 s
-/// against 2.0 s and renders the frame in 0.62 s against 0.34 s (1.23 s against 2.33 s in
-/// all), in 54 bytes per triangle against 128. A viewer that renders more than about five
-/// frames of such a scene without rebuilding would do better with `--accel bvh`; so would a
-/// very uneven scene, where a uniform grid's cells fill unevenly (the sweep's sphere is the
+/// from 8k on (0.24 s against 0.35 s at 131k), and the grid from about 0.4M–1.1M on (two runs
+/// of the sweep; the clock of a shared machine decides within that range), because the BVH's
+/// build then outweighs its faster traversal: at 2.1M triangles the grid builds in 0.6 s
+/// against 1.9–2.0 s and renders the frame in 0.62–0.68 s against 0.25–0.34 s (1.2 s against
+/// 2.2–2.3 s in all), in 54 bytes per triangle against 128. We take 1M, leaning towards the
+/// BVH, which renders every further frame 2–4× faster: a viewer that renders more than about
+/// five frames of such a scene without rebuilding does better with `--accel bvh`, and so does
+/// a very uneven scene, where a uniform grid's cells fill unevenly (the sweep's sphere is the
 /// grid's good case).
-pub const AUTO_MIN_GRID_PRIMS: usize = 1_100_000;
+pub const AUTO_MIN_GRID_PRIMS: usize = 1_000_000;
 
 /// The accelerator `Auto` builds for `valid_prims` primitives (see [`AUTO_MIN_BVH_PRIMS`] and
 /// [`AUTO_MIN_GRID_PRIMS`] for the measurements behind the rule).

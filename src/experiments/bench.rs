@@ -98,6 +98,9 @@ pub struct BenchPoint {
     pub error: ImageError,
     /// Pixels not bit-identical to the baseline render (0 for every accelerator).
     pub changed_pixels: usize,
+    /// Mean FLIP against the baseline render: at most [`SAME_IMAGE_FLIP`], the point shows
+    /// the baseline's image (bit differences that no one can see, e.g. depth 6 against 5).
+    pub flip_vs_baseline: f64,
     /// On the Pareto front of (time, mean FLIP).
     pub pareto: bool,
 }
@@ -381,6 +384,7 @@ pub fn run_sweep(
             rays: t.rays,
             error: image_error(&reference.image, &t.image),
             changed_pixels: differing_pixels(&base_image, &t.image),
+            flip_vs_baseline: image_error(&base_image, &t.image).mean_flip,
             pareto: false,
         });
     }
@@ -394,19 +398,29 @@ pub fn run_sweep(
     })
 }
 
+/// Mean FLIP against the baseline below which a point shows the same image (FLIP's authors
+/// put the threshold of a visible difference around 0.01 for a pair of images seen in
+/// alternation; a tenth of that is far below it).
+pub const SAME_IMAGE_FLIP: f64 = 1e-3;
+
+fn same_image(p: &BenchPoint) -> bool {
+    p.flip_vs_baseline <= SAME_IMAGE_FLIP
+}
+
 /// Indices of the points no other point beats in both time and mean FLIP (lower is better in
 /// both), sorted by time.
 ///
-/// Points whose image is bit-identical to the baseline's (`changed_pixels == 0`: the
-/// accelerators, and methods that change nothing in this scene) are one setting as far as the
-/// image goes; their times differ only by noise. They count once, as the baseline's own point
-/// (or the first of them), at the median of their times ([`front_secs`]), so the front never
-/// recommends a method for having been lucky with the clock.
+/// Points that show the baseline's image ([`SAME_IMAGE_FLIP`]: the accelerators, deeper
+/// recursion than the scene needs, methods that change nothing visible in this scene) are one
+/// setting as far as the image goes, and their times differ by little more than noise. They
+/// count once, as the baseline's own point (or the first of them), at the median of their
+/// times ([`front_secs`]), so the front never recommends a method for having been lucky with
+/// the clock.
 pub fn pareto_front(points: &[BenchPoint], baseline: &PointSettings) -> Vec<usize> {
     let rep = representative(points, baseline);
     let key = |i: usize| (front_secs(points, baseline, i), points[i].error.mean_flip);
     let candidates: Vec<usize> = (0..points.len())
-        .filter(|&i| points[i].changed_pixels != 0 || Some(i) == rep)
+        .filter(|&i| !same_image(&points[i]) || Some(i) == rep)
         .collect();
     let mut front: Vec<usize> = candidates
         .iter()
@@ -426,7 +440,7 @@ pub fn pareto_front(points: &[BenchPoint], baseline: &PointSettings) -> Vec<usiz
 /// The point that stands for all those with the baseline's image.
 fn representative(points: &[BenchPoint], baseline: &PointSettings) -> Option<usize> {
     let same: Vec<usize> = (0..points.len())
-        .filter(|&i| points[i].changed_pixels == 0)
+        .filter(|&i| same_image(&points[i]))
         .collect();
     same.iter()
         .copied()
@@ -437,13 +451,13 @@ fn representative(points: &[BenchPoint], baseline: &PointSettings) -> Option<usi
 /// The time the Pareto front uses for point `i`: its own, or for the baseline's image the
 /// median over every point with that image.
 pub fn front_secs(points: &[BenchPoint], baseline: &PointSettings, i: usize) -> f64 {
-    if points[i].changed_pixels != 0 || representative(points, baseline) != Some(i) {
+    if !same_image(&points[i]) || representative(points, baseline) != Some(i) {
         return points[i].secs;
     }
     median(
         points
             .iter()
-            .filter(|p| p.changed_pixels == 0)
+            .filter(|p| same_image(p))
             .map(|p| p.secs)
             .collect(),
     )
@@ -454,12 +468,12 @@ pub fn bench_csv(report: &BenchReport) -> String {
     let mut s = String::from(
         "knob,value,max_depth,samples,cutoff,sphere,triangle,offset,accel,accel_used,secs,\
          build_secs,render_secs,rays,mrays_per_sec,mean_flip,rmse,psnr_db,differing_share,\
-         changed_pixels,pareto\n",
+         changed_pixels,flip_vs_baseline,pareto\n",
     );
     for p in &report.points {
         let m = &p.settings.trace.methods;
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{:.6},{:.6},{:.6},{},{:.3},{:.6},{:.6},{:.3},{:.6},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{},{:.6},{:.6},{:.6},{},{:.3},{:.6},{:.6},{:.3},{:.6},{},{:.6},{}\n",
             p.knob.name(),
             p.value,
             p.settings.max_depth,
@@ -480,6 +494,7 @@ pub fn bench_csv(report: &BenchReport) -> String {
             p.error.psnr_db,
             p.error.differing_share,
             p.changed_pixels,
+            p.flip_vs_baseline,
             p.pareto,
         ));
     }
@@ -859,6 +874,7 @@ mod tests {
     }
 
     fn point(secs: f64, flip: f64, changed_pixels: usize) -> BenchPoint {
+        let flip_vs_baseline = if changed_pixels == 0 { 0.0 } else { 0.1 };
         BenchPoint {
             knob: Knob::Samples,
             value: String::new(),
@@ -876,6 +892,7 @@ mod tests {
                 ..ImageError::default()
             },
             changed_pixels,
+            flip_vs_baseline,
             pareto: false,
         }
     }
@@ -994,18 +1011,14 @@ pub fn write_scaling(
 
 /// The Pareto-optimal settings, one line each, fastest first.
 pub fn pareto_lines(report: &BenchReport) -> Vec<String> {
-    let same = report
-        .points
-        .iter()
-        .filter(|p| p.changed_pixels == 0)
-        .count();
+    let same = report.points.iter().filter(|p| same_image(p)).count();
     pareto_front(&report.points, &report.baseline)
         .into_iter()
         .map(|i| {
             let p = &report.points[i];
             let name = format!("{} = {}", p.knob.name(), p.value);
-            let note = if p.changed_pixels == 0 {
-                format!("  (the scene's own settings; {same} settings give this image)")
+            let note = if same_image(p) {
+                format!("  (the scene's own image; {same} settings give it)")
             } else {
                 String::new()
             };

@@ -648,6 +648,48 @@ pub struct SelfHits {
     pub transmitted: f64,
 }
 
+/// A point where a camera ray from a few radii away meets the sphere (robust method): the ray,
+/// the re-projected point, its error bound and the outward unit normal.
+fn sphere_sample(center: Vec3, r: f32, rng: &mut Pcg) -> Option<(Ray, Vec3, Vec3, Vec3)> {
+    let sm = SphereMethod::Robust;
+    let origin = center + rng.unit() * (3.0 * r);
+    let aim = center + rng.unit() * (0.9 * r);
+    let ray = Ray::new(origin, (aim - origin).normalize());
+    let t = intersect_sphere(sm, center, r, &ray, 0.0, f32::INFINITY)?;
+    let (p, err) = sphere_hit_point(sm, center, r, &ray, t);
+    Some((ray, p, err, (p - center).normalize()))
+}
+
+/// A point where a ray from `2·s` away, from either side, meets triangle `v` (unit normal
+/// `geo_n`) with method `tm`: the ray, the point, its error bound, and the normal turned
+/// towards the ray.
+fn triangle_sample(
+    v: &[Vec3; 3],
+    geo_n: Vec3,
+    tm: TriangleMethod,
+    s: f32,
+    rng: &mut Pcg,
+) -> Option<(Ray, Vec3, Vec3, Vec3)> {
+    let side = if rng.f32() < 0.5 { geo_n } else { -geo_n };
+    let (b1, b2) = (rng.f32(), rng.f32());
+    let (b1, b2) = if b1 + b2 > 1.0 {
+        (1.0 - b1, 1.0 - b2)
+    } else {
+        (b1, b2)
+    };
+    let target = v[0] + b1 * (v[1] - v[0]) + b2 * (v[2] - v[0]);
+    let origin = target + (side + 0.5 * rng.unit()).normalize() * (2.0 * s);
+    let ray = Ray::new(origin, (target - origin).normalize());
+    let hit = intersect_triangle(tm, v, &ray, 0.0, f32::INFINITY)?;
+    let (p, err) = triangle_hit_point(v, hit.b1, hit.b2);
+    let facing = if ray.dir.dot(geo_n) < 0.0 {
+        geo_n
+    } else {
+        -geo_n
+    };
+    Some((ray, p, err, facing))
+}
+
 /// A1/A3 on a sphere of radius `r` whose centre is `center_dist` from the origin (STABILITY:
 /// `4.2·r`), hit by camera rays from a few radii away.
 pub fn sphere_self_hits(
@@ -661,15 +703,10 @@ pub fn sphere_self_hits(
     let sm = SphereMethod::Robust;
     let (mut points, mut acne, mut refl, mut trans) = (0, 0, 0, 0);
     for _ in 0..n {
-        let origin = center + rng.unit() * (3.0 * r);
-        let aim = center + rng.unit() * (0.9 * r);
-        let ray = Ray::new(origin, (aim - origin).normalize());
-        let Some(t) = intersect_sphere(sm, center, r, &ray, 0.0, f32::INFINITY) else {
+        let Some((ray, p, err, nrm)) = sphere_sample(center, r, rng) else {
             continue;
         };
         points += 1;
-        let (p, err) = sphere_hit_point(sm, center, r, &ray, t);
-        let nrm = (p - center).normalize();
         let hits = |dir: Vec3| {
             let o = offset_ray_origin(method, p, err, nrm, dir);
             intersect_sphere(sm, center, r, &Ray::new(o, dir), 0.0, f32::INFINITY)
@@ -709,26 +746,10 @@ pub fn triangle_self_hits(
     let geo_n = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
     let (mut points, mut acne, mut refl, mut trans) = (0, 0, 0, 0);
     for _ in 0..n {
-        let side = if rng.f32() < 0.5 { geo_n } else { -geo_n };
-        let (b1, b2) = (rng.f32(), rng.f32());
-        let (b1, b2) = if b1 + b2 > 1.0 {
-            (1.0 - b1, 1.0 - b2)
-        } else {
-            (b1, b2)
-        };
-        let target = v[0] + b1 * (v[1] - v[0]) + b2 * (v[2] - v[0]);
-        let origin = target + (side + 0.5 * rng.unit()).normalize() * (2.0 * s);
-        let ray = Ray::new(origin, (target - origin).normalize());
-        let Some(hit) = intersect_triangle(tm, &v, &ray, 0.0, f32::INFINITY) else {
+        let Some((ray, p, err, facing)) = triangle_sample(&v, geo_n, tm, s, rng) else {
             continue;
         };
         points += 1;
-        let (p, err) = triangle_hit_point(&v, hit.b1, hit.b2);
-        let facing = if ray.dir.dot(geo_n) < 0.0 {
-            geo_n
-        } else {
-            -geo_n
-        };
         let hits = |dir: Vec3| {
             let o = offset_ray_origin(method, p, err, geo_n, dir);
             intersect_triangle(tm, &v, &Ray::new(o, dir), 0.0, f32::INFINITY).is_some()
@@ -825,43 +846,22 @@ pub fn grazing_light_acne(
     for _ in 0..n {
         match surface {
             Surface::Sphere => {
-                let origin = c + rng.unit() * (3.0 * s);
-                let aim = c + rng.unit() * (0.9 * s);
-                let ray = Ray::new(origin, (aim - origin).normalize());
-                let sm = SphereMethod::Robust;
-                let Some(t) = intersect_sphere(sm, c, s, &ray, 0.0, f32::INFINITY) else {
+                let Some((_, p, err, nrm)) = sphere_sample(c, s, rng) else {
                     continue;
                 };
                 points += 1;
-                let (p, err) = sphere_hit_point(sm, c, s, &ray, t);
-                let nrm = (p - c).normalize();
                 let l = (cos_e * rng.perpendicular(nrm) + sin_e * nrm).normalize();
                 let o = offset_ray_origin(method, p, err, nrm, l);
+                let sm = SphereMethod::Robust;
                 acne += usize::from(
                     intersect_sphere(sm, c, s, &Ray::new(o, l), 0.0, f32::INFINITY).is_some(),
                 );
             }
             Surface::Triangle(tm) => {
-                let side = if rng.f32() < 0.5 { tri_n } else { -tri_n };
-                let (b1, b2) = (rng.f32(), rng.f32());
-                let (b1, b2) = if b1 + b2 > 1.0 {
-                    (1.0 - b1, 1.0 - b2)
-                } else {
-                    (b1, b2)
-                };
-                let target = tri[0] + b1 * (tri[1] - tri[0]) + b2 * (tri[2] - tri[0]);
-                let origin = target + (side + 0.5 * rng.unit()).normalize() * (2.0 * s);
-                let ray = Ray::new(origin, (target - origin).normalize());
-                let Some(hit) = intersect_triangle(tm, &tri, &ray, 0.0, f32::INFINITY) else {
+                let Some((_, p, err, facing)) = triangle_sample(&tri, tri_n, tm, s, rng) else {
                     continue;
                 };
                 points += 1;
-                let (p, err) = triangle_hit_point(&tri, hit.b1, hit.b2);
-                let facing = if ray.dir.dot(tri_n) < 0.0 {
-                    tri_n
-                } else {
-                    -tri_n
-                };
                 let l = (cos_e * rng.perpendicular(facing) + sin_e * facing).normalize();
                 let o = offset_ray_origin(method, p, err, tri_n, l);
                 acne += usize::from(
