@@ -147,9 +147,7 @@ impl Bvh {
                 params.search_depth_threshold,
             );
             ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
-            if bvh2_depth(&bvh2) <= MAX_BVH2_DEPTH {
-                built = collapse(&bvh2, &prims).filter(|b| stack_need(&b.nodes) <= STACK_SIZE);
-            }
+            built = collapse(&bvh2, &prims).filter(|b| stack_need(&b.nodes) <= STACK_SIZE);
         }
         let bvh = built.unwrap_or_else(|| {
             let b = collapse(&median_bvh2(&boxes), &prims).unwrap_or_else(|| Bvh {
@@ -301,31 +299,49 @@ fn padded(b: &Aabb) -> (Vec3A, Vec3A) {
 }
 
 /// The 4-wide tree of a binary BVH whose leaves hold one primitive each (PLOC's and
-/// [`median_bvh2`]'s do); `None` for an empty tree.
+/// [`median_bvh2`]'s do) and whose children come after their parents; `None` for an empty
+/// tree or one deeper than [`MAX_BVH2_DEPTH`].
 fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
     if bvh2.nodes.is_empty() {
         return None;
     }
     let n = bvh2.nodes.len();
-    // Pre-order, so that reversed it is bottom-up.
-    let mut order = Vec::with_capacity(n);
-    let mut todo = vec![0usize];
-    while let Some(i) = todo.pop() {
+    // Pre-order (parents before children) and the tree's depth.
+    let mut order: Vec<u32> = Vec::with_capacity(n);
+    let mut todo = vec![(0u32, 1usize)];
+    let mut bvh2_depth = 0;
+    while let Some((i, d)) = todo.pop() {
         order.push(i);
-        let node = &bvh2.nodes[i];
+        bvh2_depth = bvh2_depth.max(d);
+        let node = &bvh2.nodes[i as usize];
         if node.prim_count == 0 {
-            todo.push(node.first_index as usize);
-            todo.push(node.first_index as usize + 1);
+            todo.push((node.first_index + 1, d + 1));
+            todo.push((node.first_index, d + 1));
         }
     }
-    // Bottom up: primitives under each node and the surface-area cost of its best subtree;
-    // `leaf[i]` when the node's subtree is cheaper as one leaf.
-    let is_sphere = |i: usize| matches!(prims[i].shape, Shape::Sphere { .. });
+    if bvh2_depth > MAX_BVH2_DEPTH {
+        return None;
+    }
+    // Bottom up (reverse index order): primitives under each node and the surface-area cost
+    // of its best subtree; `leaf[i]` when the node's subtree is cheaper as one leaf.
+    // `Accel` lists the spheres first: an index tells the kind without reading the primitive
+    // (reading them in tree order misses the cache on every one).
+    let sphere_count = prims
+        .iter()
+        .take_while(|p| matches!(p.shape, Shape::Sphere { .. }))
+        .count();
+    debug_assert!(
+        prims[sphere_count..]
+            .iter()
+            .all(|p| matches!(p.shape, Shape::Triangle(_)))
+    );
+    let is_sphere = |i: usize| i < sphere_count;
     let mut count = vec![0u32; n];
     let mut spheres = vec![0u32; n];
     let mut cost = vec![0f32; n];
     let mut leaf = vec![false; n];
     for &i in order.iter().rev() {
+        let i = i as usize;
         let node = &bvh2.nodes[i];
         let area = node.aabb.half_area().max(0.0);
         if node.prim_count > 0 {
@@ -351,10 +367,10 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
     }
 
     let mut nodes: Vec<Node> = Vec::new();
-    let mut packets: Vec<Packet> = Vec::new();
     let mut sphere_leaves: Vec<Prim> = Vec::new();
-    let mut leaf_tris: Vec<[Vec3; 3]> = Vec::with_capacity(MAX_LEAF);
-    let mut leaf_ids = [0u32; 4];
+    // Each triangle leaf's primitive indices, four per leaf (the first repeated); gathered into
+    // packets afterwards in one tight loop, whose independent loads overlap their cache misses.
+    let mut leaf_prims: Vec<[u32; 4]> = Vec::new();
     let mut depth = 0;
     // (binary node, wide node to fill, its depth); the root's slots are the root's children,
     // or the root itself when it is a leaf.
@@ -365,34 +381,41 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
         depth = depth.max(d);
         // (binary node, how many times opened); a tie in area opens the shallower child, so
         // equal boxes (a median-split tree of duplicates) collapse evenly.
-        let mut slots: Vec<(usize, u32)> = if leaf[b] {
-            vec![(b, 0)]
+        let mut slots = [(0usize, 0u32); 4];
+        let mut len = if leaf[b] {
+            slots[0] = (b, 0);
+            1
         } else {
             let f = bvh2.nodes[b].first_index as usize;
-            vec![(f, 0), (f + 1, 0)]
+            slots[0] = (f, 0);
+            slots[1] = (f + 1, 0);
+            2
         };
         // Open the largest inner child until there are four.
-        while slots.len() < 4 {
-            let area = |s: usize| bvh2.nodes[s].aabb.half_area();
-            let best = slots
-                .iter()
-                .enumerate()
-                .filter(|&(_, &(s, _))| !leaf[s])
-                .max_by(|(i, (a, la)), (j, (b, lb))| {
-                    area(*a)
-                        .total_cmp(&area(*b))
-                        .then(lb.cmp(la))
-                        .then(j.cmp(i))
-                })
-                .map(|(k, _)| k);
-            let Some(k) = best else { break };
-            let (s, level) = slots[k];
-            let f = bvh2.nodes[s].first_index as usize;
-            slots[k] = (f, level + 1);
-            slots.insert(k + 1, (f + 1, level + 1));
+        while len < 4 {
+            let mut best: Option<(usize, f32, u32)> = None;
+            for (k, &(s, opened)) in slots[..len].iter().enumerate() {
+                if leaf[s] {
+                    continue;
+                }
+                let area = bvh2.nodes[s].aabb.half_area();
+                let better = match best {
+                    None => true,
+                    Some((_, a, o)) => area > a || (area == a && opened < o),
+                };
+                if better {
+                    best = Some((k, area, opened));
+                }
+            }
+            let Some((k, _, opened)) = best else { break };
+            let f = bvh2.nodes[slots[k].0].first_index as usize;
+            slots.copy_within(k + 1..len, k + 2);
+            slots[k] = (f, opened + 1);
+            slots[k + 1] = (f + 1, opened + 1);
+            len += 1;
         }
         let mut node = empty_node();
-        for (slot, &(s, _)) in slots.iter().enumerate() {
+        for (slot, &(s, _)) in slots[..len].iter().enumerate() {
             let (lo, hi) = padded(&bvh2.nodes[s].aabb);
             for (axis, (l, h)) in [(lo.x, hi.x), (lo.y, hi.y), (lo.z, hi.z)]
                 .into_iter()
@@ -408,31 +431,25 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
                 sphere_leaves.push(prims[id]);
             } else if leaf[s] {
                 // The subtree's triangles, left to right, as one packet.
-                leaf_tris.clear();
+                let mut ids = [0u32; 4];
+                let mut c = 0;
                 under.clear();
                 under.push(s);
                 while let Some(u) = under.pop() {
                     let un = &bvh2.nodes[u];
                     if un.prim_count > 0 {
-                        let id = bvh2.primitive_indices[un.first_index as usize] as usize;
-                        if let Shape::Triangle(v) = prims[id].shape {
-                            leaf_ids[leaf_tris.len()] = prims[id].id;
-                            leaf_tris.push(v);
-                        }
+                        ids[c] = bvh2.primitive_indices[un.first_index as usize];
+                        c += 1;
                     } else {
                         under.push(un.first_index as usize + 1);
                         under.push(un.first_index as usize);
                     }
                 }
-                let c = leaf_tris.len();
                 for k in c..4 {
-                    leaf_ids[k] = leaf_ids[0];
+                    ids[k] = ids[0];
                 }
-                node.child[slot] = LEAF | ((packets.len() as u32) << 2) | (c as u32 - 1);
-                packets.push(Packet {
-                    tris: Triangles4::new(&leaf_tris),
-                    ids: leaf_ids,
-                });
+                node.child[slot] = LEAF | ((leaf_prims.len() as u32) << 2) | (c as u32 - 1);
+                leaf_prims.push(ids);
             } else {
                 let index = nodes.len() as u32;
                 nodes.push(empty_node());
@@ -443,7 +460,21 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
         nodes[w as usize] = node;
     }
     nodes.shrink_to_fit();
-    packets.shrink_to_fit();
+    let triangle = |i: u32| match prims[i as usize].shape {
+        Shape::Triangle(v) => (v, prims[i as usize].id),
+        // Leaves hold no spheres (`spheres[s] == 0`).
+        Shape::Sphere { .. } => unreachable!("a sphere in a triangle leaf"),
+    };
+    let packets = leaf_prims
+        .iter()
+        .map(|ids| {
+            let t = ids.map(triangle);
+            Packet {
+                tris: Triangles4::new(&t.map(|(v, _)| v)),
+                ids: t.map(|(_, id)| id),
+            }
+        })
+        .collect();
     Some(Bvh {
         nodes,
         packets,
