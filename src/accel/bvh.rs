@@ -74,6 +74,9 @@ pub const MAX_BVH2_DEPTH: usize = 96;
 /// tree of up to 2²⁸ primitives needs at most 3 per level for about 13 levels.
 pub const STACK_SIZE: usize = 64;
 
+/// Entries of the stack a query starts with; deeper queries continue on a [`STACK_SIZE`] one.
+const SHORT_STACK: usize = 16;
+
 /// Most triangles in one leaf: one four-lane test. A leaf holds triangles or one sphere.
 pub const MAX_LEAF: usize = 4;
 
@@ -181,20 +184,26 @@ impl Bvh {
         if self.nodes.is_empty() {
             return;
         }
-        let inv = trav_inv(ray.dir);
-        let o = ray.origin;
-        let (ox, oy, oz) = (Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z));
-        let (ix, iy, iz) = (Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z));
-        // For a negative direction the max plane is entered first.
-        let near = |i: f32, axis: usize| 2 * axis + usize::from(i < 0.0);
-        let (nx, ny, nz) = (near(inv.x, 0), near(inv.y, 1), near(inv.z, 2));
-        let (fx, fy, fz) = (nx ^ 1, ny ^ 1, nz ^ 1);
-        let slack = Vec4::splat(box_t_slack());
-        let t_min4 = Vec4::splat(t_min);
+        let r = TravRay::new(ray, t_min);
+        self.walk_from::<V, SHORT_STACK>(&r, v, &[], 0);
+    }
 
-        let mut stack = [(0u32, 0f32); STACK_SIZE];
-        let mut sp = 0usize;
-        let mut word = 0u32;
+    /// The traversal loop from child word `word` with `seed` on a stack of `N` entries. A
+    /// query starts on a short stack (clearing it is part of every query's cost) and, in the
+    /// rare case it would overflow, continues on a [`STACK_SIZE`] one.
+    #[inline(always)]
+    fn walk_from<V: Visitor, const N: usize>(
+        &self,
+        r: &TravRay,
+        v: &mut V,
+        seed: &[(u32, f32)],
+        mut word: u32,
+    ) {
+        let mut stack = [(0u32, 0f32); N];
+        stack[..seed.len()].copy_from_slice(seed);
+        let mut sp = seed.len();
+        let (nx, ny, nz) = (r.near[0], r.near[1], r.near[2]);
+        let (fx, fy, fz) = (nx ^ 1, ny ^ 1, nz ^ 1);
         loop {
             if word & LEAF != 0 {
                 let stop = if word & SPHERE != 0 {
@@ -209,16 +218,17 @@ impl Bvh {
             } else {
                 let node = &self.nodes[word as usize];
                 let p = &node.planes;
-                let t_near = ((p[nx] - ox) * ix)
-                    .max((p[ny] - oy) * iy)
-                    .max((p[nz] - oz) * iz);
-                let t_far = ((p[fx] - ox) * ix)
-                    .min((p[fy] - oy) * iy)
-                    .min((p[fz] - oz) * iz);
+                let t_near = ((p[nx] - r.ox) * r.ix)
+                    .max((p[ny] - r.oy) * r.iy)
+                    .max((p[nz] - r.oz) * r.iz);
+                let t_far = ((p[fx] - r.ox) * r.ix)
+                    .min((p[fy] - r.oy) * r.iy)
+                    .min((p[fz] - r.oz) * r.iz);
                 // Widen both ends by the rounding of the slab arithmetic *and* of the
                 // primitives' own t: a tie (equal t, lower id) in a flat box must not be
                 // culled by an ulp.
-                let t_near = (t_near - t_near.abs() * slack).max(t_min4);
+                let slack = Vec4::splat(box_t_slack());
+                let t_near = (t_near - t_near.abs() * slack).max(r.t_min);
                 let t_far = (t_far + t_far.abs() * slack).min(Vec4::splat(v.limit()));
                 let mut mask = t_near.cmple(t_far).bitmask() & node.valid;
                 if mask != 0 {
@@ -227,36 +237,33 @@ impl Bvh {
                         continue;
                     }
                     let t = t_near.to_array();
-                    if V::ORDERED {
-                        // Up to four hits, sorted farthest first; all but the nearest are
-                        // pushed with their entry t.
-                        let mut hits = [(0u32, 0f32); 4];
-                        let mut k = 0;
-                        while mask != 0 {
-                            let i = mask.trailing_zeros() as usize;
-                            mask &= mask - 1;
-                            let mut j = k;
+                    // Up to four hits; all but the one taken next are pushed with their
+                    // entry t (sorted farthest first when ordered, so the nearest is next).
+                    let mut hits = [(0u32, 0f32); 4];
+                    let mut k = 0;
+                    while mask != 0 {
+                        let i = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        let mut j = k;
+                        if V::ORDERED {
                             while j > 0 && hits[j - 1].1 < t[i] {
                                 hits[j] = hits[j - 1];
                                 j -= 1;
                             }
-                            hits[j] = (node.child[i], t[i]);
-                            k += 1;
                         }
-                        stack[sp..sp + k - 1].copy_from_slice(&hits[..k - 1]);
-                        sp += k - 1;
-                        word = hits[k - 1].0;
-                    } else {
-                        let i = mask.trailing_zeros() as usize;
-                        mask &= mask - 1;
-                        word = node.child[i];
-                        while mask != 0 {
-                            let j = mask.trailing_zeros() as usize;
-                            mask &= mask - 1;
-                            stack[sp] = (node.child[j], t[j]);
-                            sp += 1;
-                        }
+                        hits[j] = (node.child[i], t[i]);
+                        k += 1;
                     }
+                    word = hits[k - 1].0;
+                    if N < STACK_SIZE && sp + k - 1 > N {
+                        let mut deeper = [(0u32, 0f32); STACK_SIZE];
+                        deeper[..sp].copy_from_slice(&stack[..sp]);
+                        deeper[sp..sp + k - 1].copy_from_slice(&hits[..k - 1]);
+                        let seed = &deeper[..sp + k - 1];
+                        return self.walk_from::<V, STACK_SIZE>(r, v, seed, word);
+                    }
+                    stack[sp..sp + k - 1].copy_from_slice(&hits[..k - 1]);
+                    sp += k - 1;
                     continue;
                 }
             }
@@ -272,6 +279,39 @@ impl Bvh {
                     break;
                 }
             }
+        }
+    }
+}
+
+/// A ray prepared for the node test.
+struct TravRay {
+    ox: Vec4,
+    oy: Vec4,
+    oz: Vec4,
+    ix: Vec4,
+    iy: Vec4,
+    iz: Vec4,
+    /// Per axis, the plane index entered first: `2·axis`, `+1` (the max plane) for a
+    /// negative direction.
+    near: [usize; 3],
+    t_min: Vec4,
+}
+
+impl TravRay {
+    #[inline(always)]
+    fn new(ray: &Ray, t_min: f32) -> Self {
+        let inv = trav_inv(ray.dir);
+        let o = ray.origin;
+        let near = |i: f32, axis: usize| 2 * axis + usize::from(i < 0.0);
+        TravRay {
+            ox: Vec4::splat(o.x),
+            oy: Vec4::splat(o.y),
+            oz: Vec4::splat(o.z),
+            ix: Vec4::splat(inv.x),
+            iy: Vec4::splat(inv.y),
+            iz: Vec4::splat(inv.z),
+            near: [near(inv.x, 0), near(inv.y, 1), near(inv.z, 2)],
+            t_min: Vec4::splat(t_min),
         }
     }
 }
@@ -611,4 +651,53 @@ fn median_bvh2(boxes: &[Aabb]) -> Bvh2 {
     }
     bvh.max_depth = bvh2_depth(&bvh).max(obvhs::bvh2::DEFAULT_MAX_STACK_DEPTH);
     bvh
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::Closest;
+    use crate::geometry::Methods;
+
+    /// A query that overflows the short stack continues on the long one and finds what brute
+    /// force finds: a one-entry short stack overflows on nearly every query.
+    #[test]
+    fn overflow_to_the_long_stack_finds_the_same_hits() {
+        let mut seed = 7u32;
+        let mut rnd = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed as f32 / u32::MAX as f32 * 2.0 - 1.0
+        };
+        let mut prims = Vec::new();
+        for id in 0..3000u32 {
+            let c = Vec3::new(rnd(), rnd(), rnd()) * 2.0;
+            let v = [0, 1, 2].map(|_| c + Vec3::new(rnd(), rnd(), rnd()) * 0.3);
+            prims.push(Prim {
+                shape: Shape::Triangle(v),
+                id,
+            });
+        }
+        let bvh = Bvh::build(prims.clone());
+        assert!(stack_need(&bvh.nodes) > 1);
+        let m = Methods::default();
+        let mut hits = 0;
+        for _ in 0..2000 {
+            let o = Vec3::new(rnd(), rnd(), rnd()) * 4.0;
+            let ray = Ray::new(o, (Vec3::new(rnd(), rnd(), rnd()) - o).normalize());
+            let mut brute = Closest::new(&m, &ray, 0.0, f32::INFINITY);
+            for p in &prims {
+                brute.visit(p);
+            }
+            let mut tiny = Closest::new(&m, &ray, 0.0, f32::INFINITY);
+            bvh.walk_from::<_, 1>(&TravRay::new(&ray, 0.0), &mut tiny, &[], 0);
+            let mut short = Closest::new(&m, &ray, 0.0, f32::INFINITY);
+            bvh.walk(&ray, 0.0, &mut short);
+            assert_eq!(tiny.hit(), brute.hit());
+            assert_eq!(short.hit(), brute.hit());
+            hits += usize::from(brute.hit().is_some());
+        }
+        assert!(hits > 1000, "{hits}");
+    }
 }
