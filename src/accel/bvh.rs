@@ -70,7 +70,8 @@ pub const MAX_STACKED: usize = 64;
 pub const MAX_BVH2_DEPTH: usize = 96;
 
 /// Traversal stack capacity in entries. The build checks the worst case of the tree (on any
-/// root-to-leaf path, the sum of each node's children but one) against it; the median-split
+/// root-to-leaf path, the sum of each node's children but one, plus 3 for the fixed-length
+/// push) against it; the median-split
 /// tree of up to 2²⁸ primitives needs at most 3 per level for about 13 levels.
 pub const STACK_SIZE: usize = 64;
 
@@ -150,7 +151,7 @@ impl Bvh {
                 params.search_depth_threshold,
             );
             ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
-            built = collapse(&bvh2, &prims).filter(|b| stack_need(&b.nodes) <= STACK_SIZE);
+            built = collapse(&bvh2, &prims).filter(|b| stack_need(&b.nodes) + 3 <= STACK_SIZE);
         }
         let bvh = built.unwrap_or_else(|| {
             let b = collapse(&median_bvh2(&boxes), &prims).unwrap_or_else(|| Bvh {
@@ -161,7 +162,7 @@ impl Bvh {
             });
             // A balanced binary tree of 2²⁸ leaves has depth 29; its 4-wide collapse needs
             // fewer than 3·15 stack entries.
-            debug_assert!(stack_need(&b.nodes) <= STACK_SIZE);
+            debug_assert!(stack_need(&b.nodes) + 3 <= STACK_SIZE);
             b
         });
         bvh
@@ -200,7 +201,11 @@ impl Bvh {
         mut word: u32,
     ) {
         let mut stack = [(0u32, 0f32); N];
-        stack[..seed.len()].copy_from_slice(seed);
+        // Element by element: these copies are short, and `copy_from_slice` of a variable
+        // length calls `memcpy`.
+        for (to, from) in stack.iter_mut().zip(seed) {
+            *to = *from;
+        }
         let mut sp = seed.len();
         let (nx, ny, nz) = (r.near[0], r.near[1], r.near[2]);
         let (fx, fy, fz) = (nx ^ 1, ny ^ 1, nz ^ 1);
@@ -255,14 +260,22 @@ impl Bvh {
                         k += 1;
                     }
                     word = hits[k - 1].0;
-                    if N < STACK_SIZE && sp + k - 1 > N {
+                    // Three entries are always written (only `k − 1` are kept): a fixed-length
+                    // copy, where a loop of 1 to 3 would mispredict.
+                    if N < STACK_SIZE && sp + 3 > N {
                         let mut deeper = [(0u32, 0f32); STACK_SIZE];
-                        deeper[..sp].copy_from_slice(&stack[..sp]);
-                        deeper[sp..sp + k - 1].copy_from_slice(&hits[..k - 1]);
+                        for (to, from) in deeper.iter_mut().zip(stack[..sp].iter()) {
+                            *to = *from;
+                        }
+                        for j in 0..k - 1 {
+                            deeper[sp + j] = hits[j];
+                        }
                         let seed = &deeper[..sp + k - 1];
                         return self.walk_from::<V, STACK_SIZE>(r, v, seed, word);
                     }
-                    stack[sp..sp + k - 1].copy_from_slice(&hits[..k - 1]);
+                    stack[sp] = hits[0];
+                    stack[sp + 1] = hits[1];
+                    stack[sp + 2] = hits[2];
                     sp += k - 1;
                     continue;
                 }
