@@ -153,7 +153,7 @@ impl Bvh {
             ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
             built = collapse(&bvh2, &prims).filter(|b| stack_need(&b.nodes) + 3 <= STACK_SIZE);
         }
-        let bvh = built.unwrap_or_else(|| {
+        built.unwrap_or_else(|| {
             let b = collapse(&median_bvh2(&boxes), &prims).unwrap_or_else(|| Bvh {
                 nodes: Vec::new(),
                 packets: Vec::new(),
@@ -164,8 +164,7 @@ impl Bvh {
             // fewer than 3·15 stack entries.
             debug_assert!(stack_need(&b.nodes) + 3 <= STACK_SIZE);
             b
-        });
-        bvh
+        })
     }
 
     pub(super) fn memory_bytes(&self) -> usize {
@@ -264,12 +263,8 @@ impl Bvh {
                     // copy, where a loop of 1 to 3 would mispredict.
                     if N < STACK_SIZE && sp + 3 > N {
                         let mut deeper = [(0u32, 0f32); STACK_SIZE];
-                        for (to, from) in deeper.iter_mut().zip(stack[..sp].iter()) {
-                            *to = *from;
-                        }
-                        for j in 0..k - 1 {
-                            deeper[sp + j] = hits[j];
-                        }
+                        deeper[..sp].copy_from_slice(&stack[..sp]);
+                        deeper[sp..sp + k - 1].copy_from_slice(&hits[..k - 1]);
                         let seed = &deeper[..sp + k - 1];
                         return self.walk_from::<V, STACK_SIZE>(r, v, seed, word);
                     }
