@@ -70,9 +70,13 @@ pub const MAX_STACKED: usize = 64;
 pub const MAX_BVH2_DEPTH: usize = 96;
 
 /// Traversal stack capacity in entries. The build checks the worst case of the tree (on any
-/// root-to-leaf path, the sum of each node's children but one) against it; the median-split
+/// root-to-leaf path, the sum of each node's children but one, plus 3 for the fixed-length
+/// push) against it; the median-split
 /// tree of up to 2²⁸ primitives needs at most 3 per level for about 13 levels.
 pub const STACK_SIZE: usize = 64;
+
+/// Entries of the stack a query starts with; deeper queries continue on a [`STACK_SIZE`] one.
+const SHORT_STACK: usize = 16;
 
 /// Most triangles in one leaf: one four-lane test. A leaf holds triangles or one sphere.
 pub const MAX_LEAF: usize = 4;
@@ -147,9 +151,7 @@ impl Bvh {
                 params.search_depth_threshold,
             );
             ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
-            if bvh2_depth(&bvh2) <= MAX_BVH2_DEPTH {
-                built = collapse(&bvh2, &prims).filter(|b| stack_need(&b.nodes) <= STACK_SIZE);
-            }
+            built = collapse(&bvh2, &prims).filter(|b| stack_need(&b.nodes) + 3 <= STACK_SIZE);
         }
         built.unwrap_or_else(|| {
             let b = collapse(&median_bvh2(&boxes), &prims).unwrap_or_else(|| Bvh {
@@ -160,7 +162,7 @@ impl Bvh {
             });
             // A balanced binary tree of 2²⁸ leaves has depth 29; its 4-wide collapse needs
             // fewer than 3·15 stack entries.
-            debug_assert!(stack_need(&b.nodes) <= STACK_SIZE);
+            debug_assert!(stack_need(&b.nodes) + 3 <= STACK_SIZE);
             b
         })
     }
@@ -182,20 +184,30 @@ impl Bvh {
         if self.nodes.is_empty() {
             return;
         }
-        let inv = trav_inv(ray.dir);
-        let o = ray.origin;
-        let (ox, oy, oz) = (Vec4::splat(o.x), Vec4::splat(o.y), Vec4::splat(o.z));
-        let (ix, iy, iz) = (Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z));
-        // For a negative direction the max plane is entered first.
-        let near = |i: f32, axis: usize| 2 * axis + usize::from(i < 0.0);
-        let (nx, ny, nz) = (near(inv.x, 0), near(inv.y, 1), near(inv.z, 2));
-        let (fx, fy, fz) = (nx ^ 1, ny ^ 1, nz ^ 1);
-        let slack = Vec4::splat(box_t_slack());
-        let t_min4 = Vec4::splat(t_min);
+        let r = TravRay::new(ray, t_min);
+        self.walk_from::<V, SHORT_STACK>(&r, v, &[], 0);
+    }
 
-        let mut stack = [(0u32, 0f32); STACK_SIZE];
-        let mut sp = 0usize;
-        let mut word = 0u32;
+    /// The traversal loop from child word `word` with `seed` on a stack of `N` entries. A
+    /// query starts on a short stack (clearing it is part of every query's cost) and, in the
+    /// rare case it would overflow, continues on a [`STACK_SIZE`] one.
+    #[inline(always)]
+    fn walk_from<V: Visitor, const N: usize>(
+        &self,
+        r: &TravRay,
+        v: &mut V,
+        seed: &[(u32, f32)],
+        mut word: u32,
+    ) {
+        let mut stack = [(0u32, 0f32); N];
+        // Element by element: these copies are short, and `copy_from_slice` of a variable
+        // length calls `memcpy`.
+        for (to, from) in stack.iter_mut().zip(seed) {
+            *to = *from;
+        }
+        let mut sp = seed.len();
+        let (nx, ny, nz) = (r.near[0], r.near[1], r.near[2]);
+        let (fx, fy, fz) = (nx ^ 1, ny ^ 1, nz ^ 1);
         loop {
             if word & LEAF != 0 {
                 let stop = if word & SPHERE != 0 {
@@ -210,16 +222,17 @@ impl Bvh {
             } else {
                 let node = &self.nodes[word as usize];
                 let p = &node.planes;
-                let t_near = ((p[nx] - ox) * ix)
-                    .max((p[ny] - oy) * iy)
-                    .max((p[nz] - oz) * iz);
-                let t_far = ((p[fx] - ox) * ix)
-                    .min((p[fy] - oy) * iy)
-                    .min((p[fz] - oz) * iz);
+                let t_near = ((p[nx] - r.ox) * r.ix)
+                    .max((p[ny] - r.oy) * r.iy)
+                    .max((p[nz] - r.oz) * r.iz);
+                let t_far = ((p[fx] - r.ox) * r.ix)
+                    .min((p[fy] - r.oy) * r.iy)
+                    .min((p[fz] - r.oz) * r.iz);
                 // Widen both ends by the rounding of the slab arithmetic *and* of the
                 // primitives' own t: a tie (equal t, lower id) in a flat box must not be
                 // culled by an ulp.
-                let t_near = (t_near - t_near.abs() * slack).max(t_min4);
+                let slack = Vec4::splat(box_t_slack());
+                let t_near = (t_near - t_near.abs() * slack).max(r.t_min);
                 let t_far = (t_far + t_far.abs() * slack).min(Vec4::splat(v.limit()));
                 let mut mask = t_near.cmple(t_far).bitmask() & node.valid;
                 if mask != 0 {
@@ -228,36 +241,37 @@ impl Bvh {
                         continue;
                     }
                     let t = t_near.to_array();
-                    if V::ORDERED {
-                        // Up to four hits, sorted farthest first; all but the nearest are
-                        // pushed with their entry t.
-                        let mut hits = [(0u32, 0f32); 4];
-                        let mut k = 0;
-                        while mask != 0 {
-                            let i = mask.trailing_zeros() as usize;
-                            mask &= mask - 1;
-                            let mut j = k;
+                    // Up to four hits; all but the one taken next are pushed with their
+                    // entry t (sorted farthest first when ordered, so the nearest is next).
+                    let mut hits = [(0u32, 0f32); 4];
+                    let mut k = 0;
+                    while mask != 0 {
+                        let i = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        let mut j = k;
+                        if V::ORDERED {
                             while j > 0 && hits[j - 1].1 < t[i] {
                                 hits[j] = hits[j - 1];
                                 j -= 1;
                             }
-                            hits[j] = (node.child[i], t[i]);
-                            k += 1;
                         }
-                        stack[sp..sp + k - 1].copy_from_slice(&hits[..k - 1]);
-                        sp += k - 1;
-                        word = hits[k - 1].0;
-                    } else {
-                        let i = mask.trailing_zeros() as usize;
-                        mask &= mask - 1;
-                        word = node.child[i];
-                        while mask != 0 {
-                            let j = mask.trailing_zeros() as usize;
-                            mask &= mask - 1;
-                            stack[sp] = (node.child[j], t[j]);
-                            sp += 1;
-                        }
+                        hits[j] = (node.child[i], t[i]);
+                        k += 1;
                     }
+                    word = hits[k - 1].0;
+                    // Three entries are always written (only `k − 1` are kept): a fixed-length
+                    // copy, where a loop of 1 to 3 would mispredict.
+                    if N < STACK_SIZE && sp + 3 > N {
+                        let mut deeper = [(0u32, 0f32); STACK_SIZE];
+                        deeper[..sp].copy_from_slice(&stack[..sp]);
+                        deeper[sp..sp + k - 1].copy_from_slice(&hits[..k - 1]);
+                        let seed = &deeper[..sp + k - 1];
+                        return self.walk_from::<V, STACK_SIZE>(r, v, seed, word);
+                    }
+                    stack[sp] = hits[0];
+                    stack[sp + 1] = hits[1];
+                    stack[sp + 2] = hits[2];
+                    sp += k - 1;
                     continue;
                 }
             }
@@ -273,6 +287,39 @@ impl Bvh {
                     break;
                 }
             }
+        }
+    }
+}
+
+/// A ray prepared for the node test.
+struct TravRay {
+    ox: Vec4,
+    oy: Vec4,
+    oz: Vec4,
+    ix: Vec4,
+    iy: Vec4,
+    iz: Vec4,
+    /// Per axis, the plane index entered first: `2·axis`, `+1` (the max plane) for a
+    /// negative direction.
+    near: [usize; 3],
+    t_min: Vec4,
+}
+
+impl TravRay {
+    #[inline(always)]
+    fn new(ray: &Ray, t_min: f32) -> Self {
+        let inv = trav_inv(ray.dir);
+        let o = ray.origin;
+        let near = |i: f32, axis: usize| 2 * axis + usize::from(i < 0.0);
+        TravRay {
+            ox: Vec4::splat(o.x),
+            oy: Vec4::splat(o.y),
+            oz: Vec4::splat(o.z),
+            ix: Vec4::splat(inv.x),
+            iy: Vec4::splat(inv.y),
+            iz: Vec4::splat(inv.z),
+            near: [near(inv.x, 0), near(inv.y, 1), near(inv.z, 2)],
+            t_min: Vec4::splat(t_min),
         }
     }
 }
@@ -300,31 +347,49 @@ fn padded(b: &Aabb) -> (Vec3A, Vec3A) {
 }
 
 /// The 4-wide tree of a binary BVH whose leaves hold one primitive each (PLOC's and
-/// [`median_bvh2`]'s do); `None` for an empty tree.
+/// [`median_bvh2`]'s do) and whose children come after their parents; `None` for an empty
+/// tree or one deeper than [`MAX_BVH2_DEPTH`].
 fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
     if bvh2.nodes.is_empty() {
         return None;
     }
     let n = bvh2.nodes.len();
-    // Pre-order, so that reversed it is bottom-up.
-    let mut order = Vec::with_capacity(n);
-    let mut todo = vec![0usize];
-    while let Some(i) = todo.pop() {
+    // Pre-order (parents before children) and the tree's depth.
+    let mut order: Vec<u32> = Vec::with_capacity(n);
+    let mut todo = vec![(0u32, 1usize)];
+    let mut bvh2_depth = 0;
+    while let Some((i, d)) = todo.pop() {
         order.push(i);
-        let node = &bvh2.nodes[i];
+        bvh2_depth = bvh2_depth.max(d);
+        let node = &bvh2.nodes[i as usize];
         if node.prim_count == 0 {
-            todo.push(node.first_index as usize);
-            todo.push(node.first_index as usize + 1);
+            todo.push((node.first_index + 1, d + 1));
+            todo.push((node.first_index, d + 1));
         }
     }
-    // Bottom up: primitives under each node and the surface-area cost of its best subtree;
-    // `leaf[i]` when the node's subtree is cheaper as one leaf.
-    let is_sphere = |i: usize| matches!(prims[i].shape, Shape::Sphere { .. });
+    if bvh2_depth > MAX_BVH2_DEPTH {
+        return None;
+    }
+    // Bottom up (reverse index order): primitives under each node and the surface-area cost
+    // of its best subtree; `leaf[i]` when the node's subtree is cheaper as one leaf.
+    // `Accel` lists the spheres first: an index tells the kind without reading the primitive
+    // (reading them in tree order misses the cache on every one).
+    let sphere_count = prims
+        .iter()
+        .take_while(|p| matches!(p.shape, Shape::Sphere { .. }))
+        .count();
+    debug_assert!(
+        prims[sphere_count..]
+            .iter()
+            .all(|p| matches!(p.shape, Shape::Triangle(_)))
+    );
+    let is_sphere = |i: usize| i < sphere_count;
     let mut count = vec![0u32; n];
     let mut spheres = vec![0u32; n];
     let mut cost = vec![0f32; n];
     let mut leaf = vec![false; n];
     for &i in order.iter().rev() {
+        let i = i as usize;
         let node = &bvh2.nodes[i];
         let area = node.aabb.half_area().max(0.0);
         if node.prim_count > 0 {
@@ -350,10 +415,10 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
     }
 
     let mut nodes: Vec<Node> = Vec::new();
-    let mut packets: Vec<Packet> = Vec::new();
     let mut sphere_leaves: Vec<Prim> = Vec::new();
-    let mut leaf_tris: Vec<[Vec3; 3]> = Vec::with_capacity(MAX_LEAF);
-    let mut leaf_ids = [0u32; 4];
+    // Each triangle leaf's primitive indices, four per leaf (the first repeated); gathered into
+    // packets afterwards in one tight loop, whose independent loads overlap their cache misses.
+    let mut leaf_prims: Vec<[u32; 4]> = Vec::new();
     let mut depth = 0;
     // (binary node, wide node to fill, its depth); the root's slots are the root's children,
     // or the root itself when it is a leaf.
@@ -364,34 +429,41 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
         depth = depth.max(d);
         // (binary node, how many times opened); a tie in area opens the shallower child, so
         // equal boxes (a median-split tree of duplicates) collapse evenly.
-        let mut slots: Vec<(usize, u32)> = if leaf[b] {
-            vec![(b, 0)]
+        let mut slots = [(0usize, 0u32); 4];
+        let mut len = if leaf[b] {
+            slots[0] = (b, 0);
+            1
         } else {
             let f = bvh2.nodes[b].first_index as usize;
-            vec![(f, 0), (f + 1, 0)]
+            slots[0] = (f, 0);
+            slots[1] = (f + 1, 0);
+            2
         };
         // Open the largest inner child until there are four.
-        while slots.len() < 4 {
-            let area = |s: usize| bvh2.nodes[s].aabb.half_area();
-            let best = slots
-                .iter()
-                .enumerate()
-                .filter(|&(_, &(s, _))| !leaf[s])
-                .max_by(|(i, (a, la)), (j, (b, lb))| {
-                    area(*a)
-                        .total_cmp(&area(*b))
-                        .then(lb.cmp(la))
-                        .then(j.cmp(i))
-                })
-                .map(|(k, _)| k);
-            let Some(k) = best else { break };
-            let (s, level) = slots[k];
-            let f = bvh2.nodes[s].first_index as usize;
-            slots[k] = (f, level + 1);
-            slots.insert(k + 1, (f + 1, level + 1));
+        while len < 4 {
+            let mut best: Option<(usize, f32, u32)> = None;
+            for (k, &(s, opened)) in slots[..len].iter().enumerate() {
+                if leaf[s] {
+                    continue;
+                }
+                let area = bvh2.nodes[s].aabb.half_area();
+                let better = match best {
+                    None => true,
+                    Some((_, a, o)) => area > a || (area == a && opened < o),
+                };
+                if better {
+                    best = Some((k, area, opened));
+                }
+            }
+            let Some((k, _, opened)) = best else { break };
+            let f = bvh2.nodes[slots[k].0].first_index as usize;
+            slots.copy_within(k + 1..len, k + 2);
+            slots[k] = (f, opened + 1);
+            slots[k + 1] = (f + 1, opened + 1);
+            len += 1;
         }
         let mut node = empty_node();
-        for (slot, &(s, _)) in slots.iter().enumerate() {
+        for (slot, &(s, _)) in slots[..len].iter().enumerate() {
             let (lo, hi) = padded(&bvh2.nodes[s].aabb);
             for (axis, (l, h)) in [(lo.x, hi.x), (lo.y, hi.y), (lo.z, hi.z)]
                 .into_iter()
@@ -407,31 +479,25 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
                 sphere_leaves.push(prims[id]);
             } else if leaf[s] {
                 // The subtree's triangles, left to right, as one packet.
-                leaf_tris.clear();
+                let mut ids = [0u32; 4];
+                let mut c = 0;
                 under.clear();
                 under.push(s);
                 while let Some(u) = under.pop() {
                     let un = &bvh2.nodes[u];
                     if un.prim_count > 0 {
-                        let id = bvh2.primitive_indices[un.first_index as usize] as usize;
-                        if let Shape::Triangle(v) = prims[id].shape {
-                            leaf_ids[leaf_tris.len()] = prims[id].id;
-                            leaf_tris.push(v);
-                        }
+                        ids[c] = bvh2.primitive_indices[un.first_index as usize];
+                        c += 1;
                     } else {
                         under.push(un.first_index as usize + 1);
                         under.push(un.first_index as usize);
                     }
                 }
-                let c = leaf_tris.len();
                 for k in c..4 {
-                    leaf_ids[k] = leaf_ids[0];
+                    ids[k] = ids[0];
                 }
-                node.child[slot] = LEAF | ((packets.len() as u32) << 2) | (c as u32 - 1);
-                packets.push(Packet {
-                    tris: Triangles4::new(&leaf_tris),
-                    ids: leaf_ids,
-                });
+                node.child[slot] = LEAF | ((leaf_prims.len() as u32) << 2) | (c as u32 - 1);
+                leaf_prims.push(ids);
             } else {
                 let index = nodes.len() as u32;
                 nodes.push(empty_node());
@@ -442,7 +508,21 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
         nodes[w as usize] = node;
     }
     nodes.shrink_to_fit();
-    packets.shrink_to_fit();
+    let triangle = |i: u32| match prims[i as usize].shape {
+        Shape::Triangle(v) => (v, prims[i as usize].id),
+        // Leaves hold no spheres (`spheres[s] == 0`).
+        Shape::Sphere { .. } => unreachable!("a sphere in a triangle leaf"),
+    };
+    let packets = leaf_prims
+        .iter()
+        .map(|ids| {
+            let t = ids.map(triangle);
+            Packet {
+                tris: Triangles4::new(&t.map(|(v, _)| v)),
+                ids: t.map(|(_, id)| id),
+            }
+        })
+        .collect();
     Some(Bvh {
         nodes,
         packets,
@@ -579,4 +659,53 @@ fn median_bvh2(boxes: &[Aabb]) -> Bvh2 {
     }
     bvh.max_depth = bvh2_depth(&bvh).max(obvhs::bvh2::DEFAULT_MAX_STACK_DEPTH);
     bvh
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::Closest;
+    use crate::geometry::Methods;
+
+    /// A query that overflows the short stack continues on the long one and finds what brute
+    /// force finds: a one-entry short stack overflows on nearly every query.
+    #[test]
+    fn overflow_to_the_long_stack_finds_the_same_hits() {
+        let mut seed = 7u32;
+        let mut rnd = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed as f32 / u32::MAX as f32 * 2.0 - 1.0
+        };
+        let mut prims = Vec::new();
+        for id in 0..3000u32 {
+            let c = Vec3::new(rnd(), rnd(), rnd()) * 2.0;
+            let v = [0, 1, 2].map(|_| c + Vec3::new(rnd(), rnd(), rnd()) * 0.3);
+            prims.push(Prim {
+                shape: Shape::Triangle(v),
+                id,
+            });
+        }
+        let bvh = Bvh::build(prims.clone());
+        assert!(stack_need(&bvh.nodes) > 1);
+        let m = Methods::default();
+        let mut hits = 0;
+        for _ in 0..2000 {
+            let o = Vec3::new(rnd(), rnd(), rnd()) * 4.0;
+            let ray = Ray::new(o, (Vec3::new(rnd(), rnd(), rnd()) - o).normalize());
+            let mut brute = Closest::new(&m, &ray, 0.0, f32::INFINITY);
+            for p in &prims {
+                brute.visit(p);
+            }
+            let mut tiny = Closest::new(&m, &ray, 0.0, f32::INFINITY);
+            bvh.walk_from::<_, 1>(&TravRay::new(&ray, 0.0), &mut tiny, &[], 0);
+            let mut short = Closest::new(&m, &ray, 0.0, f32::INFINITY);
+            bvh.walk(&ray, 0.0, &mut short);
+            assert_eq!(tiny.hit(), brute.hit());
+            assert_eq!(short.hit(), brute.hit());
+            hits += usize::from(brute.hit().is_some());
+        }
+        assert!(hits > 1000, "{hits}");
+    }
 }

@@ -427,21 +427,37 @@ impl Shear {
             b1: (e1 * inv_det).to_array(),
             b2: (e2 * inv_det).to_array(),
         };
-        let mut rest = on_edge;
-        while rest != 0 {
-            let lane = rest.trailing_zeros() as usize;
-            rest &= rest - 1;
+        if on_edge != 0 {
+            self.on_edges(&mut hits, on_edge, tris, ray, t_min, t_max);
+        }
+        hits
+    }
+
+    /// The lanes in `lanes` (an edge function exactly 0), answered by the scalar test.
+    #[cold]
+    #[inline(never)]
+    fn on_edges(
+        &self,
+        hits: &mut TriHits4,
+        mut lanes: u32,
+        tris: &Triangles4,
+        ray: &Ray,
+        t_min: f32,
+        t_max: f32,
+    ) {
+        while lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
             hits.set(
                 lane,
                 self.intersect(&tris.triangle(lane), ray, t_min, t_max),
             );
         }
-        hits
     }
 }
 
 /// [`intersect_triangle`] of every lane of `tris`, in lanes `0..count` (the others miss).
-#[inline]
+#[inline(always)]
 pub fn intersect_triangles4(
     method: TriangleMethod,
     shear: Option<&Shear>,
@@ -459,17 +475,26 @@ pub fn intersect_triangles4(
             hits
         }
         (TriangleMethod::Watertight, None) => TriHits4::default(),
-        (method, _) => {
-            let mut hits = TriHits4::default();
-            for lane in 0..count {
-                hits.set(
-                    lane,
-                    intersect_triangle(method, &tris.triangle(lane), ray, t_min, t_max),
-                );
-            }
-            hits
-        }
+        (method, _) => one_by_one(method, tris, count, ray, t_min, t_max),
     }
+}
+
+/// The methods without a four-lane form, lane by lane.
+#[inline(never)]
+fn one_by_one(
+    method: TriangleMethod,
+    tris: &Triangles4,
+    count: usize,
+    ray: &Ray,
+    t_min: f32,
+    t_max: f32,
+) -> TriHits4 {
+    let mut hits = TriHits4::default();
+    for lane in 0..count {
+        let tri = tris.triangle(lane);
+        hits.set(lane, intersect_triangle(method, &tri, ray, t_min, t_max));
+    }
+    hits
 }
 
 /// The point with barycentric weights `(1 − b1 − b2, b1, b2)` and a per-axis bound on its
