@@ -2,7 +2,7 @@
 //! same code for the command line (`raytree bench`, `raytree stability`), the tests and the
 //! viewer:
 //!
-//! - [`bench`]: the sweep of every knob that trades render time for image error, the Pareto
+//! - [`bench`](mod@bench): the sweep of every knob that trades render time for image error, the Pareto
 //!   front, and the accelerator scaling sweep whose crossovers set `AccelKind::Auto`;
 //! - [`stability`]: the measurements of the stability matrix, naive against robust methods;
 //! - [`rows`]: the matrix's rows built from them over log-spaced sweeps (table, charts, JSON);

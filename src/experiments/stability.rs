@@ -1,5 +1,5 @@
 //! The stability matrix of `STABILITY.md`: for each row, the measurement (a function of the
-//! method, the point of the sweep and a seeded RNG) and the row as a whole ([`rows`]: the
+//! method, the point of the sweep and a seeded RNG) and the row as a whole ([`super::rows`]: the
 //! sweep, a headline for the naive and the robust method, a pass/fail against the target and
 //! a chart). `raytree stability` prints the rows; `tests/stability.rs` and `tests/geometry.rs`
 //! call the very same measurement functions with fewer rays and assert the documented points.
