@@ -15,6 +15,15 @@ use raytree::scene::{self, Scene, Shading};
 use raytree::trace::{TraceSettings, Tracer};
 use raytree::{export, ray_tree};
 
+/// `println!` that ignores a closed stdout (`raytree … | head -1`): a broken pipe is not an
+/// error worth a panic.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 /// raytree: recursive (Whitted) ray tracing with the ray tracing tree of every pixel.
 ///
 /// SCENE is a scene file (.toml), a bare OBJ file (.obj), or the name of a built-in scene:
@@ -293,7 +302,7 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         export::write_text(path, &json)?;
     }
     let r = &stats.rays;
-    println!(
+    out!(
         "wrote {} ({}x{}, {} spp, max depth {}, {} threads, accel {:?})",
         args.output.display(),
         stats.width,
@@ -303,7 +312,7 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         stats.threads,
         stats.accel.unwrap_or_default(),
     );
-    println!(
+    out!(
         "rays: {} primary, {} reflected, {} refracted, {} shadow, {} in all",
         r.primary,
         r.reflected,
@@ -311,7 +320,7 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         r.shadow,
         r.total()
     );
-    println!(
+    out!(
         "time: load {:.3} s, build {:.3} s, render {:.3} s, {:.2} Mrays/s",
         load_secs,
         stats.build_secs,
@@ -320,7 +329,7 @@ fn run_render(args: &RenderArgs) -> Result<()> {
     );
     if args.stats {
         let m = bench::MemoryStats::of(&tracer);
-        println!(
+        out!(
             "memory: accelerator {} B + scene records {} B for {} triangles and {} spheres = \
              {:.1} B per primitive ({} skipped{})",
             m.accel_bytes,
@@ -384,7 +393,7 @@ fn run_bench(args: &BenchArgs) -> Result<()> {
         let report = bench::run_sweep(&scene, &opts, &show_on(&bar), &cancel)?;
         bar.finish_and_clear();
         bench::write_bench(&args.out, &report, &args.scene)?;
-        println!(
+        out!(
             "wrote {} and bench.svg/.png ({} points, reference {}x{} at {} spp, depth {}, {:.1} s)",
             args.out.join("bench.csv").display(),
             report.points.len(),
@@ -394,9 +403,9 @@ fn run_bench(args: &BenchArgs) -> Result<()> {
             report.reference.max_depth,
             report.reference.secs
         );
-        println!("Pareto-optimal settings (time against mean FLIP):");
+        out!("Pareto-optimal settings (time against mean FLIP):");
         for line in bench::pareto_lines(&report) {
-            println!("  {line}");
+            out!("  {line}");
         }
         changed = bench::accel_changes(&report)
             .iter()
@@ -404,9 +413,7 @@ fn run_bench(args: &BenchArgs) -> Result<()> {
             .map(|(k, n)| format!("{} changed {n} pixels", bench::value_name(k)))
             .collect();
         if changed.is_empty() {
-            println!(
-                "accelerators: none, grid and bvh give the identical image (0 differing pixels)"
-            );
+            out!("accelerators: none, grid and bvh give the identical image (0 differing pixels)");
         }
     }
     if !args.no_scaling {
@@ -414,12 +421,12 @@ fn run_bench(args: &BenchArgs) -> Result<()> {
         let points = bench::run_scaling(&scaling, &show_on(&bar), &cancel)?;
         bar.finish_and_clear();
         bench::write_scaling(&args.out, &points, &scaling)?;
-        println!(
+        out!(
             "wrote {} and scaling.svg/.png",
             args.out.join("scaling.csv").display()
         );
         for line in bench::crossover_lines(&points) {
-            println!("  {line}");
+            out!("  {line}");
         }
     }
     if !changed.is_empty() {
@@ -442,14 +449,14 @@ fn run_stability(args: &StabilityArgs) -> Result<()> {
     rows::write_stability(&args.out, &measured)?;
     if args.json {
         for row in &measured {
-            println!(
+            out!(
                 "{}",
                 serde_json::to_string(row).context("cannot encode a row")?
             );
         }
     } else {
-        print!("{}", rows::markdown_table(&measured));
-        println!(
+        out!("{}", rows::markdown_table(&measured).trim_end());
+        out!(
             "wrote {} and the charts",
             args.out.join("stability.md").display()
         );
@@ -480,12 +487,15 @@ fn run_tree(args: &TreeArgs) -> Result<()> {
     let tracer = Tracer::new(Arc::new(scene), trace);
     let tree = ray_tree::pixel_tree(&tracer, x, y).context("the pixel has no tree")?;
     if args.json {
-        println!(
+        out!(
             "{}",
             serde_json::to_string_pretty(&tree).context("cannot encode the tree")?
         );
     } else {
-        print!("{}", ray_tree::tree_text(&tree));
+        {
+            use std::io::Write as _;
+            let _ = write!(std::io::stdout(), "{}", ray_tree::tree_text(&tree));
+        }
     }
     Ok(())
 }
@@ -498,7 +508,7 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::Stability(args)) => run_stability(&args),
         Some(Command::Scenes) => {
             for name in scene::builtin::NAMES {
-                println!("{name}");
+                out!("{name}");
             }
             Ok(())
         }
