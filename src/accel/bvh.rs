@@ -52,6 +52,7 @@ use obvhs::{
     bvh2::{Bvh2, node::Bvh2Node, reinsertion::ReinsertionOptimizer},
     ploc::PlocBuilder,
 };
+use rayon::prelude::*;
 
 use super::{Prim, Shape, Visitor, box_t_slack};
 use crate::geometry::{Ray, Triangles4};
@@ -129,7 +130,7 @@ impl Bvh {
         // `Accel` refuses to build this far (see there); ids would not fit a leaf word.
         assert!(prims.len() <= MAX_PRIMS, "more than 2^28 primitives");
         let boxes: Vec<Aabb> = prims
-            .iter()
+            .par_iter()
             .map(|p| {
                 let (lo, hi) = p.bounds();
                 Aabb::new(lo.into(), hi.into())
@@ -139,7 +140,7 @@ impl Bvh {
         let mut built = None;
         if max_stacked(&boxes) <= MAX_STACKED {
             let jittered: Vec<Aabb> = boxes
-                .iter()
+                .par_iter()
                 .enumerate()
                 .map(|(i, b)| jitter(b, i))
                 .collect();
@@ -346,32 +347,63 @@ fn padded(b: &Aabb) -> (Vec3A, Vec3A) {
     (b.min - pad, b.max + pad)
 }
 
-/// The 4-wide tree of a binary BVH whose leaves hold one primitive each (PLOC's and
-/// [`median_bvh2`]'s do) and whose children come after their parents; `None` for an empty
-/// tree or one deeper than [`MAX_BVH2_DEPTH`].
-fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
+/// One node of a binary BVH copied in pre-order (depth first, left child first): the left
+/// child of an inner node `i` is `i + 1`, and a subtree is a contiguous run.
+#[derive(Clone, Copy)]
+struct FlatNode {
+    aabb: Aabb,
+    /// The right child (inner nodes) or the primitive index (leaves).
+    link: u32,
+    leaf: bool,
+}
+
+/// `bvh2` in pre-order, or `None` when it is empty or deeper than [`MAX_BVH2_DEPTH`]. This is
+/// the one pass that follows the build's node order (after reinsertion, scattered over memory:
+/// a cache miss per node); everything after it reads the copy front to back or back to front.
+fn preorder(bvh2: &Bvh2) -> Option<Vec<FlatNode>> {
     if bvh2.nodes.is_empty() {
         return None;
     }
-    let n = bvh2.nodes.len();
-    // Pre-order (parents before children) and the tree's depth.
-    let mut order: Vec<u32> = Vec::with_capacity(n);
-    let mut todo = vec![(0u32, 1usize)];
-    let mut bvh2_depth = 0;
-    while let Some((i, d)) = todo.pop() {
-        order.push(i);
-        bvh2_depth = bvh2_depth.max(d);
+    let mut flat: Vec<FlatNode> = Vec::with_capacity(bvh2.nodes.len());
+    // (binary node, pre-order index of the parent whose right child it is, depth)
+    let mut todo = vec![(0u32, u32::MAX, 1usize)];
+    while let Some((i, parent, d)) = todo.pop() {
+        if d > MAX_BVH2_DEPTH {
+            return None;
+        }
+        let here = flat.len() as u32;
+        if parent != u32::MAX {
+            flat[parent as usize].link = here;
+        }
         let node = &bvh2.nodes[i as usize];
         if node.prim_count == 0 {
-            todo.push((node.first_index + 1, d + 1));
-            todo.push((node.first_index, d + 1));
+            flat.push(FlatNode {
+                aabb: node.aabb,
+                link: 0,
+                leaf: false,
+            });
+            todo.push((node.first_index + 1, here, d + 1));
+            todo.push((node.first_index, u32::MAX, d + 1));
+        } else {
+            assert!(node.prim_count == 1, "binary leaves hold one primitive");
+            flat.push(FlatNode {
+                aabb: node.aabb,
+                link: bvh2.primitive_indices[node.first_index as usize],
+                leaf: true,
+            });
         }
     }
-    if bvh2_depth > MAX_BVH2_DEPTH {
-        return None;
-    }
-    // Bottom up (reverse index order): primitives under each node and the surface-area cost
-    // of its best subtree; `leaf[i]` when the node's subtree is cheaper as one leaf.
+    Some(flat)
+}
+
+/// The 4-wide tree of a binary BVH whose leaves hold one primitive each (PLOC's and
+/// [`median_bvh2`]'s do); `None` for an empty tree or one deeper than [`MAX_BVH2_DEPTH`].
+fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
+    let flat = preorder(bvh2)?;
+    let n = flat.len();
+    let right = |i: usize| flat[i].link as usize;
+    // Bottom up (reverse pre-order): primitives under each node and the surface-area cost of
+    // its best subtree; `leaf[i]` when the node's subtree is cheaper as one leaf.
     // `Accel` lists the spheres first: an index tells the kind without reading the primitive
     // (reading them in tree order misses the cache on every one).
     let sphere_count = prims
@@ -388,19 +420,17 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
     let mut spheres = vec![0u32; n];
     let mut cost = vec![0f32; n];
     let mut leaf = vec![false; n];
-    for &i in order.iter().rev() {
-        let i = i as usize;
-        let node = &bvh2.nodes[i];
+    for i in (0..n).rev() {
+        let node = &flat[i];
         let area = node.aabb.half_area().max(0.0);
-        if node.prim_count > 0 {
-            assert!(node.prim_count == 1, "binary leaves hold one primitive");
-            let sphere = is_sphere(bvh2.primitive_indices[node.first_index as usize] as usize);
+        if node.leaf {
+            let sphere = is_sphere(node.link as usize);
             count[i] = 1;
             spheres[i] = u32::from(sphere);
             cost[i] = if sphere { SPHERE_COST } else { PACKET_COST } * area;
             leaf[i] = true;
         } else {
-            let (l, r) = (node.first_index as usize, node.first_index as usize + 1);
+            let (l, r) = (i + 1, right(i));
             count[i] = count[l] + count[r];
             spheres[i] = spheres[l] + spheres[r];
             let split = NODE_COST * area + cost[l] + cost[r];
@@ -424,7 +454,6 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
     // or the root itself when it is a leaf.
     let mut todo = vec![(0usize, 0u32, 1usize)];
     nodes.push(empty_node());
-    let mut under = Vec::new();
     while let Some((b, w, d)) = todo.pop() {
         depth = depth.max(d);
         // (binary node, how many times opened); a tie in area opens the shallower child, so
@@ -434,9 +463,8 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
             slots[0] = (b, 0);
             1
         } else {
-            let f = bvh2.nodes[b].first_index as usize;
-            slots[0] = (f, 0);
-            slots[1] = (f + 1, 0);
+            slots[0] = (b + 1, 0);
+            slots[1] = (right(b), 0);
             2
         };
         // Open the largest inner child until there are four.
@@ -446,7 +474,7 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
                 if leaf[s] {
                     continue;
                 }
-                let area = bvh2.nodes[s].aabb.half_area();
+                let area = flat[s].aabb.half_area();
                 let better = match best {
                     None => true,
                     Some((_, a, o)) => area > a || (area == a && opened < o),
@@ -456,15 +484,15 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
                 }
             }
             let Some((k, _, opened)) = best else { break };
-            let f = bvh2.nodes[slots[k].0].first_index as usize;
+            let s = slots[k].0;
             slots.copy_within(k + 1..len, k + 2);
-            slots[k] = (f, opened + 1);
-            slots[k + 1] = (f + 1, opened + 1);
+            slots[k] = (s + 1, opened + 1);
+            slots[k + 1] = (right(s), opened + 1);
             len += 1;
         }
         let mut node = empty_node();
         for (slot, &(s, _)) in slots[..len].iter().enumerate() {
-            let (lo, hi) = padded(&bvh2.nodes[s].aabb);
+            let (lo, hi) = padded(&flat[s].aabb);
             for (axis, (l, h)) in [(lo.x, hi.x), (lo.y, hi.y), (lo.z, hi.z)]
                 .into_iter()
                 .enumerate()
@@ -474,24 +502,15 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
             }
             node.valid |= 1 << slot;
             if leaf[s] && spheres[s] == 1 {
-                let id = bvh2.primitive_indices[bvh2.nodes[s].first_index as usize] as usize;
                 node.child[slot] = LEAF | SPHERE | sphere_leaves.len() as u32;
-                sphere_leaves.push(prims[id]);
+                sphere_leaves.push(prims[flat[s].link as usize]);
             } else if leaf[s] {
-                // The subtree's triangles, left to right, as one packet.
+                // The subtree's triangles, left to right: the leaves of its run of
+                // `2·count − 1` nodes, as one packet.
+                let c = count[s] as usize;
                 let mut ids = [0u32; 4];
-                let mut c = 0;
-                under.clear();
-                under.push(s);
-                while let Some(u) = under.pop() {
-                    let un = &bvh2.nodes[u];
-                    if un.prim_count > 0 {
-                        ids[c] = bvh2.primitive_indices[un.first_index as usize];
-                        c += 1;
-                    } else {
-                        under.push(un.first_index as usize + 1);
-                        under.push(un.first_index as usize);
-                    }
+                for (k, f) in flat[s..s + 2 * c - 1].iter().filter(|f| f.leaf).enumerate() {
+                    ids[k] = f.link;
                 }
                 for k in c..4 {
                     ids[k] = ids[0];
@@ -507,14 +526,16 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
         }
         nodes[w as usize] = node;
     }
+    drop(flat);
     nodes.shrink_to_fit();
     let triangle = |i: u32| match prims[i as usize].shape {
         Shape::Triangle(v) => (v, prims[i as usize].id),
         // Leaves hold no spheres (`spheres[s] == 0`).
         Shape::Sphere { .. } => unreachable!("a sphere in a triangle leaf"),
     };
+    // Random reads of the primitives: split over the threads.
     let packets = leaf_prims
-        .iter()
+        .par_iter()
         .map(|ids| {
             let t = ids.map(triangle);
             Packet {
@@ -582,13 +603,13 @@ fn bvh2_depth(bvh: &Bvh2) -> usize {
 /// The largest number of boxes sharing exactly the same centre.
 fn max_stacked(boxes: &[Aabb]) -> usize {
     let mut keys: Vec<[u32; 3]> = boxes
-        .iter()
+        .par_iter()
         .map(|b| {
             let c = b.center();
             [c.x.to_bits(), c.y.to_bits(), c.z.to_bits()]
         })
         .collect();
-    keys.sort_unstable();
+    keys.par_sort_unstable();
     let mut best = 0;
     let mut run = 0;
     for i in 0..keys.len() {
