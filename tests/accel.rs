@@ -3,9 +3,7 @@
 //! random and degenerate scenes (STABILITY B1, B2, T1 "including through the BVH", T4).
 
 use glam::Vec3;
-use raytree::accel::{
-    AUTO_MIN_BVH_PRIMS, AUTO_MIN_GRID_PRIMS, Accel, AccelKind, PrimHit, PrimSet, auto_kind,
-};
+use raytree::accel::{AUTO_MIN_BVH_PRIMS, Accel, AccelKind, PrimHit, PrimSet, auto_kind};
 use raytree::experiments::meshes::octasphere;
 use raytree::experiments::rng::Pcg;
 use raytree::geometry::{Methods, Ray, SphereMethod, TriangleMethod};
@@ -504,11 +502,11 @@ fn auto_resolves_by_size() {
         Accel::build(AccelKind::Auto, &PrimSet::default()).kind(),
         AccelKind::None
     );
-    // The measured rule (see the constants): none, then the BVH, then the grid for huge scenes.
+    // The measured rule (see the constant): none for a handful of primitives, then the BVH.
     assert_eq!(auto_kind(AUTO_MIN_BVH_PRIMS - 1), AccelKind::None);
     assert_eq!(auto_kind(AUTO_MIN_BVH_PRIMS), AccelKind::Bvh);
-    assert_eq!(auto_kind(AUTO_MIN_GRID_PRIMS - 1), AccelKind::Bvh);
-    assert_eq!(auto_kind(AUTO_MIN_GRID_PRIMS), AccelKind::Grid);
+    assert_eq!(auto_kind(1_000_000), AccelKind::Bvh);
+    assert_eq!(auto_kind(100_000_000), AccelKind::Bvh);
 }
 
 /// Rays from outside at the vertices and edges of a closed mesh never pass through it, through

@@ -62,7 +62,7 @@ pub struct PrimHit {
 }
 
 /// `Auto` tests every primitive (no accelerator) below this many valid primitives, and builds
-/// the BVH from here on (up to [`AUTO_MIN_GRID_PRIMS`]).
+/// the BVH from here on, at every size.
 ///
 /// Measured with `raytree bench default --no-sweep --out DIR` (the scaling sweep of
 /// `experiments::bench`: a tessellated sphere filling a 640×480 image, one sample, primary and
@@ -70,31 +70,23 @@ pub struct PrimHit {
 /// kinds are within noise of each other (15–68 ms), from 8 on the BVH is faster than none
 /// (44–72 ms against 61–93 ms; 84–92 ms against 230–260 ms at 32). Three runs put the
 /// crossover at about 4, 6 and 7.
+///
+/// The uniform grid is never chosen. On the sweep's sphere (the grid's best case: one even
+/// surface) its cheaper build won a *single* frame from about 1M triangles while the BVH build
+/// was serial (2.1M: 1.2 s against 2.2 s in all); with the parallel build the BVH builds 1M
+/// triangles in 0.6–0.75 s, and on the issue-7 Whitted scene (a torus, mirror and glass, 1M
+/// and 2M triangles) the BVH wins the first frame too (0.93 s against 1.9 s at 1M, 1.8 s
+/// against 2.8 s at 2M: the grid renders 10× slower there). A viewer renders many frames per
+/// build, where the BVH is 2–10× faster each.
 pub const AUTO_MIN_BVH_PRIMS: usize = 6;
 
-/// `Auto` builds the uniform grid from this many valid primitives on.
-///
-/// Same measurement: the grid and the BVH tie from 128 to 2048 triangles, the BVH is faster
-/// from 8k on (0.24 s against 0.35 s at 131k), and the grid from about 0.4M–1.1M on (two runs
-/// of the sweep; the clock of a shared machine decides within that range), because the BVH's
-/// build then outweighs its faster traversal: at 2.1M triangles the grid builds in 0.6 s
-/// against 1.9–2.0 s and renders the frame in 0.62–0.68 s against 0.25–0.34 s (1.2 s against
-/// 2.2–2.3 s in all), in 54 bytes per triangle against 128. We take 1M, leaning towards the
-/// BVH, which renders every further frame 2–4× faster: a viewer that renders more than about
-/// five frames of such a scene without rebuilding does better with `--accel bvh`, and so does
-/// a very uneven scene, where a uniform grid's cells fill unevenly (the sweep's sphere is the
-/// grid's good case).
-pub const AUTO_MIN_GRID_PRIMS: usize = 1_000_000;
-
-/// The accelerator `Auto` builds for `valid_prims` primitives (see [`AUTO_MIN_BVH_PRIMS`] and
-/// [`AUTO_MIN_GRID_PRIMS`] for the measurements behind the rule).
+/// The accelerator `Auto` builds for `valid_prims` primitives (see [`AUTO_MIN_BVH_PRIMS`] for
+/// the measurements behind the rule).
 pub fn auto_kind(valid_prims: usize) -> AccelKind {
     if valid_prims < AUTO_MIN_BVH_PRIMS {
         AccelKind::None
-    } else if valid_prims < AUTO_MIN_GRID_PRIMS {
-        AccelKind::Bvh
     } else {
-        AccelKind::Grid
+        AccelKind::Bvh
     }
 }
 
