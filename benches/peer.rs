@@ -13,13 +13,15 @@
 //!
 //! Run: `cargo bench --bench peer` (80k and 320k triangles, 2 threads, 3 runs each), or e.g.
 //! `cargo bench --bench peer -- --sizes 1000,1000000 --threads 1 --runs 5 --keep /tmp/b`.
-//! `--scaling` instead prints raytree's render time against triangle count (1k to 2M) on 1
-//! and 2 threads.
+//! `--embree-quality high` (or `low`) builds Embree's BVH at that quality instead of its
+//! default, medium. `--scaling` instead prints raytree's build and render time against
+//! triangle count (1k to 2M) on 1 and 2 threads, and with `--chart FILE.png` draws it.
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use raytree::experiments::chart::{Chart, Series, write_chart};
 use raytree::scene::procedural::{torus_triangles, write_bench_scene};
 use raytree::scene::{Scene, Shading, load_scene_file};
 
@@ -32,6 +34,8 @@ struct Options {
     keep: Option<PathBuf>,
     scaling: bool,
     peer: bool,
+    embree_quality: Option<String>,
+    chart: Option<PathBuf>,
 }
 
 fn parse_options() -> Options {
@@ -42,6 +46,8 @@ fn parse_options() -> Options {
         keep: None,
         scaling: false,
         peer: true,
+        embree_quality: None,
+        chart: None,
     };
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
@@ -61,6 +67,8 @@ fn parse_options() -> Options {
             "--keep" => o.keep = Some(PathBuf::from(value("--keep"))),
             "--scaling" => o.scaling = true,
             "--no-peer" => o.peer = false,
+            "--embree-quality" => o.embree_quality = Some(value("--embree-quality")),
+            "--chart" => o.chart = Some(PathBuf::from(value("--chart"))),
             // `cargo bench` passes `--bench`; filters and the rest are not ours.
             _ => {}
         }
@@ -230,8 +238,18 @@ fn build_harness(dir: &Path) -> Option<PathBuf> {
     }
 }
 
-fn harness_run(exe: &Path, scene_bin: &Path, image: &Path, threads: usize) -> Run {
-    let output = Command::new(exe)
+fn harness_run(
+    exe: &Path,
+    scene_bin: &Path,
+    image: &Path,
+    threads: usize,
+    quality: Option<&str>,
+) -> Run {
+    let mut command = Command::new(exe);
+    if let Some(q) = quality {
+        command.env("EMBREE_WHITTED_QUALITY", q);
+    }
+    let output = command
         .arg(scene_bin)
         .arg(threads.to_string())
         .arg(image)
@@ -296,9 +314,10 @@ fn mb(bytes: u64) -> f64 {
 fn peer_comparison(o: &Options, root: &Path) {
     let harness = if o.peer { build_harness(root) } else { None };
     println!(
-        "issue-7 peer bench: {} threads, {} runs each (median), load average before: {}",
+        "issue-7 peer bench: {} threads, {} runs each (median), Embree build quality {}, load average before: {}",
         o.threads,
         o.runs,
+        o.embree_quality.as_deref().unwrap_or("medium (default)"),
         load_average()
     );
     let mut rows = Vec::new();
@@ -314,7 +333,13 @@ fn peer_comparison(o: &Options, root: &Path) {
         for _ in 0..o.runs {
             ours.push(raytree_run(&scene_file, &ours_png, o.threads));
             if let Some(exe) = &harness {
-                theirs.push(harness_run(exe, &scene_bin, &theirs_f32, o.threads));
+                theirs.push(harness_run(
+                    exe,
+                    &scene_bin,
+                    &theirs_f32,
+                    o.threads,
+                    o.embree_quality.as_deref(),
+                ));
             }
         }
         let diff = harness.as_ref().map(|_| {
@@ -404,6 +429,9 @@ fn peer_comparison(o: &Options, root: &Path) {
     }
 }
 
+/// (triangles, build seconds, render seconds) at one thread count.
+type ScalingPoint = (f64, f64, f64);
+
 fn scaling(o: &Options, root: &Path) {
     let sizes = [1_000, 10_000, 100_000, 320_000, 1_000_000, 2_000_000];
     println!(
@@ -413,23 +441,40 @@ fn scaling(o: &Options, root: &Path) {
     );
     println!();
     println!(
-        "| triangles | build s | render s, 1 thread | render s, 2 threads | Mrays/s, 1 thread | Mrays/s, 2 threads | bytes/tri |"
+        "| triangles | build s, 1 thread | build s, 2 threads | render s, 1 thread | render s, 2 threads | Mrays/s, 1 thread | Mrays/s, 2 threads | bytes/tri |"
     );
-    println!("|---:|---:|---:|---:|---:|---:|---:|");
+    println!("|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let mut csv = String::from(
+        "triangles,threads,load_secs,build_secs,render_secs,mrays_per_sec,bytes_per_triangle\n",
+    );
+    let mut series: Vec<(usize, Vec<ScalingPoint>)> = vec![(1, Vec::new()), (2, Vec::new())];
     for size in sizes {
         let dir = root.join(format!("scaling_{size}"));
         let scene_file = write_bench_scene(&dir, size).expect("write the bench scene");
         let png = dir.join("raytree.png");
-        let one: Vec<Run> = (0..o.runs)
-            .map(|_| raytree_run(&scene_file, &png, 1))
-            .collect();
-        let two: Vec<Run> = (0..o.runs)
-            .map(|_| raytree_run(&scene_file, &png, 2))
-            .collect();
-        let (one, two) = (summary(&one), summary(&two));
+        let triangles = torus_triangles(size) + 2;
+        let mut by_threads = Vec::new();
+        for (threads, points) in &mut series {
+            let runs: Vec<Run> = (0..o.runs)
+                .map(|_| raytree_run(&scene_file, &png, *threads))
+                .collect();
+            let r = summary(&runs);
+            csv.push_str(&format!(
+                "{triangles},{threads},{:.6},{:.6},{:.6},{:.4},{:.1}\n",
+                r.load_secs,
+                r.build_secs,
+                r.render_secs,
+                r.mrays(),
+                r.bytes_per_triangle
+            ));
+            points.push((triangles as f64, r.build_secs, r.render_secs));
+            by_threads.push(r);
+        }
+        let (one, two) = (&by_threads[0], &by_threads[1]);
         println!(
-            "| {} | {:.3} | {:.3} | {:.3} | {:.2} | {:.2} | {:.0} |",
-            torus_triangles(size) + 2,
+            "| {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.2} | {:.2} | {:.0} |",
+            triangles,
+            one.build_secs,
             two.build_secs,
             one.render_secs,
             two.render_secs,
@@ -440,6 +485,32 @@ fn scaling(o: &Options, root: &Path) {
         let _ = std::io::stdout().flush();
     }
     println!("load average after: {}", load_average());
+    if let Some(stem) = &o.chart {
+        let mut lines = Vec::new();
+        for (threads, points) in &series {
+            let s = if *threads == 1 { "" } else { "s" };
+            lines.push(Series::new(
+                format!("render, {threads} thread{s}"),
+                points.iter().map(|&(n, _, r)| (n, r)).collect(),
+            ));
+            lines.push(Series::new(
+                format!("BVH build, {threads} thread{s}"),
+                points.iter().map(|&(n, b, _)| (n, b)).collect(),
+            ));
+        }
+        let chart = Chart {
+            title: "Whitted bench scene, 640x480, 1 spp: time against triangle count".into(),
+            x_label: "triangles".into(),
+            y_label: "seconds".into(),
+            x_log: true,
+            y_log: true,
+            series: lines,
+        };
+        let stem = stem.with_extension("");
+        std::fs::write(stem.with_extension("csv"), &csv).expect("write the scaling CSV");
+        write_chart(&chart, &stem).expect("write the scaling chart");
+        println!("wrote {0}.csv, {0}.svg and {0}.png", stem.display());
+    }
 }
 
 fn main() {

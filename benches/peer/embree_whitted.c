@@ -5,6 +5,8 @@
  * 32x32 tiles taken from an atomic counter.
  *
  * Usage: embree_whitted SCENE.bin THREADS [IMAGE.f32]
+ * The environment variable EMBREE_WHITTED_QUALITY (low, medium or high) sets the scene's and
+ * the triangle mesh's build quality; Embree's default, medium, without it.
  * Prints `key value` lines (load/build/render seconds, rays by kind, Mrays/s, memory); writes
  * the linear RGB image as raw little-endian f32 when IMAGE is given.
  *
@@ -429,11 +431,20 @@ int main(int argc, char **argv) {
     rtcSetDeviceErrorFunction(device, rtc_error, NULL);
     rtcSetDeviceMemoryMonitorFunction(device, memory_monitor, NULL);
     scene = rtcNewScene(device);
+    const char *quality_name = getenv("EMBREE_WHITTED_QUALITY");
+    if (!quality_name || !*quality_name) quality_name = "medium";
+    enum RTCBuildQuality quality;
+    if (strcmp(quality_name, "low") == 0) quality = RTC_BUILD_QUALITY_LOW;
+    else if (strcmp(quality_name, "medium") == 0) quality = RTC_BUILD_QUALITY_MEDIUM;
+    else if (strcmp(quality_name, "high") == 0) quality = RTC_BUILD_QUALITY_HIGH;
+    else die("EMBREE_WHITTED_QUALITY must be low, medium or high");
+    rtcSetSceneBuildQuality(scene, quality);
 
     uint32_t *indices = alloc(sizeof(uint32_t) * 3 * (size_t)S.n_triangles);
     for (uint32_t i = 0; i < 3 * S.n_triangles; i++) indices[i] = i;
     if (S.n_triangles > 0) {
         RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        rtcSetGeometryBuildQuality(g, quality);
         rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, S.vertices, 0,
                                    12, 3 * (size_t)S.n_triangles);
         rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, indices, 0, 12,
@@ -486,6 +497,7 @@ int main(int argc, char **argv) {
     double render = t4 - t3;
     printf("embree_version %d.%d.%d\n", RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH);
     printf("threads %d\n", threads);
+    printf("build_quality %s\n", quality_name);
     printf("triangles %u\nspheres %u\n", S.n_triangles, S.n_spheres);
     printf("load_secs %.6f\nbuild_secs %.6f\nrender_secs %.6f\n", t1 - t0, t2 - t1, render);
     printf("primary %llu\nreflected %llu\nrefracted %llu\nshadow %llu\n",

@@ -129,33 +129,40 @@ impl Bvh {
     pub(super) fn build(prims: Vec<Prim>) -> Bvh {
         // `Accel` refuses to build this far (see there); ids would not fit a leaf word.
         assert!(prims.len() <= MAX_PRIMS, "more than 2^28 primitives");
-        let boxes: Vec<Aabb> = prims
-            .par_iter()
-            .map(|p| {
-                let (lo, hi) = p.bounds();
-                Aabb::new(lo.into(), hi.into())
-            })
-            .collect();
+        let bounds = |prims: &[Prim]| -> Vec<Aabb> {
+            prims
+                .par_iter()
+                .map(|p| {
+                    let (lo, hi) = p.bounds();
+                    Aabb::new(lo.into(), hi.into())
+                })
+                .collect()
+        };
         let params = BvhBuildParams::medium_build();
         let mut built = None;
+        let mut boxes = bounds(&prims);
         if max_stacked(&boxes) <= MAX_STACKED {
-            let jittered: Vec<Aabb> = boxes
-                .par_iter()
+            boxes
+                .par_iter_mut()
                 .enumerate()
-                .map(|(i, b)| jitter(b, i))
-                .collect();
-            let mut bvh2 = PlocBuilder::with_capacity(jittered.len()).build(
+                .for_each(|(i, b)| *b = jitter(b, i));
+            let mut bvh2 = PlocBuilder::with_capacity(boxes.len()).build(
                 params.ploc_search_distance,
-                &jittered,
-                (0..jittered.len() as u32).collect(),
+                &boxes,
+                (0..boxes.len() as u32).collect(),
                 params.sort_precision,
                 params.search_depth_threshold,
             );
             ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
-            built = collapse(&bvh2, &prims).filter(|b| stack_need(&b.nodes) + 3 <= STACK_SIZE);
+            // Peak memory: the boxes are not needed by the collapse (the fallback below makes
+            // its own, unjittered).
+            drop(boxes);
+            built = collapse(bvh2, &prims).filter(|b| stack_need(&b.nodes) + 3 <= STACK_SIZE);
+        } else {
+            drop(boxes);
         }
         built.unwrap_or_else(|| {
-            let b = collapse(&median_bvh2(&boxes), &prims).unwrap_or_else(|| Bvh {
+            let b = collapse(median_bvh2(&bounds(&prims)), &prims).unwrap_or_else(|| Bvh {
                 nodes: Vec::new(),
                 packets: Vec::new(),
                 spheres: Vec::new(),
@@ -348,13 +355,33 @@ fn padded(b: &Aabb) -> (Vec3A, Vec3A) {
 }
 
 /// One node of a binary BVH copied in pre-order (depth first, left child first): the left
-/// child of an inner node `i` is `i + 1`, and a subtree is a contiguous run.
+/// child of an inner node `i` is `i + 1`, and a subtree is a contiguous run. 28 bytes.
 #[derive(Clone, Copy)]
 struct FlatNode {
-    aabb: Aabb,
-    /// The right child (inner nodes) or the primitive index (leaves).
+    min: [f32; 3],
+    max: [f32; 3],
+    /// The right child (inner nodes) or, with [`FLAT_LEAF`], the primitive index (leaves).
     link: u32,
-    leaf: bool,
+}
+
+/// The leaf flag of [`FlatNode::link`] (primitive and node indices stay below 2²⁹).
+const FLAT_LEAF: u32 = 1 << 31;
+
+impl FlatNode {
+    fn leaf(&self) -> bool {
+        self.link & FLAT_LEAF != 0
+    }
+    fn prim(&self) -> u32 {
+        self.link & !FLAT_LEAF
+    }
+    fn aabb(&self) -> Aabb {
+        Aabb::new(Vec3A::from_array(self.min), Vec3A::from_array(self.max))
+    }
+    /// As [`Aabb::half_area`] (same operations, so the same tree as before the copy).
+    fn half_area(&self) -> f32 {
+        let d = Vec3::from_array(self.max) - Vec3::from_array(self.min);
+        (d.x + d.y) * d.z + d.x * d.y
+    }
 }
 
 /// `bvh2` in pre-order, or `None` when it is empty or deeper than [`MAX_BVH2_DEPTH`]. This is
@@ -376,20 +403,17 @@ fn preorder(bvh2: &Bvh2) -> Option<Vec<FlatNode>> {
             flat[parent as usize].link = here;
         }
         let node = &bvh2.nodes[i as usize];
+        let (min, max) = (node.aabb.min.to_array(), node.aabb.max.to_array());
         if node.prim_count == 0 {
-            flat.push(FlatNode {
-                aabb: node.aabb,
-                link: 0,
-                leaf: false,
-            });
+            flat.push(FlatNode { min, max, link: 0 });
             todo.push((node.first_index + 1, here, d + 1));
             todo.push((node.first_index, u32::MAX, d + 1));
         } else {
             assert!(node.prim_count == 1, "binary leaves hold one primitive");
             flat.push(FlatNode {
-                aabb: node.aabb,
-                link: bvh2.primitive_indices[node.first_index as usize],
-                leaf: true,
+                min,
+                max,
+                link: FLAT_LEAF | bvh2.primitive_indices[node.first_index as usize],
             });
         }
     }
@@ -398,8 +422,10 @@ fn preorder(bvh2: &Bvh2) -> Option<Vec<FlatNode>> {
 
 /// The 4-wide tree of a binary BVH whose leaves hold one primitive each (PLOC's and
 /// [`median_bvh2`]'s do); `None` for an empty tree or one deeper than [`MAX_BVH2_DEPTH`].
-fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
-    let flat = preorder(bvh2)?;
+fn collapse(bvh2: Bvh2, prims: &[Prim]) -> Option<Bvh> {
+    let flat = preorder(&bvh2)?;
+    // The copy is all that is needed from here on.
+    drop(bvh2);
     let n = flat.len();
     let right = |i: usize| flat[i].link as usize;
     // Bottom up (reverse pre-order): primitives under each node and the surface-area cost of
@@ -422,9 +448,9 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
     let mut leaf = vec![false; n];
     for i in (0..n).rev() {
         let node = &flat[i];
-        let area = node.aabb.half_area().max(0.0);
-        if node.leaf {
-            let sphere = is_sphere(node.link as usize);
+        let area = node.half_area().max(0.0);
+        if node.leaf() {
+            let sphere = is_sphere(node.prim() as usize);
             count[i] = 1;
             spheres[i] = u32::from(sphere);
             cost[i] = if sphere { SPHERE_COST } else { PACKET_COST } * area;
@@ -474,7 +500,7 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
                 if leaf[s] {
                     continue;
                 }
-                let area = flat[s].aabb.half_area();
+                let area = flat[s].half_area();
                 let better = match best {
                     None => true,
                     Some((_, a, o)) => area > a || (area == a && opened < o),
@@ -492,7 +518,7 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
         }
         let mut node = empty_node();
         for (slot, &(s, _)) in slots[..len].iter().enumerate() {
-            let (lo, hi) = padded(&flat[s].aabb);
+            let (lo, hi) = padded(&flat[s].aabb());
             for (axis, (l, h)) in [(lo.x, hi.x), (lo.y, hi.y), (lo.z, hi.z)]
                 .into_iter()
                 .enumerate()
@@ -503,14 +529,18 @@ fn collapse(bvh2: &Bvh2, prims: &[Prim]) -> Option<Bvh> {
             node.valid |= 1 << slot;
             if leaf[s] && spheres[s] == 1 {
                 node.child[slot] = LEAF | SPHERE | sphere_leaves.len() as u32;
-                sphere_leaves.push(prims[flat[s].link as usize]);
+                sphere_leaves.push(prims[flat[s].prim() as usize]);
             } else if leaf[s] {
                 // The subtree's triangles, left to right: the leaves of its run of
                 // `2·count − 1` nodes, as one packet.
                 let c = count[s] as usize;
                 let mut ids = [0u32; 4];
-                for (k, f) in flat[s..s + 2 * c - 1].iter().filter(|f| f.leaf).enumerate() {
-                    ids[k] = f.link;
+                for (k, f) in flat[s..s + 2 * c - 1]
+                    .iter()
+                    .filter(|f| f.leaf())
+                    .enumerate()
+                {
+                    ids[k] = f.prim();
                 }
                 for k in c..4 {
                     ids[k] = ids[0];
