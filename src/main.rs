@@ -227,7 +227,21 @@ fn print_warnings(scene: &Scene) {
     }
 }
 
+/// Makes `--threads N` hold for everything parallel in the command, the accelerator build
+/// included (it runs on rayon's global pool), not only for the render's own pool. 0 keeps
+/// rayon's default (every core).
+fn use_threads(threads: usize) {
+    if threads > 0 {
+        // Fails only when the global pool already exists, and then it keeps its size: a
+        // command configures it first thing, so that cannot happen here.
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build_global();
+    }
+}
+
 fn run_render(args: &RenderArgs) -> Result<()> {
+    use_threads(args.threads);
     let load_start = std::time::Instant::now();
     let mut scene = load_scene(&args.scene)?;
     let load_secs = load_start.elapsed().as_secs_f64();
@@ -297,6 +311,7 @@ fn run_render(args: &RenderArgs) -> Result<()> {
             "stats": stats, "mrays_per_sec": stats.mrays_per_sec(),
             "triangles": scene.triangles.len(), "spheres": scene.spheres.len(),
             "load_secs": load_secs, "memory": memory,
+            "build_threads": rayon::current_num_threads(),
         }))
         .context("cannot encode the statistics")?;
         export::write_text(path, &json)?;
@@ -370,6 +385,7 @@ fn show_on(bar: &indicatif::ProgressBar) -> impl Fn(&bench::BenchProgress) + '_ 
 }
 
 fn run_bench(args: &BenchArgs) -> Result<()> {
+    use_threads(args.threads);
     let scene = load_scene(&args.scene)?;
     print_warnings(&scene);
     let (mut opts, scaling) = if args.quick {

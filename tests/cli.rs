@@ -81,6 +81,68 @@ fn renders_exr() {
     );
 }
 
+/// `--stats-json` (issue 7): every figure the peer bench reads, consistent with each other,
+/// and `--threads` holding for the accelerator build too.
+#[test]
+fn stats_json_has_consistent_figures() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (out, stats) = (dir.path().join("box.png"), dir.path().join("s.json"));
+    raytree()
+        .args([
+            "render",
+            "box",
+            "--width",
+            "48",
+            "--height",
+            "36",
+            "--threads",
+            "1",
+        ])
+        .args(["--accel", "bvh", "--quiet", "-o"])
+        .arg(&out)
+        .arg("--stats-json")
+        .arg(&stats)
+        .assert()
+        .success();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).expect("stats written"))
+            .expect("stats are JSON");
+    let f = |v: &serde_json::Value| v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"));
+    let s = &json["stats"];
+    for key in ["build_secs", "render_secs"] {
+        assert!(f(&s[key]) > 0.0, "{key} = {}", s[key]);
+    }
+    assert!(f(&json["load_secs"]) > 0.0);
+    let rays: f64 = ["primary", "reflected", "refracted", "shadow"]
+        .iter()
+        .map(|k| f(&s["rays"][k]))
+        .sum();
+    assert_eq!(
+        f(&s["rays"]["primary"]),
+        48.0 * 36.0,
+        "one camera ray a pixel"
+    );
+    assert!(f(&s["rays"]["shadow"]) > 0.0 && f(&s["rays"]["reflected"]) > 0.0);
+    let mrays = rays / f(&s["render_secs"]) / 1e6;
+    assert!((f(&json["mrays_per_sec"]) - mrays).abs() <= 1e-9 * mrays.max(1.0));
+    assert_eq!(s["accel"], "bvh");
+    assert_eq!(s["threads"], 1);
+    assert_eq!(
+        json["build_threads"], 1,
+        "--threads 1 holds for the build too"
+    );
+    let m = &json["memory"];
+    let triangles = f(&json["triangles"]);
+    assert!(triangles > 0.0);
+    assert!(f(&m["accel_bytes"]) > f(&m["scene_geometry_bytes"]) * 0.5);
+    let per_tri = (f(&m["accel_bytes"]) + f(&m["scene_geometry_bytes"])) / triangles;
+    assert!((f(&m["bytes_per_triangle"]) - per_tri).abs() < 1e-6 * per_tri);
+    assert!(
+        f(&m["peak_bytes"]) > f(&m["accel_bytes"]),
+        "peak RSS holds the structure"
+    );
+}
+
 #[test]
 fn bad_scene_is_one_sentence_and_no_file() {
     let dir = tempfile::tempdir().expect("temp dir");
