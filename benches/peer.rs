@@ -15,7 +15,7 @@
 //! `cargo bench --bench peer -- --sizes 1000,1000000 --threads 1 --runs 5 --keep /tmp/b`.
 //! `--embree-quality high` (or `low`) builds Embree's BVH at that quality instead of its
 //! default, medium. `--scaling` instead prints raytree's build and render time against
-//! triangle count (1k to 2M) on 1 and 2 threads, and with `--chart FILE.png` draws it.
+//! triangle count (1k to 4M) on 1 and 2 threads, and with `--chart FILE.png` draws it.
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -433,7 +433,7 @@ fn peer_comparison(o: &Options, root: &Path) {
 type ScalingPoint = (f64, f64, f64);
 
 fn scaling(o: &Options, root: &Path) {
-    let sizes = [1_000, 10_000, 100_000, 320_000, 1_000_000, 2_000_000];
+    let sizes = [1_000, 10_000, 100_000, 320_000, 1_000_000, 2_000_000, 4_000_000];
     println!(
         "raytree scaling, bench scene 640×480, median of {} runs; load average before: {}",
         o.runs,
