@@ -433,7 +433,9 @@ fn peer_comparison(o: &Options, root: &Path) {
 type ScalingPoint = (f64, f64, f64);
 
 fn scaling(o: &Options, root: &Path) {
-    let sizes = [1_000, 10_000, 100_000, 320_000, 1_000_000, 2_000_000, 4_000_000];
+    let sizes = [
+        1_000, 10_000, 100_000, 320_000, 1_000_000, 2_000_000, 4_000_000,
+    ];
     println!(
         "raytree scaling, bench scene 640×480, median of {} runs; load average before: {}",
         o.runs,

@@ -392,28 +392,45 @@ pub fn render_with(
         batch_memory_estimate(width, height),
     )?;
     let frame = CameraFrame::new(&tracer.scene.camera, width, height);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| RenderError::Threads {
-            threads,
-            message: e.to_string(),
-        })?;
+    // The pool we are on (rayon's global one, which the CLI sizes by `--threads`) when it has
+    // the size asked for; a pool of our own otherwise.
+    let own_pool = if threads == 0 || threads == rayon::current_num_threads() {
+        None
+    } else {
+        Some(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .map_err(|e| RenderError::Threads {
+                    threads,
+                    message: e.to_string(),
+                })?,
+        )
+    };
     let tiles = tiles(width, height, TILE_SIZE);
     let total = width as u64 * height as u64;
+    // One buffer for every tile's sums, tile after tile: no allocation per tile.
+    let mut sums = vec![Vec3::ZERO; total as usize];
+    let mut parts: Vec<&mut [Vec3]> = Vec::with_capacity(tiles.len());
+    let mut rest = sums.as_mut_slice();
+    for rect in &tiles {
+        let (part, tail) = rest.split_at_mut((rect.width * rect.height) as usize);
+        parts.push(part);
+        rest = tail;
+    }
     let done = AtomicU64::new(0);
     let start = Instant::now();
-    let results: Vec<_> = pool.install(|| {
+    let work = || -> Vec<Result<RayCounts, RenderError>> {
         tiles
             .par_iter()
-            .map(|&rect| {
-                let mut sums = vec![Vec3::ZERO; (rect.width * rect.height) as usize];
+            .zip(parts.into_par_iter())
+            .map(|(&rect, sums)| {
                 let outcome = catch_unwind(AssertUnwindSafe(|| {
-                    tile(tracer, &frame, rect, 0..samples, &mut sums)
+                    tile(tracer, &frame, rect, 0..samples, sums)
                 }));
                 let n = rect.width as u64 * rect.height as u64;
                 progress(done.fetch_add(n, Ordering::Relaxed) + n, total);
-                outcome.map(|counts| (rect, sums, counts)).map_err(|panic| {
+                outcome.map_err(|panic| {
                     let message = panic
                         .downcast_ref::<&str>()
                         .map(|s| s.to_string())
@@ -427,16 +444,22 @@ pub fn render_with(
                 })
             })
             .collect()
-    });
+    };
+    let (results, used_threads) = match &own_pool {
+        Some(pool) => (pool.install(work), pool.current_num_threads()),
+        None => (work(), rayon::current_num_threads()),
+    };
     let render_secs = start.elapsed().as_secs_f64();
     let mut image = Image::new(width, height);
     let mut rays = RayCounts::default();
-    for result in results {
-        let (rect, sums, counts) = result?;
-        rays.add(&counts);
+    let mut offset = 0;
+    for (rect, result) in tiles.iter().zip(results) {
+        rays.add(&result?);
+        let tile_sums = &sums[offset..offset + (rect.width * rect.height) as usize];
+        offset += tile_sums.len();
         for j in 0..rect.height {
             for i in 0..rect.width {
-                let sum = sums[(j * rect.width + i) as usize];
+                let sum = tile_sums[(j * rect.width + i) as usize];
                 image.pixels[((rect.y + j) * width + rect.x + i) as usize] = sum / samples as f32;
             }
         }
@@ -445,7 +468,7 @@ pub fn render_with(
         width,
         height,
         samples,
-        threads: pool.current_num_threads(),
+        threads: used_threads,
         accel: Some(tracer.accel.kind()),
         rays,
         build_secs: tracer.build_secs,
