@@ -15,11 +15,16 @@ pub fn reflect(u: Vec3, n: Vec3) -> Vec3 {
 
 /// Refracted direction of the unit incoming direction `u` through a surface with unit normal `n`
 /// facing the incoming side (`u·n ≤ 0`), where `eta = ηi/ηr`. `None` on total internal
-/// reflection, i.e. when `1 − eta²(1 − cos²θi) < 0`.
+/// reflection, i.e. when `cos²θr = 1 − eta²(1 − cos²θi) < 0`.
 #[inline]
 pub fn refract(u: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
     let cos_i = (-u.dot(n)).clamp(0.0, 1.0);
-    let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+    let eta2 = eta * eta;
+    // cos²θr as `(1 − eta²) + eta²·cos²θi`, not `1 − eta²(1 − cos²θi)`: the latter cancels at
+    // grazing angles (cos θi → 0), where `1 − cos²θi` rounds to within ε/2 of 1, and so bends
+    // a ray even for eta = 1 (up to ~1e-4). Here eta = 1 gives `k = cos²θi` and
+    // `cos_r = cos_i` exactly (sqrt(x²) = x in IEEE arithmetic), so `T = u`.
+    let k = (1.0 - eta2) + eta2 * (cos_i * cos_i);
     if k < 0.0 {
         return None;
     }
@@ -136,5 +141,98 @@ mod tests {
         assert!(at(41.0).is_some());
         assert!(at(42.0).is_none());
         assert!(at(80.0).is_none());
+    }
+
+    /// Incidence cosines from normal incidence to grazing: an even sweep, then down to 1e-7 by
+    /// factors of ten (cos θi = 1e-3 included), then exactly grazing.
+    fn incidence_cosines() -> Vec<f32> {
+        let mut c: Vec<f32> = (0..=200).map(|i| 1.0 - i as f32 / 200.0).collect();
+        c.extend((1..=7).flat_map(|e| [1.0, 2.0, 5.0].map(|m| m * 10f32.powi(-e))));
+        c.push(0.0);
+        c
+    }
+
+    /// Unit normals, axis-aligned and not, each with two tangents.
+    fn frames() -> Vec<(Vec3, Vec3)> {
+        let normals = [
+            Vec3::Y,
+            -Vec3::Z,
+            Vec3::new(1.0, 2.0, 3.0).normalize(),
+            Vec3::new(-0.3, 0.05, -0.9).normalize(),
+        ];
+        normals
+            .into_iter()
+            .flat_map(|n| {
+                let t = n.any_orthonormal_vector();
+                [(n, t), (n, n.cross(t))]
+            })
+            .collect()
+    }
+
+    /// The incoming unit direction at cosine `cos_i` to `-n`, in the plane of `n` and `t`.
+    fn incoming(n: Vec3, t: Vec3, cos_i: f32) -> Vec3 {
+        let sin_i = (1.0 - cos_i * cos_i).max(0.0).sqrt();
+        (sin_i * t - cos_i * n).normalize()
+    }
+
+    #[test]
+    fn refract_same_index_leaves_direction_alone_at_every_angle() {
+        // `1 − η²(1 − cos²θ)` cancels at grazing angles and bent these rays by up to ~1e-4.
+        for (n, t) in frames() {
+            for cos_i in incidence_cosines() {
+                let u = incoming(n, t, cos_i);
+                let r = refract(u, n, 1.0)
+                    .unwrap_or_else(|| panic!("TIR with eta = 1 at cos θi = {cos_i}, n = {n}"));
+                let dev = (r - u).abs().max_element();
+                assert!(
+                    dev < 1e-6,
+                    "eta = 1, cos θi = {cos_i}, n = {n}: T = {r}, u = {u}, deviation {dev:e}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn refract_snell_and_total_internal_reflection_sweep() {
+        for eta in [1.5f32, 1.0 / 1.5] {
+            for (n, t) in frames() {
+                for cos_i in incidence_cosines() {
+                    let u = incoming(n, t, cos_i);
+                    let (ud, nd) = (u.as_dvec3(), n.as_dvec3());
+                    let cos_exact = -ud.dot(nd);
+                    let sin_i = ud.cross(nd).length();
+                    let k = 1.0 - f64::from(eta).powi(2) * (1.0 - cos_exact * cos_exact);
+                    let what = format!("eta = {eta}, cos θi = {cos_i}, n = {n}");
+                    match refract(u, n, eta) {
+                        None => assert!(k < 1e-6, "{what}: TIR reported, k = {k}"),
+                        Some(r) => {
+                            assert!(k > -1e-6, "{what}: TIR missed, k = {k}, T = {r}");
+                            let rd = r.as_dvec3();
+                            assert!((rd.length() - 1.0).abs() < 1e-6, "{what}: |T| = {rd}");
+                            // Transmitted into the far side, in the plane of incidence.
+                            assert!(rd.dot(nd) <= 1e-6, "{what}: T = {r}");
+                            assert!(rd.dot(nd.cross(ud)).abs() < 1e-6, "{what}: T = {r}");
+                            let sin_t = rd.cross(nd).length();
+                            let want = f64::from(eta) * sin_i;
+                            assert!(
+                                (sin_t - want).abs() < 1e-5,
+                                "{what}: sin θt = {sin_t}, η sin θi = {want}"
+                            );
+                        }
+                    }
+                    if eta < 1.0 {
+                        assert!(refract(u, n, eta).is_some(), "{what}: entering never TIRs");
+                    } else if (k).abs() > 1e-6 {
+                        assert_eq!(refract(u, n, eta).is_none(), k < 0.0, "{what}: k = {k}");
+                    }
+                }
+            }
+        }
+        // Both sides of the critical angle asin(1/1.5) occur in the sweep.
+        let n = Vec3::Y;
+        let t = Vec3::X;
+        let crit = (1.0f32 / 1.5).asin().cos();
+        assert!(refract(incoming(n, t, crit + 1e-3), n, 1.5).is_some());
+        assert!(refract(incoming(n, t, crit - 1e-3), n, 1.5).is_none());
     }
 }

@@ -251,3 +251,74 @@ fn help_documents_the_options() {
         assert!(help.contains(flag), "render --help lacks {flag}");
     }
 }
+
+/// `raytree … | head -1`: stdout closes while the program still writes. That is not an error
+/// worth a panic (Rust ignores SIGPIPE, so every write after the close fails with BrokenPipe).
+#[test]
+fn closed_stdout_is_not_a_panic() {
+    use std::io::{BufRead, BufReader};
+    use std::process::{Command, Stdio};
+
+    /// Exit code and stderr of a run, checked to be free of panics.
+    fn check(what: &str, output: std::process::Output) {
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(!stderr.contains("panicked"), "{what}: {stderr}");
+        assert!(
+            output.status.code().is_some_and(|c| c != 101),
+            "{what}: {:?}, {stderr}",
+            output.status
+        );
+    }
+
+    // The first line is read, then the pipe closes. The tree of this pixel is cut at
+    // MAX_NODES: megabytes of JSON, over 100 KB of text, far more than a pipe buffers (64 KiB
+    // on Linux), so the program is still writing when the pipe closes.
+    let tree = ["tree", "glass", "--pixel", "200,240", "--max-depth", "64"];
+    for json in [true, false] {
+        let args: Vec<&str> = tree
+            .iter()
+            .copied()
+            .chain(json.then_some("--json"))
+            .collect();
+        let what = args.join(" ");
+        let full = raytree().args(&args).output().expect("runs");
+        assert!(full.status.success(), "{what}");
+        assert!(full.stdout.len() > 100_000, "{what}: too short a test");
+        let mut child = Command::new(env!("CARGO_BIN_EXE_raytree"))
+            .args(&args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("spawns");
+        let mut first = String::new();
+        BufReader::new(child.stdout.take().expect("piped stdout"))
+            .read_line(&mut first)
+            .expect("reads the first line");
+        // The reader (and so the pipe's read end) is dropped here.
+        assert!(!first.is_empty(), "{what}: no output");
+        check(&what, child.wait_with_output().expect("waits"));
+    }
+
+    // The read end closed before the program starts: its first write already fails.
+    for args in [
+        &["scenes"][..],
+        &[
+            "render", "quiz", "--width", "8", "--height", "8", "-q", "-o",
+        ],
+    ] {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let (reader, writer) = std::io::pipe().expect("pipe");
+        drop(reader);
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_raytree"));
+        cmd.args(args);
+        if args[0] == "render" {
+            cmd.arg(dir.path().join("x.png"));
+        }
+        let output = cmd
+            .stdout(writer)
+            .stderr(Stdio::piped())
+            .output()
+            .expect("runs");
+        check(&args.join(" "), output);
+    }
+}

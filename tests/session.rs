@@ -1,10 +1,12 @@
 //! The viewer's progressive render session, headless: the converged image equals the batch
-//! render bit for bit, and a restart in the middle of a pass never mixes generations.
+//! render bit for bit, a restart in the middle of a pass never mixes generations, and a worker
+//! that panics is reported without stopping the session.
 
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
-use raytree::render::session::{Session, SessionEvent};
+use raytree::render::session::{Pass, Session, SessionEvent};
 use raytree::render::{Image, render};
 use raytree::scene::builtin::load_builtin;
 use raytree::trace::{TraceSettings, Tracer};
@@ -97,5 +99,81 @@ fn restart_mid_pass_never_mixes_generations() {
     assert!(
         img == batch,
         "the second generation's image holds foreign pixels"
+    );
+}
+
+/// A worker that panics on one tile (through the session's tile hook) is reported as
+/// `Failed`, naming the tile and the panic; the generation stops (no further pass or finish);
+/// nothing deadlocks; and the next start, after an edit, renders the whole image exactly as
+/// the batch render does.
+#[test]
+fn panicking_worker_is_reported_and_the_next_start_renders() {
+    let t = tracer("default", 96, 72, 5);
+    let mut session = Session::new(2).expect("pool");
+    let armed = Arc::new(AtomicBool::new(true));
+    let calls = Arc::new(AtomicU32::new(0));
+    {
+        let (armed, calls) = (armed.clone(), calls.clone());
+        session.set_tile_hook(Some(Arc::new(move |pass, rect| {
+            calls.fetch_add(1, Ordering::Relaxed);
+            // Once, in the second full pass: the first pass and the preview went through.
+            if pass == Pass::Samples(2)
+                && (rect.x, rect.y) == (32, 32)
+                && armed.swap(false, Ordering::SeqCst)
+            {
+                panic!("injected fault");
+            }
+        })));
+    }
+    let failed = session.start(t.clone(), 6, None);
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let mut passes = Vec::new();
+    let message = loop {
+        assert!(
+            Instant::now() < deadline,
+            "no Failed event: the session hangs"
+        );
+        let Some(ev) = session.try_next() else {
+            std::thread::sleep(Duration::from_millis(2));
+            continue;
+        };
+        assert_eq!(ev.generation(), failed, "{ev:?}");
+        match ev {
+            SessionEvent::Failed { message, .. } => break message,
+            SessionEvent::PassDone { pass, .. } => passes.push(pass),
+            SessionEvent::Finished { .. } => panic!("finished despite the panic"),
+            SessionEvent::Tile(_) => {}
+        }
+    };
+    assert!(!armed.load(Ordering::SeqCst), "the hook never fired");
+    assert_eq!(
+        message,
+        "a render worker failed on the tile at (32, 32): injected fault"
+    );
+    assert_eq!(passes, vec![Pass::Preview, Pass::Samples(1)]);
+    // The failed generation stops: tiles already traced may still arrive, but no pass ends.
+    let quiet = Instant::now() + Duration::from_millis(300);
+    while Instant::now() < quiet {
+        match session.try_next() {
+            Some(SessionEvent::Tile(t)) => assert_eq!(t.generation, failed),
+            Some(ev) => panic!("after the failure: {ev:?}"),
+            None => std::thread::sleep(Duration::from_millis(2)),
+        }
+    }
+    // An edit restarts the render with the hook still installed (now harmless).
+    let before = calls.load(Ordering::Relaxed);
+    let edited = tracer("default", 96, 72, 3);
+    let next = session.start(edited.clone(), 4, None);
+    assert!(next > failed);
+    let (img, passes) = collect(&session, next, 96, 72);
+    assert_eq!(passes, vec![1, 2, 4]);
+    assert!(
+        calls.load(Ordering::Relaxed) > before,
+        "the restart bypassed the hook"
+    );
+    let (batch, _) = render(&edited, 4, 1, &|_, _| {}).expect("render");
+    assert!(
+        img == batch,
+        "the render after the failure differs from the batch render"
     );
 }

@@ -1084,7 +1084,8 @@ fn row_r1(o: &StabilityOptions, rng: &mut Pcg) -> Row {
         robust: format!(
             "{guarded_nan} NaN; TIR verdict wrong on {mismatch}; Snell residual ≤ {}; \
              | |T|−1 | ≤ {}; refract∘refract error ≤ {} for cos θi, cos θt ≥ 0.1, ≤ {} at \
-             grazing angles; η = 1: |T − u| ≤ {} (1 − η²(1 − cos²) cancels at grazing angles)",
+             grazing angles; η = 1: |T − u| ≤ {} (cos²θt as (1 − η²) + η²cos²θi: no \
+             cancellation at grazing angles)",
             fmt_g(snell),
             fmt_g(len),
             fmt_g(roundtrip_regular),

@@ -142,6 +142,11 @@ pub fn sample_batches(target: u32) -> Vec<std::ops::Range<u32>> {
     out
 }
 
+/// Called by a worker at the start of each tile of every pass, inside the panic guard: the
+/// fault tests make it panic to check that a failed worker is reported, as
+/// [`super::render_with`] does for the batch render. The viewer sets none.
+pub type TileHook = dyn Fn(Pass, Rect) + Send + Sync;
+
 /// Owns the worker pool and the channel; one per viewer.
 pub struct Session {
     generation: Arc<AtomicU64>,
@@ -152,6 +157,7 @@ pub struct Session {
     stats: Arc<LiveStats>,
     /// Events of older generations dropped on receipt.
     stale_dropped: std::cell::Cell<u64>,
+    tile_hook: Option<Arc<TileHook>>,
 }
 
 impl Session {
@@ -166,7 +172,13 @@ impl Session {
             threads,
             stats: Arc::new(LiveStats::default()),
             stale_dropped: std::cell::Cell::new(0),
+            tile_hook: None,
         })
+    }
+
+    /// Sets (or with `None` removes) the [`TileHook`]; takes effect at the next start.
+    pub fn set_tile_hook(&mut self, hook: Option<Arc<TileHook>>) {
+        self.tile_hook = hook;
     }
 
     /// Changes the worker count (takes effect at the next start).
@@ -209,6 +221,7 @@ impl Session {
             failed: AtomicBool::new(false),
             sender: self.sender.clone(),
             stats: self.stats.clone(),
+            tile_hook: self.tile_hook.clone(),
         };
         let pool = self.pool.clone();
         // The coordinator runs on its own thread so the UI never waits; it only hands passes to
@@ -254,6 +267,7 @@ struct Job {
     failed: AtomicBool,
     sender: SyncSender<SessionEvent>,
     stats: Arc<LiveStats>,
+    tile_hook: Option<Arc<TileHook>>,
 }
 
 impl Job {
@@ -341,7 +355,12 @@ impl Job {
             if self.stale() {
                 return;
             }
-            match catch_unwind(AssertUnwindSafe(|| work(rect, i))) {
+            match catch_unwind(AssertUnwindSafe(|| {
+                if let Some(hook) = &self.tile_hook {
+                    hook(pass, rect);
+                }
+                work(rect, i)
+            })) {
                 Ok((pixels, aux)) => {
                     if self.stale() {
                         return;
