@@ -138,7 +138,12 @@ impl Bvh {
                 })
                 .collect()
         };
-        let params = BvhBuildParams::medium_build();
+        let params = match std::env::var("TMP_PRESET").as_deref() {
+            Ok("fast") => BvhBuildParams::fast_build(),
+            Ok("veryfast") => BvhBuildParams::very_fast_build(),
+            Ok("slow") => BvhBuildParams::slow_build(),
+            _ => BvhBuildParams::medium_build(),
+        };
         let mut built = None;
         let mut boxes = bounds(&prims);
         if max_stacked(&boxes) <= MAX_STACKED {

@@ -981,7 +981,7 @@ pub fn refract_identity_err(n: usize, rng: &mut Pcg) -> f64 {
 // =============================================================================================
 // B2: pathological BVH builds
 
-/// The traversal stack of the BVH holds 64 entries; the build guarantees the BVH8 is
+/// The traversal stack of the BVH holds 64 entries; the build guarantees the 4-wide BVH is
 /// shallower (`accel::bvh`), so a depth at or above this would be a bug.
 pub const BVH_DEPTH_CAP: usize = 64;
 
