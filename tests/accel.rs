@@ -554,3 +554,33 @@ fn closed_mesh_has_no_leaks_through_any_accelerator() {
         }
     }
 }
+
+/// From `accel::bvh::FAST_BUILD_MIN_PRIMS` (500k) primitives on the BVH is built with obvhs's
+/// faster preset (and PLOC runs in parallel): its hits must still equal the grid's (testing
+/// every primitive is too slow at this size; the grid is itself checked against it above).
+#[test]
+fn large_scene_built_with_the_fast_preset_agrees_with_the_grid() {
+    let mut rng = Pcg::new(11);
+    let scene = random_scene(&mut rng, 20, 600_000, 4.0, 0.02);
+    let rays = rays_for(&scene, &mut rng, 3000);
+    let methods = default_methods();
+    let bvh = Accel::build(AccelKind::Bvh, &scene);
+    let grid = Accel::build(AccelKind::Grid, &scene);
+    assert_eq!(bvh.prim_count(), 600_020);
+    let mut hits = 0;
+    for (i, (ray, t_min, t_max)) in rays.iter().enumerate() {
+        let want = grid.closest_hit(&methods, ray, *t_min, *t_max);
+        assert_eq!(
+            bvh.closest_hit(&methods, ray, *t_min, *t_max),
+            want,
+            "closest hit, ray {i}: {ray:?}"
+        );
+        assert_eq!(
+            bvh.occluded(&methods, ray, *t_min, *t_max),
+            want.is_some(),
+            "occlusion, ray {i}: {ray:?}"
+        );
+        hits += usize::from(want.is_some());
+    }
+    assert!(hits > 1000, "too few hits to be a test: {hits}");
+}
