@@ -7,11 +7,12 @@
 //! triangles, a mirror sphere, a glass sphere, a floor, two point lights; 640×480, 1 sample,
 //! depth 4 below the primary ray) on the same number of threads, each in its own process:
 //! raytree through `raytree render bench.toml --stats-json`, the peer from a binary copy of the
-//! very scene raytree loaded. Reported: render-phase Mrays/s (median of the runs) and their
-//! ratio, load and build seconds, bytes per triangle, peak memory, rays by kind (which must
+//! very scene raytree loaded, runs alternating. Reported: render-phase Mrays/s (median of the
+//! runs), their ratio (the median, smallest and largest of the ratios of each raytree run to
+//! the Embree run after it), load and build seconds, bytes per triangle, peak memory, rays by kind (which must
 //! agree within a few percent) and how many pixels differ between the two images.
 //!
-//! Run: `cargo bench --bench peer` (80k and 320k triangles, 2 threads, 3 runs each), or e.g.
+//! Run: `cargo bench --bench peer` (80k and 320k triangles, 2 threads, 7 runs each), or e.g.
 //! `cargo bench --bench peer -- --sizes 1000,1000000 --threads 1 --runs 5 --keep /tmp/b`.
 //! `--embree-quality high` (or `low`) builds Embree's BVH at that quality instead of its
 //! default, medium. `--scaling` instead prints raytree's build and render time against
@@ -42,7 +43,7 @@ fn parse_options() -> Options {
     let mut o = Options {
         sizes: vec![80_000, 320_000],
         threads: 2,
-        runs: 3,
+        runs: 7,
         keep: None,
         scaling: false,
         peer: true,
@@ -350,32 +351,51 @@ fn peer_comparison(o: &Options, root: &Path) {
                 scene.render.height,
             )
         });
+        // Each raytree run is paired with the Embree run right after it: the median of the
+        // pairs' ratios is steadier on a shared machine than the ratio of the two medians,
+        // and the pairs' spread shows how steady.
+        let mut ratios: Vec<f64> = ours
+            .iter()
+            .zip(&theirs)
+            .map(|(a, b)| a.mrays() / b.mrays())
+            .collect();
+        ratios.sort_by(f64::total_cmp);
+        let ratio = (!ratios.is_empty()).then(|| {
+            (
+                ratios[ratios.len() / 2],
+                ratios[0],
+                ratios[ratios.len() - 1],
+            )
+        });
         rows.push((
             scene.triangles.len(),
             summary(&ours),
             (!theirs.is_empty()).then(|| summary(&theirs)),
             diff,
+            ratio,
         ));
         let _ = std::io::stdout().flush();
     }
     println!("load average after: {}", load_average());
     println!();
     println!(
-        "| triangles | raytree Mrays/s | Embree Mrays/s | ratio | load s (rt / E) | build s (rt / E) | render s (rt / E) | bytes/tri (rt / E) | peak MB (rt / E) |"
+        "| triangles | raytree Mrays/s | Embree Mrays/s | ratio (pairs: median, min–max) | load s (rt / E) | build s (rt / E) | render s (rt / E) | bytes/tri (rt / E) | peak MB (rt / E) |"
     );
     println!("|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     let pair = |a: f64, b: Option<f64>, digits: usize| match b {
         Some(b) => format!("{a:.digits$} / {b:.digits$}"),
         None => format!("{a:.digits$} / –"),
     };
-    for (tris, r, e, _) in &rows {
+    for (tris, r, e, _, ratio) in &rows {
         let em = e.as_ref().map(Run::mrays);
         println!(
             "| {} | {:.2} | {} | {} | {} | {} | {} | {} | {} |",
             tris,
             r.mrays(),
             em.map_or("–".into(), |m| format!("{m:.2}")),
-            em.map_or("–".into(), |m| format!("{:.2}", r.mrays() / m)),
+            ratio.map_or("–".into(), |(m, lo, hi)| format!(
+                "**{m:.2}** ({lo:.2}–{hi:.2})"
+            )),
             pair(r.load_secs, e.as_ref().map(|e| e.load_secs), 3),
             pair(r.build_secs, e.as_ref().map(|e| e.build_secs), 3),
             pair(r.render_secs, e.as_ref().map(|e| e.render_secs), 3),
@@ -396,7 +416,7 @@ fn peer_comparison(o: &Options, root: &Path) {
         "| triangles | rays raytree (P / R / T / S) | rays Embree (P / R / T / S) | total differs | pixels differing (> 2/255) |"
     );
     println!("|---:|---:|---:|---:|---:|");
-    for (tris, r, e, diff) in &rows {
+    for (tris, r, e, diff, _) in &rows {
         let kinds = |x: &Run| {
             let [p, rf, t, s] = x.rays;
             format!("{p} / {rf} / {t} / {s}")
