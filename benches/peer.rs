@@ -14,7 +14,8 @@
 //!
 //! Run: `cargo bench --bench peer` (80k and 320k triangles, 2 threads, 7 runs each), or e.g.
 //! `cargo bench --bench peer -- --sizes 1000,1000000 --threads 1 --runs 5 --keep /tmp/b`.
-//! `--embree-quality high` (or `low`) builds Embree's BVH at that quality instead of its
+//! `--size 1280x960` renders more rays than the scene's 640×480 (a longer, steadier render
+//! phase on a noisy machine). `--embree-quality high` (or `low`) builds Embree's BVH at that quality instead of its
 //! default, medium. `--scaling` instead prints raytree's build and render time against
 //! triangle count (1k to 4M) on 1 and 2 threads, and with `--chart FILE.png` draws it.
 
@@ -37,6 +38,8 @@ struct Options {
     peer: bool,
     embree_quality: Option<String>,
     chart: Option<PathBuf>,
+    /// Image size instead of the scene's 640×480 (more rays: a longer, steadier render phase).
+    size: Option<(u32, u32)>,
 }
 
 fn parse_options() -> Options {
@@ -49,6 +52,7 @@ fn parse_options() -> Options {
         peer: true,
         embree_quality: None,
         chart: None,
+        size: None,
     };
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
@@ -70,6 +74,14 @@ fn parse_options() -> Options {
             "--no-peer" => o.peer = false,
             "--embree-quality" => o.embree_quality = Some(value("--embree-quality")),
             "--chart" => o.chart = Some(PathBuf::from(value("--chart"))),
+            "--size" => {
+                let v = value("--size");
+                let (w, h) = v.split_once('x').expect("--size: WIDTHxHEIGHT");
+                o.size = Some((
+                    w.parse().expect("--size: a whole width"),
+                    h.parse().expect("--size: a whole height"),
+                ));
+            }
             // `cargo bench` passes `--bench`; filters and the rest are not ours.
             _ => {}
         }
@@ -119,11 +131,14 @@ fn summary(runs: &[Run]) -> Run {
     out
 }
 
-fn raytree_run(scene_file: &Path, image: &Path, threads: usize) -> Run {
+fn raytree_run(scene_file: &Path, image: &Path, threads: usize, size: Option<(u32, u32)>) -> Run {
     let stats = image.with_extension("json");
-    let output = Command::new(env!("CARGO_BIN_EXE_raytree"))
-        .arg("render")
-        .arg(scene_file)
+    let mut command = Command::new(env!("CARGO_BIN_EXE_raytree"));
+    command.arg("render").arg(scene_file);
+    if let Some((w, h)) = size {
+        command.args(["--width", &w.to_string(), "--height", &h.to_string()]);
+    }
+    let output = command
         .arg("-o")
         .arg(image)
         .args(["--quiet", "--threads", &threads.to_string(), "--stats-json"])
@@ -325,14 +340,17 @@ fn peer_comparison(o: &Options, root: &Path) {
     for &size in &o.sizes {
         let dir = root.join(format!("tris_{size}"));
         let scene_file = write_bench_scene(&dir, size).expect("write the bench scene");
-        let scene = load_scene_file(&scene_file).expect("load the bench scene");
+        let mut scene = load_scene_file(&scene_file).expect("load the bench scene");
+        if let Some((w, h)) = o.size {
+            (scene.render.width, scene.render.height) = (w, h);
+        }
         let scene_bin = dir.join("scene.bin");
         write_peer_scene(&scene, &scene_bin);
         let (ours_png, theirs_f32) = (dir.join("raytree.png"), dir.join("embree.f32"));
         let mut ours = Vec::new();
         let mut theirs = Vec::new();
         for _ in 0..o.runs {
-            ours.push(raytree_run(&scene_file, &ours_png, o.threads));
+            ours.push(raytree_run(&scene_file, &ours_png, o.threads, o.size));
             if let Some(exe) = &harness {
                 theirs.push(harness_run(
                     exe,
@@ -478,7 +496,7 @@ fn scaling(o: &Options, root: &Path) {
         let mut by_threads = Vec::new();
         for (threads, points) in &mut series {
             let runs: Vec<Run> = (0..o.runs)
-                .map(|_| raytree_run(&scene_file, &png, *threads))
+                .map(|_| raytree_run(&scene_file, &png, *threads, o.size))
                 .collect();
             let r = summary(&runs);
             csv.push_str(&format!(
