@@ -183,15 +183,74 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &Chart) -> Res
         .flat_map(|s| s.points.iter().map(|p| p.1));
     let (x0, x1) = axis_range(xs, chart.x_log);
     let (y0, y1) = axis_range(ys, chart.y_log);
+    let legend = legend_corner(chart, (x0, x1), (y0, y1));
     match (chart.x_log, chart.y_log) {
-        (false, false) => plot(root, chart, x0..x1, y0..y1),
-        (true, false) => plot(root, chart, (x0..x1).log_scale(), y0..y1),
-        (false, true) => plot(root, chart, x0..x1, (y0..y1).log_scale()),
-        (true, true) => plot(root, chart, (x0..x1).log_scale(), (y0..y1).log_scale()),
+        (false, false) => plot(root, chart, x0..x1, y0..y1, legend),
+        (true, false) => plot(root, chart, (x0..x1).log_scale(), y0..y1, legend),
+        (false, true) => plot(root, chart, x0..x1, (y0..y1).log_scale(), legend),
+        (true, true) => plot(
+            root,
+            chart,
+            (x0..x1).log_scale(),
+            (y0..y1).log_scale(),
+            legend,
+        ),
     }
 }
 
-fn plot<DB, X, Y>(root: &DrawingArea<DB, Shift>, chart: &Chart, x: X, y: Y) -> Result<(), String>
+/// The corner of the plot where the legend covers the fewest points (upper right on a tie,
+/// then upper left, lower right, lower left).
+fn legend_corner(chart: &Chart, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPosition {
+    // Where a value falls along an axis, 0 to 1.
+    let along = |v: f64, (lo, hi): (f64, f64), log: bool| {
+        if log {
+            (v.ln() - lo.ln()) / (hi.ln() - lo.ln())
+        } else {
+            (v - lo) / (hi - lo)
+        }
+    };
+    let points: Vec<(f64, f64)> = chart
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter())
+        .filter(|p| p.0.is_finite() && p.1.is_finite())
+        .filter(|p| (!chart.x_log || p.0 > 0.0) && (!chart.y_log || p.1 > 0.0))
+        .map(|p| (along(p.0, x, chart.x_log), along(p.1, y, chart.y_log)))
+        .collect();
+    // The legend box is about this much of the plot's width and height.
+    let (w, h) = (0.4, 0.35);
+    let corners = [
+        (SeriesLabelPosition::UpperRight, true, true),
+        (SeriesLabelPosition::UpperLeft, false, true),
+        (SeriesLabelPosition::LowerRight, true, false),
+        (SeriesLabelPosition::LowerLeft, false, false),
+    ];
+    let covered = |right: bool, upper: bool| {
+        points
+            .iter()
+            .filter(|&&(px, py)| {
+                (if right { px >= 1.0 - w } else { px <= w })
+                    && (if upper { py >= 1.0 - h } else { py <= h })
+            })
+            .count()
+    };
+    let mut best = (SeriesLabelPosition::UpperRight, usize::MAX);
+    for (position, right, upper) in corners {
+        let n = covered(right, upper);
+        if n < best.1 {
+            best = (position, n);
+        }
+    }
+    best.0
+}
+
+fn plot<DB, X, Y>(
+    root: &DrawingArea<DB, Shift>,
+    chart: &Chart,
+    x: X,
+    y: Y,
+    legend_position: SeriesLabelPosition,
+) -> Result<(), String>
 where
     DB: DrawingBackend,
     X: AsRangedCoord<Value = f64>,
@@ -276,7 +335,7 @@ where
         .map_err(err)?;
     }
     cc.configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
+        .position(legend_position)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .label_font(("sans-serif", 14))
@@ -288,6 +347,44 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_legend_goes_where_it_covers_fewest_points() {
+        let chart = |points: Vec<(f64, f64)>, log: bool| Chart {
+            title: String::new(),
+            x_label: String::new(),
+            y_label: String::new(),
+            x_log: log,
+            y_log: log,
+            series: vec![Series::new("s", points)],
+        };
+        let corner = |c: &Chart| {
+            let xs = c.series.iter().flat_map(|s| s.points.iter().map(|p| p.0));
+            let ys = c.series.iter().flat_map(|s| s.points.iter().map(|p| p.1));
+            legend_corner(c, axis_range(xs, c.x_log), axis_range(ys, c.y_log))
+        };
+        // Rising, log-log (time against size): the upper right is taken, the upper left free.
+        let rising = chart(
+            (0..7).map(|i| (10f64.powi(i), 10f64.powi(i))).collect(),
+            true,
+        );
+        assert_eq!(corner(&rising), SeriesLabelPosition::UpperLeft);
+        // Falling, linear: the upper right is free.
+        let falling = chart((0..10).map(|i| (i as f64, 9.0 - i as f64)).collect(), false);
+        assert_eq!(corner(&falling), SeriesLabelPosition::UpperRight);
+        // Everything high: the legend goes below.
+        let high = chart(
+            (0..10)
+                .map(|i| (i as f64, 10.0 + (i % 2) as f64))
+                .chain([(5.0, 0.0)])
+                .collect(),
+            false,
+        );
+        assert!(matches!(
+            corner(&high),
+            SeriesLabelPosition::LowerRight | SeriesLabelPosition::LowerLeft
+        ));
+    }
 
     #[test]
     fn ticks_are_short() {
