@@ -72,12 +72,12 @@ pub struct PrimHit {
 /// crossover at about 4, 6 and 7.
 ///
 /// The uniform grid is never chosen. On the sweep's sphere (the grid's best case: one even
-/// surface) its cheaper build won a *single* frame from about 1M triangles while the BVH build
-/// was serial (2.1M: 1.2 s against 2.2 s in all); with the parallel build the BVH builds 1M
-/// triangles in 0.6–0.75 s, and on the issue-7 Whitted scene (a torus, mirror and glass, 1M
-/// and 2M triangles) the BVH wins the first frame too (0.93 s against 1.9 s at 1M, 1.8 s
-/// against 2.8 s at 2M: the grid renders 10× slower there). A viewer renders many frames per
-/// build, where the BVH is 2–10× faster each.
+/// surface, cells evenly filled) its cheaper build still wins a *single* frame from about 0.9M
+/// triangles (after the parallel BVH build: 1M 0.65 s against 0.68 s, 2M 0.73 s against
+/// 1.28 s). But on the issue-7 Whitted scene (a torus, mirror and glass spheres) the grid
+/// renders about 10× slower and loses the first frame too (1M: 1.9 s against 0.93 s; 2M:
+/// 2.8 s against 1.8 s), and a viewer renders many frames per build, where the BVH is 2–10×
+/// faster each. `--accel grid` remains for the single frame of a huge even mesh.
 pub const AUTO_MIN_BVH_PRIMS: usize = 6;
 
 /// The accelerator `Auto` builds for `valid_prims` primitives (see [`AUTO_MIN_BVH_PRIMS`] for
