@@ -101,7 +101,7 @@ struct RenderArgs {
     /// Samples per pixel (sample 0 is the pixel centre).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
     samples: Option<u32>,
-    /// Worker threads; 0 uses every core (at most 1024).
+    /// Worker threads for the BVH build and the render; 0 uses every core (at most 1024).
     #[arg(long, default_value_t = 0,
           value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1024))]
     threads: usize,
@@ -135,8 +135,9 @@ struct BenchArgs {
     /// Image height of the sweep (default 240; --quick: 72).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     height: Option<u32>,
-    /// Worker threads; 0 uses every core.
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads for the builds and renders; 0 uses every core (at most 1024).
+    #[arg(long, default_value_t = 0,
+          value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1024))]
     threads: usize,
     /// Skip the accelerator scaling sweep.
     #[arg(long)]

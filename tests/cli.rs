@@ -195,6 +195,16 @@ fn out_of_range_options_are_refused() {
             .assert()
             .failure();
     }
+    // A thread count past the bound is a usage error (exit 2) before any thread starts.
+    for (command, output) in [("render", "-o"), ("bench", "--out")] {
+        let out = raytree()
+            .args([command, "quiz", "--threads", "99999999", output, "x.png"])
+            .output()
+            .expect("runs");
+        assert_eq!(out.status.code(), Some(2), "{command}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("--threads"), "{command}: {err}");
+    }
 }
 
 #[test]
