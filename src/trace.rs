@@ -15,6 +15,7 @@
 use std::sync::Arc;
 
 use glam::{Vec3, Vec3A};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::accel::{Accel, AccelKind, PrimHit, PrimSet};
@@ -177,7 +178,7 @@ impl Default for TraceSettings {
 pub fn prim_set(scene: &Scene) -> PrimSet {
     PrimSet {
         spheres: scene.spheres.iter().map(|s| (s.center, s.radius)).collect(),
-        triangles: scene.triangles.iter().map(|t| t.vertices).collect(),
+        triangles: scene.triangles.par_iter().map(|t| t.vertices).collect(),
     }
 }
 

@@ -24,6 +24,7 @@ mod bvh;
 mod grid;
 
 use glam::Vec3;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::geometry::{
@@ -328,33 +329,30 @@ impl Accel {
     /// Build the accelerator `kind` over `prims` (copied; invalid primitives dropped and
     /// counted). `Auto` resolves to a concrete kind, see [`auto_kind`].
     pub fn build(kind: AccelKind, prims: &PrimSet) -> Accel {
-        let mut list = Vec::with_capacity(prims.spheres.len() + prims.triangles.len());
-        let mut skipped = 0;
-        let mut id = 0u32;
-        for &(center, radius) in &prims.spheres {
-            if center.is_finite() && radius.is_finite() && radius > 0.0 {
-                list.push(Prim {
+        // Spheres first (the BVH tells kinds apart by index), then triangles; ids are the
+        // indices in `prims` (spheres, then triangles), kept by invalid ones too. In parallel:
+        // a million triangles take tens of milliseconds to check and copy.
+        let n_spheres = prims.spheres.len();
+        let spheres = prims
+            .spheres
+            .par_iter()
+            .enumerate()
+            .filter_map(|(i, &(center, radius))| {
+                (center.is_finite() && radius.is_finite() && radius > 0.0).then_some(Prim {
                     shape: Shape::Sphere { center, radius },
-                    id,
-                });
-            } else {
-                skipped += 1;
-            }
-            id += 1;
-        }
-        for v in &prims.triangles {
+                    id: i as u32,
+                })
+            });
+        let triangles = prims.triangles.par_iter().enumerate().filter_map(|(i, v)| {
             let cross = (v[1] - v[0]).cross(v[2] - v[0]);
             let finite = v.iter().all(|p| p.is_finite()) && cross.is_finite();
-            if finite && cross != Vec3::ZERO {
-                list.push(Prim {
-                    shape: Shape::Triangle(*v),
-                    id,
-                });
-            } else {
-                skipped += 1;
-            }
-            id += 1;
-        }
+            (finite && cross != Vec3::ZERO).then_some(Prim {
+                shape: Shape::Triangle(*v),
+                id: (n_spheres + i) as u32,
+            })
+        });
+        let list: Vec<Prim> = spheres.chain(triangles).collect();
+        let skipped = n_spheres + prims.triangles.len() - list.len();
         let kind = match kind {
             AccelKind::Auto => auto_kind(list.len()),
             k => k,
