@@ -417,13 +417,13 @@ impl FlatNode {
 /// `bvh2` in pre-order, or `None` when it is empty or deeper than [`MAX_BVH2_DEPTH`]. This is
 /// the one pass that follows the build's node order (after reinsertion, scattered over memory:
 /// a cache miss per node); everything after it reads the copy front to back or back to front.
-fn preorder(bvh2: &Bvh2) -> Option<Vec<FlatNode>> {
+fn preorder(bvh2: Bvh2) -> Option<Vec<FlatNode>> {
     if bvh2.nodes.is_empty() {
         return None;
     }
     if bvh2.nodes.len() < PARALLEL_PREORDER_NODES {
         let mut flat = Vec::with_capacity(bvh2.nodes.len());
-        return preorder_from(bvh2, 0, 1, &mut flat).then_some(flat);
+        return preorder_from(&bvh2, 0, 1, &mut flat).then_some(flat);
     }
     // The walk is a chain of dependent cache misses, so it is split: the top
     // [`PREORDER_SPLIT_DEPTH`] levels are walked here, listing the subtrees below them in
@@ -459,11 +459,13 @@ fn preorder(bvh2: &Bvh2) -> Option<Vec<FlatNode>> {
         .map(|item| match *item {
             Item::Subtree(i, d) => {
                 let mut piece = Vec::new();
-                preorder_from(bvh2, i, d, &mut piece).then_some(piece)
+                preorder_from(&bvh2, i, d, &mut piece).then_some(piece)
             }
             Item::Node(..) => Some(Vec::new()),
         })
         .collect();
+    // Peak memory: the pieces hold everything from here on.
+    drop(bvh2);
     // Where each item starts in the joined copy.
     let mut start = Vec::with_capacity(items.len());
     let mut total = 0usize;
@@ -539,9 +541,8 @@ fn preorder_from(bvh2: &Bvh2, root: u32, depth: usize, out: &mut Vec<FlatNode>) 
 /// The 4-wide tree of a binary BVH whose leaves hold one primitive each (PLOC's and
 /// [`median_bvh2`]'s do); `None` for an empty tree or one deeper than [`MAX_BVH2_DEPTH`].
 fn collapse(bvh2: Bvh2, prims: &[Prim]) -> Option<Bvh> {
-    let flat = preorder(&bvh2)?;
-    // The copy is all that is needed from here on.
-    drop(bvh2);
+    // The copy is all that is needed from here on (`preorder` frees the binary tree).
+    let flat = preorder(bvh2)?;
     let n = flat.len();
     let right = |i: usize| flat[i].link as usize;
     // Bottom up (reverse pre-order): primitives under each node and the surface-area cost of
@@ -851,9 +852,9 @@ mod tests {
             1,
         );
         assert!(bvh2.nodes.len() >= PARALLEL_PREORDER_NODES);
-        let parallel = preorder(&bvh2).expect("a tree");
         let mut serial = Vec::new();
         assert!(preorder_from(&bvh2, 0, 1, &mut serial));
+        let parallel = preorder(bvh2).expect("a tree");
         assert_eq!(parallel.len(), serial.len());
         for (k, (a, b)) in parallel.iter().zip(&serial).enumerate() {
             assert!(
