@@ -417,132 +417,45 @@ impl FlatNode {
 /// `bvh2` in pre-order, or `None` when it is empty or deeper than [`MAX_BVH2_DEPTH`]. This is
 /// the one pass that follows the build's node order (after reinsertion, scattered over memory:
 /// a cache miss per node); everything after it reads the copy front to back or back to front.
-fn preorder(bvh2: Bvh2) -> Option<Vec<FlatNode>> {
+fn preorder(bvh2: &Bvh2) -> Option<Vec<FlatNode>> {
     if bvh2.nodes.is_empty() {
         return None;
     }
-    if bvh2.nodes.len() < PARALLEL_PREORDER_NODES {
-        let mut flat = Vec::with_capacity(bvh2.nodes.len());
-        return preorder_from(&bvh2, 0, 1, &mut flat).then_some(flat);
-    }
-    // The walk is a chain of dependent cache misses, so it is split: the top
-    // [`PREORDER_SPLIT_DEPTH`] levels are walked here, listing the subtrees below them in
-    // pre-order; the threads copy those subtrees, and the pieces are joined in order.
-    enum Item {
-        /// A top node; for an inner one, the item index of its right child.
-        Node(FlatNode, usize),
-        /// A subtree below the split: its binary node and depth.
-        Subtree(u32, usize),
-    }
-    let mut items: Vec<Item> = Vec::new();
-    // (binary node, item index of the parent whose right child it is, depth)
-    let mut todo = vec![(0u32, usize::MAX, 1usize)];
-    while let Some((i, parent, d)) = todo.pop() {
-        let here = items.len();
-        if parent != usize::MAX
-            && let Item::Node(_, right) = &mut items[parent]
-        {
-            *right = here;
-        }
-        let node = &bvh2.nodes[i as usize];
-        if node.prim_count == 0 && d < PREORDER_SPLIT_DEPTH {
-            let (min, max) = (node.aabb.min.to_array(), node.aabb.max.to_array());
-            items.push(Item::Node(FlatNode { min, max, link: 0 }, 0));
-            todo.push((node.first_index + 1, here, d + 1));
-            todo.push((node.first_index, usize::MAX, d + 1));
-        } else {
-            items.push(Item::Subtree(i, d));
-        }
-    }
-    let pieces: Vec<Option<Vec<FlatNode>>> = items
-        .par_iter()
-        .map(|item| match *item {
-            Item::Subtree(i, d) => {
-                let mut piece = Vec::new();
-                preorder_from(&bvh2, i, d, &mut piece).then_some(piece)
-            }
-            Item::Node(..) => Some(Vec::new()),
-        })
-        .collect();
-    // Peak memory: the pieces hold everything from here on.
-    drop(bvh2);
-    // Where each item starts in the joined copy.
-    let mut start = Vec::with_capacity(items.len());
-    let mut total = 0usize;
-    for (item, piece) in items.iter().zip(&pieces) {
-        start.push(total);
-        total += match item {
-            Item::Node(..) => 1,
-            Item::Subtree(..) => piece.as_ref()?.len(),
-        };
-    }
-    let mut flat = Vec::with_capacity(total);
-    for ((item, piece), &at) in items.iter().zip(pieces).zip(&start) {
-        match item {
-            Item::Node(node, right) => flat.push(FlatNode {
-                link: start[*right] as u32,
-                ..*node
-            }),
-            Item::Subtree(..) => flat.extend(piece?.into_iter().map(|f| {
-                if f.leaf() {
-                    f
-                } else {
-                    FlatNode {
-                        link: f.link + at as u32,
-                        ..f
-                    }
-                }
-            })),
-        }
-    }
-    Some(flat)
-}
-
-/// Binary trees of this many nodes and more are copied by [`preorder`] on several threads.
-const PARALLEL_PREORDER_NODES: usize = 1 << 16;
-
-/// [`preorder`] walks the levels above this one itself and hands the subtrees below (up to
-/// 2⁶ = 64 of them) to the threads.
-const PREORDER_SPLIT_DEPTH: usize = 7;
-
-/// Appends the subtree of binary node `root` (at depth `depth`, the root's being 1) to `out`
-/// in pre-order, links relative to `out`'s start; `false` when it reaches below
-/// [`MAX_BVH2_DEPTH`].
-fn preorder_from(bvh2: &Bvh2, root: u32, depth: usize, out: &mut Vec<FlatNode>) -> bool {
-    let base = out.len();
-    // (binary node, index in `out` of the parent whose right child it is, depth)
-    let mut todo = vec![(root, usize::MAX, depth)];
+    let mut flat: Vec<FlatNode> = Vec::with_capacity(bvh2.nodes.len());
+    // (binary node, pre-order index of the parent whose right child it is, depth)
+    let mut todo = vec![(0u32, u32::MAX, 1usize)];
     while let Some((i, parent, d)) = todo.pop() {
         if d > MAX_BVH2_DEPTH {
-            return false;
+            return None;
         }
-        let here = out.len();
-        if parent != usize::MAX {
-            out[parent].link = (here - base) as u32;
+        let here = flat.len() as u32;
+        if parent != u32::MAX {
+            flat[parent as usize].link = here;
         }
         let node = &bvh2.nodes[i as usize];
         let (min, max) = (node.aabb.min.to_array(), node.aabb.max.to_array());
         if node.prim_count == 0 {
-            out.push(FlatNode { min, max, link: 0 });
+            flat.push(FlatNode { min, max, link: 0 });
             todo.push((node.first_index + 1, here, d + 1));
-            todo.push((node.first_index, usize::MAX, d + 1));
+            todo.push((node.first_index, u32::MAX, d + 1));
         } else {
             assert!(node.prim_count == 1, "binary leaves hold one primitive");
-            out.push(FlatNode {
+            flat.push(FlatNode {
                 min,
                 max,
                 link: FLAT_LEAF | bvh2.primitive_indices[node.first_index as usize],
             });
         }
     }
-    true
+    Some(flat)
 }
 
 /// The 4-wide tree of a binary BVH whose leaves hold one primitive each (PLOC's and
 /// [`median_bvh2`]'s do); `None` for an empty tree or one deeper than [`MAX_BVH2_DEPTH`].
 fn collapse(bvh2: Bvh2, prims: &[Prim]) -> Option<Bvh> {
-    // The copy is all that is needed from here on (`preorder` frees the binary tree).
-    let flat = preorder(bvh2)?;
+    let flat = preorder(&bvh2)?;
+    // The copy is all that is needed from here on.
+    drop(bvh2);
     let n = flat.len();
     let right = |i: usize| flat[i].link as usize;
     // Bottom up (reverse pre-order): primitives under each node and the surface-area cost of
@@ -834,39 +747,6 @@ mod tests {
     use super::*;
     use crate::accel::Closest;
     use crate::geometry::Methods;
-
-    #[test]
-    fn the_parallel_preorder_copy_equals_the_serial_one() {
-        // 50k boxes on a jittered grid: a PLOC tree of about 100k nodes, past the split.
-        let boxes: Vec<Aabb> = (0..50_000)
-            .map(|i| {
-                let c = Vec3A::new((i % 50) as f32, ((i / 50) % 40) as f32, (i / 2000) as f32);
-                jitter(&Aabb::new(c, c + Vec3A::splat(0.7)), i)
-            })
-            .collect();
-        let bvh2 = PlocBuilder::with_capacity(boxes.len()).build(
-            obvhs::ploc::PlocSearchDistance::Minimum,
-            &boxes,
-            (0..boxes.len() as u32).collect(),
-            obvhs::ploc::SortPrecision::U64,
-            1,
-        );
-        assert!(bvh2.nodes.len() >= PARALLEL_PREORDER_NODES);
-        let mut serial = Vec::new();
-        assert!(preorder_from(&bvh2, 0, 1, &mut serial));
-        let parallel = preorder(bvh2).expect("a tree");
-        assert_eq!(parallel.len(), serial.len());
-        for (k, (a, b)) in parallel.iter().zip(&serial).enumerate() {
-            assert!(
-                a.min == b.min && a.max == b.max && a.link == b.link,
-                "node {k} differs"
-            );
-        }
-        // Pre-order: a leaf count of n below a node spans 2n − 1 entries, the right child
-        // starts after the left subtree.
-        assert_eq!(serial.iter().filter(|f| f.leaf()).count(), boxes.len());
-        assert!(!serial[0].leaf() && serial[0].link as usize > 1);
-    }
 
     #[test]
     fn the_preset_follows_the_scene_size() {
