@@ -198,6 +198,11 @@ fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &Chart) -> Res
     }
 }
 
+/// A point the axes can show: finite, and positive on a log axis.
+fn drawable(chart: &Chart, p: &(f64, f64)) -> bool {
+    p.0.is_finite() && p.1.is_finite() && (!chart.x_log || p.0 > 0.0) && (!chart.y_log || p.1 > 0.0)
+}
+
 /// The corner of the plot where the legend covers the fewest points (upper right on a tie,
 /// then upper left, lower right, lower left).
 fn legend_corner(chart: &Chart, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPosition {
@@ -213,8 +218,7 @@ fn legend_corner(chart: &Chart, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPosi
         .series
         .iter()
         .flat_map(|s| s.points.iter())
-        .filter(|p| p.0.is_finite() && p.1.is_finite())
-        .filter(|p| (!chart.x_log || p.0 > 0.0) && (!chart.y_log || p.1 > 0.0))
+        .filter(|p| drawable(chart, p))
         .map(|p| (along(p.0, x, chart.x_log), along(p.1, y, chart.y_log)))
         .collect();
     // The legend box is about this much of the plot's width and height.
@@ -278,12 +282,6 @@ where
         .light_line_style(RGBColor(235, 235, 235))
         .draw()
         .map_err(err)?;
-    let visible = |p: &&(f64, f64)| {
-        p.0.is_finite()
-            && p.1.is_finite()
-            && (!chart.x_log || p.0 > 0.0)
-            && (!chart.y_log || p.1 > 0.0)
-    };
     let mut colour_index = 0;
     for s in &chart.series {
         let shown: Vec<(usize, (f64, f64))> = s
@@ -291,7 +289,7 @@ where
             .iter()
             .copied()
             .enumerate()
-            .filter(|(_, p)| visible(&p))
+            .filter(|(_, p)| drawable(chart, p))
             .collect();
         let points: Vec<(f64, f64)> = shown.iter().map(|(_, p)| *p).collect();
         let (colour, line_width, ring) = match s.style {
