@@ -1,6 +1,18 @@
 //! raytree: recursive (Whitted) ray tracing as in the lecture notes in `shared/seed`, with the
 //! ray tracing tree of any pixel.
 //!
+//! Layers, bottom to top; a module imports only from the layers below it, never in a circle:
+//! 1. [`choice`] and [`geometry`]: named options; rays, hits, ray-origin offsets, the sphere
+//!    and triangle intersection methods.
+//! 2. [`scene`]: plain scene data, the camera ([`scene::camera`]), the rules and limits every
+//!    input is held to ([`scene::rules`]), TOML and OBJ loading, built-in scenes.
+//! 3. [`accel`]: none / uniform grid / BVH behind one type.
+//! 4. [`shade`], [`trace`], [`ray_tree`]: the local model, the one recursive trace, the tree.
+//! 5. [`render`] (tiles, film, the viewer's worker session, statistics) and [`export`].
+//! 6. `experiments` (feature `lab`: sweeps, charts, image metrics) and `app` (feature `viewer`:
+//!    the egui window; the only module that uses egui, eframe or wgpu).
+//! 7. The `raytree` command (`src/main.rs`).
+//!
 //! Data flow: a scene file or OBJ → [`scene::Scene`] (or a [`scene::SceneError`]; callers keep
 //! their old scene) → an accelerator ([`accel::Accel`]) over the scene's spheres and triangles →
 //! [`trace::Tracer::trace`] per sample in worker threads ([`render`]) → a linear `f32` film → [`export`]
@@ -8,7 +20,10 @@
 //! no-op one.
 
 pub mod accel;
+#[cfg(feature = "viewer")]
 pub mod app;
+pub mod choice;
+#[cfg(feature = "lab")]
 pub mod experiments;
 pub mod export;
 pub mod geometry;

@@ -1,17 +1,20 @@
 //! The `raytree` command: parse, call the library, print one-line errors, set the exit code.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
+#[cfg(feature = "lab")]
 use std::sync::atomic::AtomicBool;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand};
 use raytree::accel::AccelKind;
+use raytree::choice::Choice;
+#[cfg(feature = "lab")]
 use raytree::experiments::{bench, rows};
 use raytree::geometry::{Methods, OffsetMethod, SphereMethod, TriangleMethod};
 use raytree::render::{RenderSettings, render};
-use raytree::scene::{self, Scene, Shading};
+use raytree::scene::{self, Scene, Shading, rules};
 use raytree::trace::{TraceSettings, Tracer};
 use raytree::{export, ray_tree};
 
@@ -43,10 +46,12 @@ enum Command {
     Render(RenderArgs),
     /// Print the ray tracing tree of one pixel's centre sample.
     Tree(TreeArgs),
+    #[cfg(feature = "lab")]
     /// Chart render time against image error for every speed/accuracy knob (bench.csv,
     /// bench.svg, bench.png) and build/render time against triangle count per accelerator
     /// (scaling.csv, scaling.svg, scaling.png).
     Bench(BenchArgs),
+    #[cfg(feature = "lab")]
     /// Measure where the naive intersection, offset and refraction methods fail and that the
     /// robust ones hold (the rows of STABILITY.md): stability.md and one chart per row.
     Stability(StabilityArgs),
@@ -57,38 +62,75 @@ enum Command {
 #[derive(Args, Debug)]
 struct SceneOverrides {
     /// Image width in pixels (overrides the scene's [render] width).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_parser = count(&rules::IMAGE_SIZE))]
     width: Option<u32>,
     /// Image height in pixels.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_parser = count(&rules::IMAGE_SIZE))]
     height: Option<u32>,
-    /// Deepest child ray traced; the primary ray has depth 0 (0..=64).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=64))]
+    /// Deepest child ray traced; the primary ray has depth 0.
+    #[arg(long, value_parser = count(&rules::DEPTH))]
     max_depth: Option<u32>,
     /// Specular model.
-    #[arg(long, value_enum)]
-    shading: Option<ShadingArg>,
+    #[arg(long, value_parser = ChoiceParser::<Shading>::default())]
+    shading: Option<Shading>,
     /// Accelerator: auto picks from the scene's size.
-    #[arg(long, value_enum, default_value_t = AccelKind::Auto)]
+    #[arg(long, value_parser = ChoiceParser::<AccelKind>::default(), default_value = "auto")]
     accel: AccelKind,
     /// Ray/sphere intersection method.
-    #[arg(long, value_enum, default_value_t = SphereMethod::default())]
+    #[arg(long, value_parser = ChoiceParser::<SphereMethod>::default(),
+          default_value = SphereMethod::default().name())]
     sphere: SphereMethod,
     /// Ray/triangle intersection method.
-    #[arg(long, value_enum, default_value_t = TriangleMethod::default())]
+    #[arg(long, value_parser = ChoiceParser::<TriangleMethod>::default(),
+          default_value = TriangleMethod::default().name())]
     triangle: TriangleMethod,
     /// How secondary rays leave a surface.
-    #[arg(long, value_enum, default_value_t = OffsetMethod::default())]
+    #[arg(long, value_parser = ChoiceParser::<OffsetMethod>::default(),
+          default_value = OffsetMethod::default().name())]
     offset: OffsetMethod,
     /// Skip rays whose weight (product of kr/kt) is below this (adaptive depth); 0 = off.
     #[arg(long, default_value_t = 0.0)]
     cutoff: f32,
 }
 
-#[derive(clap::ValueEnum, Clone, Copy, Debug)]
-enum ShadingArg {
-    Phong,
-    BlinnPhong,
+/// A clap parser for a library [`Choice`]: its names are the possible values, each with its
+/// help line (the library stays free of CLI derives).
+#[derive(Clone, Debug)]
+struct ChoiceParser<T>(std::marker::PhantomData<T>);
+
+impl<T> Default for ChoiceParser<T> {
+    fn default() -> Self {
+        Self(std::marker::PhantomData)
+    }
+}
+
+impl<T: Choice> clap::builder::TypedValueParser for ChoiceParser<T> {
+    type Value = T;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<T, clap::Error> {
+        let names = T::ALL.iter().map(|c| c.name());
+        clap::builder::PossibleValuesParser::new(names)
+            .parse_ref(cmd, arg, value)
+            .map(|name| T::from_name(&name).unwrap_or_default())
+    }
+
+    fn possible_values(
+        &self,
+    ) -> Option<Box<dyn Iterator<Item = clap::builder::PossibleValue> + '_>> {
+        Some(Box::new(T::ALL.iter().map(|c| {
+            clap::builder::PossibleValue::new(c.name()).help(c.help())
+        })))
+    }
+}
+
+/// A whole-number option held to a scene rule's range.
+fn count(range: &std::ops::RangeInclusive<u32>) -> clap::builder::RangedI64ValueParser<u32> {
+    clap::value_parser!(u32).range(i64::from(*range.start())..=i64::from(*range.end()))
 }
 
 #[derive(Args, Debug)]
@@ -99,7 +141,7 @@ struct RenderArgs {
     #[arg(short, long)]
     output: PathBuf,
     /// Samples per pixel (sample 0 is the pixel centre).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, value_parser = count(&rules::SAMPLES))]
     samples: Option<u32>,
     /// Worker threads for the BVH build and the render; 0 uses every core (at most 1024).
     #[arg(long, default_value_t = 0,
@@ -119,6 +161,7 @@ struct RenderArgs {
     overrides: SceneOverrides,
 }
 
+#[cfg(feature = "lab")]
 #[derive(Args, Debug)]
 struct BenchArgs {
     /// Scene file, OBJ file or built-in scene name.
@@ -130,10 +173,10 @@ struct BenchArgs {
     #[arg(long)]
     quick: bool,
     /// Image width of the sweep (default 320; --quick: 96).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_parser = count(&rules::IMAGE_SIZE))]
     width: Option<u32>,
     /// Image height of the sweep (default 240; --quick: 72).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
+    #[arg(long, value_parser = count(&rules::IMAGE_SIZE))]
     height: Option<u32>,
     /// Worker threads for the builds and renders; 0 uses every core (at most 1024).
     #[arg(long, default_value_t = 0,
@@ -147,6 +190,7 @@ struct BenchArgs {
     no_sweep: bool,
 }
 
+#[cfg(feature = "lab")]
 #[derive(Args, Debug)]
 struct StabilityArgs {
     /// Folder for stability.md and the charts (created if missing).
@@ -188,11 +232,7 @@ fn parse_pixel(s: &str) -> Result<(u32, u32), String> {
 
 /// Loads a scene file, an OBJ, or a built-in scene by name (a file of that name wins).
 fn load_scene(arg: &str) -> Result<Scene> {
-    let path = Path::new(arg);
-    if !path.exists() && scene::builtin::NAMES.contains(&arg) {
-        return Ok(scene::builtin::load_builtin(arg)?);
-    }
-    Ok(scene::load_scene_file(path)?)
+    Ok(scene::open_scene_arg(arg)?)
 }
 
 fn apply_overrides(scene: &mut Scene, o: &SceneOverrides) -> TraceSettings {
@@ -206,10 +246,7 @@ fn apply_overrides(scene: &mut Scene, o: &SceneOverrides) -> TraceSettings {
         scene.render.max_depth = d;
     }
     if let Some(s) = o.shading {
-        scene.render.shading = match s {
-            ShadingArg::Phong => Shading::Phong,
-            ShadingArg::BlinnPhong => Shading::BlinnPhong,
-        };
+        scene.render.shading = s;
     }
     TraceSettings {
         accel: o.accel,
@@ -364,6 +401,7 @@ fn run_render(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+#[cfg(feature = "lab")]
 /// A progress bar for the sweeps: position, length and what is running.
 fn sweep_bar() -> indicatif::ProgressBar {
     let bar = indicatif::ProgressBar::new(1);
@@ -376,6 +414,7 @@ fn sweep_bar() -> indicatif::ProgressBar {
     bar
 }
 
+#[cfg(feature = "lab")]
 /// A progress callback that moves `bar`.
 fn show_on(bar: &indicatif::ProgressBar) -> impl Fn(&bench::BenchProgress) + '_ {
     move |p| {
@@ -385,6 +424,7 @@ fn show_on(bar: &indicatif::ProgressBar) -> impl Fn(&bench::BenchProgress) + '_ 
     }
 }
 
+#[cfg(feature = "lab")]
 fn run_bench(args: &BenchArgs) -> Result<()> {
     use_threads(args.threads);
     let scene = load_scene(&args.scene)?;
@@ -452,6 +492,7 @@ fn run_bench(args: &BenchArgs) -> Result<()> {
     Ok(())
 }
 
+#[cfg(feature = "lab")]
 fn run_stability(args: &StabilityArgs) -> Result<()> {
     let opts = if args.quick {
         rows::StabilityOptions::quick()
@@ -521,7 +562,9 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Some(Command::Render(args)) => run_render(&args),
         Some(Command::Tree(args)) => run_tree(&args),
+        #[cfg(feature = "lab")]
         Some(Command::Bench(args)) => run_bench(&args),
+        #[cfg(feature = "lab")]
         Some(Command::Stability(args)) => run_stability(&args),
         Some(Command::Scenes) => {
             for name in scene::builtin::NAMES {
@@ -529,7 +572,13 @@ fn run(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
+        #[cfg(feature = "viewer")]
         None => raytree::app::run(cli.scene.as_deref()),
+        #[cfg(not(feature = "viewer"))]
+        None => bail!(
+            "this raytree was built without the viewer (feature `viewer`); use `raytree render \
+             SCENE -o out.png` or `raytree tree SCENE --pixel X,Y`"
+        ),
     }
 }
 

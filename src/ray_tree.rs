@@ -5,8 +5,7 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use crate::geometry::Ray;
-use crate::render::{CameraFrame, sample_offset};
-use crate::scene::Scene;
+use crate::scene::{CameraFrame, Scene, primary_ray};
 use crate::trace::{
     EndReason, RayCounts, RayKind, Recorder, SampleInfo, ShadowTest, SurfaceHit, TraceSettings,
     Tracer,
@@ -284,8 +283,7 @@ pub fn pixel_tree(tracer: &Tracer, x: u32, y: u32) -> Option<RayTree> {
         return None;
     }
     let frame = CameraFrame::new(&scene.camera, w, h);
-    let (u, v) = sample_offset(x, y, 0);
-    let ray = frame.ray(x as f32 + u, y as f32 + v);
+    let ray = primary_ray(&frame, x, y, 0);
     let mut rec = TreeRecorder {
         scene,
         stack: Vec::new(),

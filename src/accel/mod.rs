@@ -33,7 +33,7 @@ use crate::geometry::{
 };
 
 /// Which accelerator to build. `Auto` picks from the scene's size.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum AccelKind {
     #[default]
@@ -42,6 +42,13 @@ pub enum AccelKind {
     Grid,
     Bvh,
 }
+
+crate::choice::choice!(AccelKind {
+    Auto => ("auto", "picks from the scene's size (measured crossovers)"),
+    None => ("none", "tests every primitive"),
+    Grid => ("grid", "uniform grid, 3D-DDA traversal (spatial subdivision)"),
+    Bvh => ("bvh", "bounding volume hierarchy (obvhs build, 4-wide nodes)"),
+});
 
 /// Geometry the accelerators see. Primitive ids: spheres are `0..spheres.len()`, triangles
 /// follow, so id `spheres.len() + i` is triangle `i`.

@@ -120,7 +120,7 @@ pub struct ViewerApp {
 /// Opens the window and runs the viewer until it is closed.
 pub fn run(scene_arg: Option<&str>) -> anyhow::Result<()> {
     let (scene, label) = match scene_arg {
-        Some(arg) => (load_scene_arg(arg)?, arg.to_string()),
+        Some(arg) => (scene::open_scene_arg(arg)?, arg.to_string()),
         None => (
             scene::builtin::load_builtin("default")?,
             "default".to_string(),
@@ -154,94 +154,6 @@ pub fn run(scene_arg: Option<&str>) -> anyhow::Result<()> {
     })
 }
 
-/// Holds what the panels can change to the loader's rules, so an edit never hands the tracer
-/// what a scene file could not (`geometry`: also check every sphere and triangle).
-fn check_edit(s: &Scene, geometry: bool) -> Result<(), String> {
-    use crate::scene::load::{MAX_COORDINATE, MAX_DEPTH_LIMIT, MAX_IMAGE_SIZE, MAX_SAMPLES};
-    let placed = |v: Vec3| v.is_finite() && v.abs().max_element() <= MAX_COORDINATE;
-    let coefficient = |v: Vec3| v.is_finite() && v.min_element() >= 0.0;
-    let r = &s.render;
-    if !(1..=MAX_IMAGE_SIZE).contains(&r.width) || !(1..=MAX_IMAGE_SIZE).contains(&r.height) {
-        return Err(format!("width and height must be 1 to {MAX_IMAGE_SIZE}"));
-    }
-    if !(1..=MAX_SAMPLES).contains(&r.samples) || r.max_depth > MAX_DEPTH_LIMIT {
-        return Err(format!(
-            "samples must be 1 to {MAX_SAMPLES} and max depth at most {MAX_DEPTH_LIMIT}"
-        ));
-    }
-    if !coefficient(r.background) || !coefficient(r.ambient_light) {
-        return Err("background and ambient light must be finite and not negative".into());
-    }
-    let c = &s.camera;
-    if !placed(c.position) || !placed(c.look_at) || !c.up.is_finite() {
-        return Err("the camera's position, target and up must be finite and within ±1e15".into());
-    }
-    let view = c.look_at - c.position;
-    if view.length_squared() == 0.0 || c.up.cross(view).length_squared() == 0.0 {
-        return Err("the camera's target must differ from its position and its up must not lie along the view".into());
-    }
-    if !(c.fov_y_deg > 0.0 && c.fov_y_deg < 180.0) {
-        return Err("the camera's fov y must be between 0 and 180 degrees".into());
-    }
-    for l in &s.lights {
-        if !(placed(l.position)
-            && coefficient(l.color)
-            && (0.0..=MAX_COORDINATE).contains(&l.radius))
-        {
-            return Err(format!(
-                "light `{}` needs a finite position within ±1e15, a colour not negative and a radius from 0 to 1e15",
-                l.name
-            ));
-        }
-    }
-    for m in &s.materials {
-        let ok = [
-            m.ambient,
-            m.diffuse,
-            m.specular,
-            m.reflectivity,
-            m.transparency,
-        ]
-        .into_iter()
-        .all(coefficient)
-            && m.shininess.is_finite()
-            && m.shininess >= 0.0
-            && m.ior.is_finite()
-            && m.ior > 0.0;
-        if !ok {
-            return Err(format!(
-                "material `{}` needs finite coefficients not negative, shininess ≥ 0 and ior > 0",
-                m.name
-            ));
-        }
-    }
-    if geometry {
-        let spheres = s
-            .spheres
-            .iter()
-            .all(|sp| placed(sp.center) && sp.radius > 0.0 && sp.radius <= MAX_COORDINATE);
-        let triangles = s
-            .triangles
-            .iter()
-            .all(|t| t.vertices.iter().all(|&v| placed(v)));
-        if !spheres || !triangles {
-            return Err(
-                "every sphere and triangle must lie within ±1e15 with a radius above 0".into(),
-            );
-        }
-    }
-    Ok(())
-}
-
-/// A scene file, OBJ, or built-in scene name (a file of that name wins).
-pub fn load_scene_arg(arg: &str) -> Result<Scene, scene::SceneError> {
-    let path = Path::new(arg);
-    if !path.exists() && scene::builtin::NAMES.contains(&arg) {
-        return scene::builtin::load_builtin(arg);
-    }
-    scene::load_scene_file(path)
-}
-
 impl ViewerApp {
     /// The viewer over `scene`, drawing through the wgpu renderer of `cc`.
     pub fn new(
@@ -259,7 +171,7 @@ impl ViewerApp {
 
     /// The viewer's state without a window (the GPU display is installed by [`Self::new`]).
     pub fn headless(scene: Scene, label: String) -> Result<Self, String> {
-        Self::with_limit(scene, label, crate::scene::load::MAX_IMAGE_SIZE)
+        Self::with_limit(scene, label, scene::rules::MAX_IMAGE_SIZE)
     }
 
     fn with_limit(scene: Scene, label: String, max_side: u32) -> Result<Self, String> {
@@ -342,7 +254,7 @@ impl ViewerApp {
             self.error(e);
         }
         // An edit is held to the loader's rules; a bad one is refused and the scene stays.
-        if let Err(e) = check_edit(&self.edit, rebuild) {
+        if let Err(e) = scene::rules::check_scene(&self.edit, rebuild) {
             self.error(format!("{e}; the edit was undone"));
             self.edit = (*self.scene).clone();
             if self.generation > 0 {
@@ -352,8 +264,8 @@ impl ViewerApp {
         // The viewer's buffers must fit the GPU's largest texture and the memory budget: a
         // larger render is shown scaled down (with a message); `raytree render` does full size.
         let (w, h) = (self.edit.render.width, self.edit.render.height);
-        let limit = crate::render::memory_limit();
-        let per_pixel = crate::render::viewer_memory_estimate(1, 1).max(1);
+        let limit = crate::scene::budget::memory_limit();
+        let per_pixel = crate::scene::budget::viewer_memory_estimate(1, 1).max(1);
         let max_pixels = (limit.bytes / per_pixel).max(1) as f64;
         let k = (self.max_side as f64 / w.max(h) as f64)
             .min((max_pixels / (w as f64 * h as f64)).sqrt())
@@ -547,7 +459,9 @@ impl ViewerApp {
                     }
                 }
                 Command::FrameAll => {
-                    panels::frame_all(&mut self.edit);
+                    if let Some((lo, hi)) = self.edit.bounds() {
+                        self.edit.camera = self.edit.camera.framing_all(lo, hi);
+                    }
                     restart = true;
                 }
                 Command::Stop => {
@@ -685,7 +599,7 @@ impl ViewerApp {
                 .map(|(lo, hi)| (hi - lo).length())
                 .unwrap_or(10.0)
                 .max(1e-3);
-            let frame = crate::render::CameraFrame::new(
+            let frame = crate::scene::CameraFrame::new(
                 &self.scene.camera,
                 self.scene.render.width,
                 self.scene.render.height,
@@ -717,19 +631,19 @@ impl ViewerApp {
         let delta = response.drag_delta();
         if delta != egui::Vec2::ZERO {
             if response.dragged_by(egui::PointerButton::Primary) {
-                panels::orbit(&mut self.edit.camera, delta.x * 0.01, delta.y * 0.01);
+                self.edit.camera.orbit(delta.x * 0.01, delta.y * 0.01);
                 self.pending.push(Command::Restart);
             } else if response.dragged_by(egui::PointerButton::Secondary)
                 || response.dragged_by(egui::PointerButton::Middle)
             {
-                panels::pan(&mut self.edit.camera, delta.x / size.y, delta.y / size.y);
+                self.edit.camera.pan(delta.x / size.y, delta.y / size.y);
                 self.pending.push(Command::Restart);
             }
         }
         if response.hovered() {
             let scroll = ui.input(|i| i.smooth_scroll_delta.y);
             if scroll != 0.0 {
-                panels::zoom(&mut self.edit.camera, (-scroll * 0.002).exp());
+                self.edit.camera.zoom((-scroll * 0.002).exp());
                 self.pending.push(Command::Restart);
             }
         }

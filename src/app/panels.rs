@@ -8,59 +8,8 @@ use super::file_browser::{BrowseFor, FileBrowser};
 use super::modes::{ImageMode, TERMINATION_LEGEND};
 use super::tree_view;
 use super::{Command, ViewerApp};
-use crate::accel::AccelKind;
-use crate::geometry::{OffsetMethod, SphereMethod, TriangleMethod};
-use crate::scene::{Camera, Light, Material, Scene, Shading, builtin};
-
-// ---- camera moves -------------------------------------------------------------------------
-
-/// Turns the camera about its target: `yaw` about the up axis, `pitch` about its right axis.
-pub fn orbit(camera: &mut Camera, yaw: f32, pitch: f32) {
-    let offset = camera.position - camera.look_at;
-    let up = camera.up.normalize_or(Vec3::Y);
-    let radius = offset.length();
-    let yawed = glam::Quat::from_axis_angle(up, -yaw) * offset;
-    let right = up.cross(-yawed).normalize_or(Vec3::X);
-    let pitched = glam::Quat::from_axis_angle(right, -pitch) * yawed;
-    // Never flip over the pole: keep 1° away from the up axis.
-    let cos = pitched.normalize().dot(up);
-    let next = if cos.abs() < 0.9998 { pitched } else { yawed };
-    camera.position = camera.look_at + next.normalize() * radius;
-}
-
-/// Moves camera and target together, by fractions of the image height.
-pub fn pan(camera: &mut Camera, dx: f32, dy: f32) {
-    let back = camera.position - camera.look_at;
-    let dist = back.length();
-    let right = camera.up.cross(back).normalize_or(Vec3::X);
-    let up = back.cross(right).normalize_or(Vec3::Y);
-    let span = 2.0 * dist * (camera.fov_y_deg.to_radians() * 0.5).tan();
-    let shift = (-dx * right + dy * up) * span;
-    camera.position += shift;
-    camera.look_at += shift;
-}
-
-/// Moves the camera towards (`factor` < 1) or away from its target.
-pub fn zoom(camera: &mut Camera, factor: f32) {
-    let back = camera.position - camera.look_at;
-    let len = (back.length() * factor).clamp(1e-4, 1e7);
-    camera.position = camera.look_at + back.normalize_or(Vec3::Z) * len;
-}
-
-/// Aims the camera at the scene's bounds from its current direction, the whole scene in view.
-pub fn frame_all(scene: &mut Scene) {
-    let Some((lo, hi)) = scene.bounds() else {
-        return;
-    };
-    let centre = (lo + hi) * 0.5;
-    let radius = ((hi - lo).length() * 0.5).max(1e-3);
-    let cam = &mut scene.camera;
-    let dir = (cam.position - cam.look_at).normalize_or(Vec3::Z);
-    let half = (cam.fov_y_deg.to_radians() * 0.5).min(1.5);
-    let dist = radius / half.sin() * 1.05;
-    cam.look_at = centre;
-    cam.position = centre + dir * dist;
-}
+use crate::choice::Choice;
+use crate::scene::{Light, Material, builtin, rules};
 
 // ---- small widgets ------------------------------------------------------------------------
 
@@ -112,18 +61,17 @@ fn color_edit(ui: &mut Ui, label: &str, v: &mut Vec3) -> bool {
     changed
 }
 
-fn combo<T: PartialEq + Copy + std::fmt::Debug>(
-    ui: &mut Ui,
-    label: &str,
-    value: &mut T,
-    options: &[T],
-) -> bool {
+/// A menu of every variant of a [`Choice`], each with its help line as a tooltip.
+fn combo<T: Choice>(ui: &mut Ui, label: &str, value: &mut T) -> bool {
     let mut changed = false;
     egui::ComboBox::from_label(label)
         .selected_text(format!("{value:?}"))
         .show_ui(ui, |ui| {
-            for &o in options {
-                changed |= ui.selectable_value(value, o, format!("{o:?}")).changed();
+            for &o in T::ALL {
+                changed |= ui
+                    .selectable_value(value, o, format!("{o:?}"))
+                    .on_hover_text(o.help())
+                    .changed();
             }
         });
     changed
@@ -253,7 +201,7 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
         .show(ui, |ui| {
             let r = &mut app.edit.render;
             restart |= ui
-                .add(egui::Slider::new(&mut r.max_depth, 0..=64).text("max depth"))
+                .add(egui::Slider::new(&mut r.max_depth, rules::DEPTH).text("max depth"))
                 .changed();
             restart |= ui
                 .add(
@@ -266,52 +214,14 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                 restart |= drag(ui, "width", DragValue::new(&mut r.width).range(1..=8192));
                 restart |= drag(ui, "height", DragValue::new(&mut r.height).range(1..=8192));
             });
-            restart |= combo(
-                ui,
-                "shading",
-                &mut r.shading,
-                &[Shading::BlinnPhong, Shading::Phong],
-            );
+            restart |= combo(ui, "shading", &mut r.shading);
             restart |= color_edit(ui, "background", &mut r.background);
             restart |= color_edit(ui, "ambient light", &mut r.ambient_light);
             let t = &mut app.settings.trace;
-            restart |= combo(
-                ui,
-                "sphere",
-                &mut t.methods.sphere,
-                &[SphereMethod::Robust, SphereMethod::Lecture],
-            );
-            restart |= combo(
-                ui,
-                "triangle",
-                &mut t.methods.triangle,
-                &[
-                    TriangleMethod::Watertight,
-                    TriangleMethod::MollerTrumbore,
-                    TriangleMethod::Lecture,
-                ],
-            );
-            restart |= combo(
-                ui,
-                "offset",
-                &mut t.methods.offset,
-                &[
-                    OffsetMethod::ErrorBound,
-                    OffsetMethod::NormalScaled,
-                    OffsetMethod::Fixed,
-                ],
-            );
-            rebuild |= combo(
-                ui,
-                "accelerator",
-                &mut t.accel,
-                &[
-                    AccelKind::Auto,
-                    AccelKind::None,
-                    AccelKind::Grid,
-                    AccelKind::Bvh,
-                ],
-            );
+            restart |= combo(ui, "sphere", &mut t.methods.sphere);
+            restart |= combo(ui, "triangle", &mut t.methods.triangle);
+            restart |= combo(ui, "offset", &mut t.methods.offset);
+            rebuild |= combo(ui, "accelerator", &mut t.accel);
             ui.horizontal(|ui| {
                 restart |= drag(
                     ui,

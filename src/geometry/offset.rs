@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 use super::{next_float_down, next_float_up};
 
 /// How secondary ray origins are moved off the surface.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum OffsetMethod {
     /// A fixed distance along the normal, whatever the scene's scale.
@@ -26,6 +26,12 @@ pub enum OffsetMethod {
     #[default]
     ErrorBound,
 }
+
+crate::choice::choice!(OffsetMethod {
+    ErrorBound => ("error-bound", "pbrt-v4: the hit point's error bound along the normal (robust at any scale)"),
+    NormalScaled => ("normal-scaled", "a distance along the normal scaled by the hit point's magnitude"),
+    Fixed => ("fixed", "the textbook fixed 1e-4 along the normal (acne on large scenes)"),
+});
 
 /// [`OffsetMethod::Fixed`]: the textbook `1e-4` (world units). Right for scenes of size about
 /// 1 centred near the origin; below one `f32` step of the coordinates from `|p| ≈ 1e3` on

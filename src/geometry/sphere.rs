@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 use super::{Ray, gamma};
 
 /// How rays meet spheres.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SphereMethod {
     /// The lecture's `s = u·ΔP ± sqrt((u·ΔP)² − |ΔP|² + r²)`, nearest root above `t_min`.
@@ -26,6 +26,11 @@ pub enum SphereMethod {
     #[default]
     Robust,
 }
+
+crate::choice::choice!(SphereMethod {
+    Robust => ("robust", "Ray Tracing Gems ch. 7: stable roots, hit point re-projected"),
+    Lecture => ("lecture", "the lecture's quadratic (misses far-away spheres)"),
+});
 
 /// Nearest `t` in `(t_min, t_max)` where the ray meets the sphere, if any.
 ///

@@ -20,7 +20,7 @@ use serde::{Deserialize, Serialize};
 use super::{Ray, gamma};
 
 /// How rays meet triangles.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum TriangleMethod {
     /// The lecture: intersect the plane `n·p = d`, then solve for barycentric coordinates.
@@ -31,6 +31,12 @@ pub enum TriangleMethod {
     #[default]
     Watertight,
 }
+
+crate::choice::choice!(TriangleMethod {
+    Watertight => ("watertight", "Woop, Benthin, Wald 2013: no cracks along shared edges"),
+    MollerTrumbore => ("moller-trumbore", "Moller-Trumbore 1997"),
+    Lecture => ("lecture", "the lecture's plane, then barycentric coordinates"),
+});
 
 /// A ray/triangle hit: `t` and the barycentric weights of vertices 1 and 2.
 #[derive(Clone, Copy, Debug, PartialEq)]

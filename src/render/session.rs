@@ -17,7 +17,8 @@ use std::time::Instant;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::{CameraFrame, Rect, TILE_SIZE, tiles, trace_sample};
+use super::{Rect, TILE_SIZE, tiles, trace_sample};
+use crate::scene::CameraFrame;
 use crate::trace::{RayCounts, SampleInfo, Tracer};
 
 /// Side of the blocks of the coarse preview pass.

@@ -7,7 +7,8 @@
 //! moller-trumbore` or `lecture`) that the defaults do not have.
 
 use super::Scene;
-use super::load::{SceneError, load_scene_str_with};
+use super::diag::{SceneError, list_and};
+use super::load::load_scene_str_with;
 
 /// The built-in scenes, in the order a menu should show them.
 pub const NAMES: &[&str] = &["default", "quiz", "glass", "box", "acne", "cracks"];
@@ -64,7 +65,7 @@ pub fn load_builtin(name: &str) -> Result<Scene, SceneError> {
         let names: Vec<String> = NAMES.iter().map(|n| format!("\"{n}\"")).collect();
         SceneError(format!(
             "there is no built-in scene \"{name}\"; the built-in scenes are {}.",
-            super::load::list_and(&names)
+            list_and(&names)
         ))
     })?;
     load_scene_str_with(text, &format!("builtin/{name}.toml"), &resolve)

@@ -3,11 +3,18 @@
 //! line and column in every error), [`obj`] (OBJ/MTL through `tobj`) and [`builtin`] (scenes
 //! compiled into the binary). SPEC §3 is the contract for the file format.
 
+pub mod budget;
 pub mod builtin;
+pub mod camera;
+pub mod diag;
+pub mod files;
 pub mod load;
 pub mod obj;
 pub mod procedural;
+pub mod rules;
+pub mod sampling;
 pub mod save;
+pub mod toml_reader;
 
 use std::path::PathBuf;
 
@@ -15,9 +22,15 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 pub use builtin::load_builtin;
-pub use load::{
-    ResolveFn, SceneError, fs_resolver, load_scene_file, load_scene_str, load_scene_str_with,
-};
+pub use camera::{Camera, CameraFrame, primary_ray};
+pub use diag::SceneError;
+pub use files::{fs_resolver, load_scene_file, load_scene_str, open_scene_arg};
+pub use load::load_scene_str_with;
+
+/// Returns the text of a mesh or material library, given its path as written in the scene
+/// (relative to the scene file's folder), or the reason it cannot, as a short phrase. Built-in
+/// scenes resolve from strings compiled into the binary, files from the scene's folder.
+pub type ResolveFn<'a> = dyn Fn(&str) -> Result<String, String> + 'a;
 pub use save::scene_to_toml;
 
 /// Index into [`Scene::materials`].
@@ -38,6 +51,11 @@ pub enum Shading {
     #[default]
     BlinnPhong,
 }
+
+crate::choice::choice!(Shading {
+    Phong => ("phong", "specular max(R.V, 0)^n with R = 2(N.L)N - L"),
+    BlinnPhong => ("blinn-phong", "specular max(N.H, 0)^n with H = normalize(L + V)"),
+});
 
 /// The `[render]` section: what the scene asks of an image.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -68,27 +86,6 @@ impl Default for RenderParams {
             background: Vec3::ZERO,
             ambient_light: Vec3::ONE,
             shading: Shading::BlinnPhong,
-        }
-    }
-}
-
-/// A pinhole camera; SPEC §2 gives the pixel-to-ray mapping.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Camera {
-    pub position: Vec3,
-    pub look_at: Vec3,
-    pub up: Vec3,
-    /// Vertical field of view in degrees, in (0, 180).
-    pub fov_y_deg: f32,
-}
-
-impl Default for Camera {
-    fn default() -> Self {
-        Self {
-            position: Vec3::new(0.0, 0.0, 5.0),
-            look_at: Vec3::ZERO,
-            up: Vec3::Y,
-            fov_y_deg: 45.0,
         }
     }
 }
@@ -197,6 +194,16 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// The material named "default" (a `[[material]]` of that name, or [`Material::default`]
+    /// added once, when first needed).
+    pub fn default_material(&mut self) -> MaterialId {
+        if let Some(i) = self.materials.iter().position(|m| m.name == "default") {
+            return MaterialId(i as u32);
+        }
+        self.materials.push(Material::default());
+        MaterialId(self.materials.len() as u32 - 1)
+    }
+
     pub fn material(&self, id: MaterialId) -> &Material {
         &self.materials[id.0 as usize]
     }

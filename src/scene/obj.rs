@@ -14,11 +14,12 @@ use std::sync::Once;
 
 use glam::{Mat3, Vec3};
 
-use super::load::{
-    MAX_COORDINATE, ResolveFn, SceneError, check_camera, default_material, short, short_path,
+use super::budget::{MemoryLimit, memory_limit, mesh_memory_estimate};
+use super::diag::{SceneError, list_and, short, short_path};
+use super::rules::{MAX_COORDINATE, check_camera, is_visible_triangle};
+use super::{
+    Camera, Light, Material, MaterialId, Object, ObjectId, ObjectSource, ResolveFn, Scene, Triangle,
 };
-use super::{Camera, Light, Material, MaterialId, Object, ObjectId, ObjectSource, Scene, Triangle};
-use crate::render::{MemoryLimit, memory_limit, mesh_memory_estimate};
 
 /// Where a mesh goes: `scale` first, then the rotation (degrees about X, then Y, then Z), then
 /// `translate`.
@@ -54,12 +55,6 @@ impl MeshPlacement {
     pub fn mirrors(&self) -> bool {
         self.scale.x * self.scale.y * self.scale.z < 0.0
     }
-}
-
-/// True if the triangle can be seen: finite corners and a finite, non-zero cross product.
-pub fn is_visible_triangle(v: &[Vec3; 3]) -> bool {
-    let cross = (v[1] - v[0]).cross(v[2] - v[0]);
-    v.iter().all(|p| p.is_finite()) && cross.is_finite() && cross != Vec3::ZERO
 }
 
 /// True if `path` ends in `.obj`, in any case: the only files a `[[mesh]]` may name.
@@ -402,7 +397,7 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
                             mtl_material(scene, req, &mtl_materials[i], &mut warnings)
                         })
                     }
-                    (None, _) => default_material(scene),
+                    (None, _) => scene.default_material(),
                 });
             scene.triangles.push(Triangle {
                 vertices: v,
@@ -453,7 +448,7 @@ fn warn_unknown_usemtl(req: &MeshRequest, known: &[tobj::Material], warnings: &m
         warnings.push(format!(
             "{}: `usemtl` names materials that no material library defines ({}); their faces use the default material.",
             req.label,
-            super::load::list_and(&names)
+            list_and(&names)
         ));
     }
 }
@@ -592,10 +587,11 @@ pub(crate) fn load_obj_scene(
         )));
     }
     let (lo, hi) = scene.bounds().unwrap_or((Vec3::ZERO, Vec3::ZERO));
-    let camera = frame(lo, hi, Camera::default().fov_y_deg);
-    if check_camera(&camera).is_err() || !camera.position.is_finite() {
+    // From the +z side, slightly above, the whole model in view.
+    let camera = Camera::default().framing(lo, hi, Vec3::new(0.0, 0.3, 1.0).normalize());
+    if check_camera(&camera).is_err() {
         return Err(SceneError(format!(
-            "{label}: cannot frame a camera on the OBJ: its bounds {lo} to {hi} are too large or too small to look at in f32."
+            "{label}: cannot frame a camera on the OBJ: its bounds {lo} to {hi} are too large (the camera would stand beyond ±1e15, raytree's limit on scene size) or too small to look at in f32."
         )));
     }
     let forward = (camera.look_at - camera.position).normalize();
@@ -610,21 +606,6 @@ pub(crate) fn load_obj_scene(
     });
     scene.camera = camera;
     Ok(scene)
-}
-
-/// A camera on the +z side, slightly above, looking at the bounds' centre from far enough that
-/// the bounding sphere fits the vertical field of view (with a small margin).
-pub fn frame(lo: Vec3, hi: Vec3, fov_y_deg: f32) -> Camera {
-    let center = 0.5 * (lo + hi);
-    let radius = 0.5 * (hi - lo).length();
-    let distance = 1.1 * radius / (0.5 * fov_y_deg).to_radians().sin();
-    let direction = Vec3::new(0.0, 0.3, 1.0).normalize();
-    Camera {
-        position: center + direction * distance,
-        look_at: center,
-        up: Vec3::Y,
-        fov_y_deg,
-    }
 }
 
 #[cfg(test)]

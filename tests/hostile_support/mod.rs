@@ -10,7 +10,7 @@ use std::sync::Arc;
 use glam::Vec3;
 use raytree::render::render;
 use raytree::scene::Scene;
-use raytree::scene::load::MAX_COORDINATE;
+use raytree::scene::rules::MAX_COORDINATE;
 use raytree::trace::{TraceSettings, Tracer};
 
 /// Every number finite, sizes in range, radii > 0, triangles of non-zero area, ids in range,

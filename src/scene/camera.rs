@@ -1,0 +1,349 @@
+//! The camera, in one place: its data (SPEC §2), its frame for an image size, the primary ray
+//! of pixel (x, y) and sample s that the tiles and the ray tree both trace, framing of bounds,
+//! and the orbit / pan / zoom moves of the viewer.
+//!
+//! Pixel (x, y), y = 0 at the top, looks through
+//! `((2(x+0.5)/W − 1)·a·tan(fov_y/2), (1 − 2(y+0.5)/H)·tan(fov_y/2), −1)` in camera space
+//! (a = W/H), camera looking down −z, for the pixel centre.
+
+use glam::{Mat4, Vec3, Vec4};
+use serde::{Deserialize, Serialize};
+
+use super::sampling::sample_offset;
+use crate::geometry::Ray;
+
+/// A pinhole camera; SPEC §2 gives the pixel-to-ray mapping.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Camera {
+    pub position: Vec3,
+    pub look_at: Vec3,
+    pub up: Vec3,
+    /// Vertical field of view in degrees, in (0, 180).
+    pub fov_y_deg: f32,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Self {
+            position: Vec3::new(0.0, 0.0, 5.0),
+            look_at: Vec3::ZERO,
+            up: Vec3::Y,
+            fov_y_deg: 45.0,
+        }
+    }
+}
+
+/// A camera with its basis precomputed for an image size.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraFrame {
+    origin: Vec3,
+    /// Camera x, y and z axes in world space (z points backwards, away from `look_at`).
+    right: Vec3,
+    up: Vec3,
+    back: Vec3,
+    tan_half_fov_y: f32,
+    aspect: f32,
+    width: f32,
+    height: f32,
+}
+
+impl CameraFrame {
+    /// The frame of `camera` for a `width × height` image.
+    pub fn new(camera: &Camera, width: u32, height: u32) -> Self {
+        let back = (camera.position - camera.look_at).normalize();
+        let right = camera.up.cross(back).normalize();
+        let up = back.cross(right);
+        Self {
+            origin: camera.position,
+            right,
+            up,
+            back,
+            tan_half_fov_y: (camera.fov_y_deg.to_radians() * 0.5).tan(),
+            aspect: width as f32 / height as f32,
+            width: width as f32,
+            height: height as f32,
+        }
+    }
+
+    /// The primary ray through image position (`x`, `y`) in pixels, where pixel (i, j) covers
+    /// `[i, i+1) × [j, j+1)` and its centre is (i + 0.5, j + 0.5).
+    pub fn ray(&self, x: f32, y: f32) -> Ray {
+        let cx = (2.0 * x / self.width - 1.0) * self.aspect * self.tan_half_fov_y;
+        let cy = (1.0 - 2.0 * y / self.height) * self.tan_half_fov_y;
+        let dir = (cx * self.right + cy * self.up - self.back).normalize();
+        Ray::new(self.origin, dir)
+    }
+
+    /// Projects a world point to image position in pixels, or `None` when it is behind the
+    /// camera. The inverse of [`CameraFrame::ray`], used to draw rays over the image.
+    pub fn project(&self, p: Vec3) -> Option<(f32, f32)> {
+        let d = p - self.origin;
+        let z = -d.dot(self.back);
+        if z <= 0.0 {
+            return None;
+        }
+        let cx = d.dot(self.right) / z;
+        let cy = d.dot(self.up) / z;
+        let x = (cx / (self.aspect * self.tan_half_fov_y) + 1.0) * 0.5 * self.width;
+        let y = (1.0 - cy / self.tan_half_fov_y) * 0.5 * self.height;
+        Some((x, y))
+    }
+}
+
+impl CameraFrame {
+    /// The matrix taking world points to wgpu clip space (depth 0..1 between `near` and
+    /// `far`) such that the image position of [`CameraFrame::project`] is where the point lands
+    /// on screen: the GPU overlay and the CPU projection agree.
+    pub fn clip_from_world(&self, near: f32, far: f32) -> Mat4 {
+        let o = self.origin;
+        let view = Mat4::from_cols(
+            Vec4::new(self.right.x, self.up.x, self.back.x, 0.0),
+            Vec4::new(self.right.y, self.up.y, self.back.y, 0.0),
+            Vec4::new(self.right.z, self.up.z, self.back.z, 0.0),
+            Vec4::new(-self.right.dot(o), -self.up.dot(o), -self.back.dot(o), 1.0),
+        );
+        let sx = 1.0 / (self.aspect * self.tan_half_fov_y);
+        let sy = 1.0 / self.tan_half_fov_y;
+        let a = far / (near - far);
+        let proj = Mat4::from_cols(
+            Vec4::new(sx, 0.0, 0.0, 0.0),
+            Vec4::new(0.0, sy, 0.0, 0.0),
+            Vec4::new(0.0, 0.0, a, -1.0),
+            Vec4::new(0.0, 0.0, a * near, 0.0),
+        );
+        proj * view
+    }
+}
+
+/// The primary ray of sample `sample` of pixel (`x`, `y`): sample 0 looks through the pixel
+/// centre, the others through [`sample_offset`]. Tiles and the ray tree both call this, so a
+/// clicked pixel's tree is exactly the 1-sample render of that pixel.
+pub fn primary_ray(frame: &CameraFrame, x: u32, y: u32, sample: u32) -> Ray {
+    let (u, v) = sample_offset(x, y, sample);
+    frame.ray(x as f32 + u, y as f32 + v)
+}
+
+/// How far outside the bounding sphere a framed camera stands: 1.1 leaves a tenth of the
+/// field of view free around the scene.
+pub const FRAME_MARGIN: f32 = 1.1;
+
+impl Camera {
+    /// This camera moved along the unit vector `direction` (from the target towards the eye) so that the
+    /// bounding sphere of `lo..hi` fills the vertical field of view with [`FRAME_MARGIN`],
+    /// aimed at its centre; `up` and `fov_y_deg` are kept.
+    pub fn framing(&self, lo: Vec3, hi: Vec3, direction: Vec3) -> Camera {
+        let center = 0.5 * (lo + hi);
+        let radius = 0.5 * (hi - lo).length();
+        // Beyond about 172° the sine flattens and the distance would run away.
+        let half = (0.5 * self.fov_y_deg).to_radians().min(1.5);
+        let distance = FRAME_MARGIN * radius / half.sin();
+        Camera {
+            position: center + direction * distance,
+            look_at: center,
+            ..self.clone()
+        }
+    }
+
+    /// This camera framed on `lo..hi` from the direction it looks now (the viewer's "frame
+    /// all").
+    pub fn framing_all(&self, lo: Vec3, hi: Vec3) -> Camera {
+        self.framing(lo, hi, (self.position - self.look_at).normalize_or(Vec3::Z))
+    }
+
+    /// Turns the camera about its target: `yaw` radians about the up axis, `pitch` about its
+    /// right axis. Never flips over the pole: stops 1° short of the up axis.
+    pub fn orbit(&mut self, yaw: f32, pitch: f32) {
+        let offset = self.position - self.look_at;
+        let up = self.up.normalize_or(Vec3::Y);
+        let radius = offset.length();
+        let yawed = glam::Quat::from_axis_angle(up, -yaw) * offset;
+        let right = up.cross(-yawed).normalize_or(Vec3::X);
+        let pitched = glam::Quat::from_axis_angle(right, -pitch) * yawed;
+        let cos = pitched.normalize().dot(up);
+        let next = if cos.abs() < 0.9998 { pitched } else { yawed };
+        self.position = self.look_at + next.normalize() * radius;
+    }
+
+    /// Moves camera and target together by fractions of the image height (`dx` right, `dy`
+    /// down on screen, so a drag moves the scene with the pointer).
+    pub fn pan(&mut self, dx: f32, dy: f32) {
+        let back = self.position - self.look_at;
+        let dist = back.length();
+        let right = self.up.cross(back).normalize_or(Vec3::X);
+        let up = back.cross(right).normalize_or(Vec3::Y);
+        let span = 2.0 * dist * (self.fov_y_deg.to_radians() * 0.5).tan();
+        let shift = (-dx * right + dy * up) * span;
+        self.position += shift;
+        self.look_at += shift;
+    }
+
+    /// Moves the camera towards (`factor` < 1) or away from its target, staying between 1e-4
+    /// and 1e7 from it.
+    pub fn zoom(&mut self, factor: f32) {
+        let back = self.position - self.look_at;
+        let len = (back.length() * factor).clamp(1e-4, 1e7);
+        self.position = self.look_at + back.normalize_or(Vec3::Z) * len;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn centre_pixel_looks_at_target() {
+        let cam = Camera {
+            position: Vec3::new(1.0, 2.0, 3.0),
+            look_at: Vec3::new(1.0, 2.0, -7.0),
+            up: Vec3::Y,
+            fov_y_deg: 60.0,
+        };
+        let frame = CameraFrame::new(&cam, 101, 51);
+        let r = frame.ray(50.5, 25.5);
+        assert!((r.dir - Vec3::NEG_Z).length() < 1e-6, "{}", r.dir);
+        // The top-left corner is at tan(30°) up and aspect·tan(30°) left.
+        let t = (30f32).to_radians().tan();
+        let c = frame.ray(0.0, 0.0).dir;
+        let expect = Vec3::new(-t * 101.0 / 51.0, t, -1.0).normalize();
+        assert!((c - expect).length() < 1e-6, "{c} vs {expect}");
+        let (x, y) = frame
+            .project(Vec3::new(1.0, 2.0, 3.0) + 5.0 * c)
+            .expect("in front");
+        assert!(x.abs() < 1e-3 && y.abs() < 1e-3, "{x} {y}");
+    }
+
+    #[test]
+    fn clip_matrix_agrees_with_project() {
+        let cam = Camera {
+            position: Vec3::new(0.3, 1.7, 6.5),
+            look_at: Vec3::new(0.0, 0.9, 0.0),
+            up: Vec3::Y,
+            fov_y_deg: 45.0,
+        };
+        let frame = CameraFrame::new(&cam, 640, 480);
+        let m = frame.clip_from_world(0.01, 1000.0);
+        for p in [
+            Vec3::new(1.0, 1.0, -1.2),
+            Vec3::new(-2.0, 0.0, 3.0),
+            Vec3::ZERO,
+        ] {
+            let c = m * p.extend(1.0);
+            let (ndc_x, ndc_y, ndc_z) = (c.x / c.w, c.y / c.w, c.z / c.w);
+            let x = (ndc_x + 1.0) * 0.5 * 640.0;
+            let y = (1.0 - ndc_y) * 0.5 * 480.0;
+            let (px, py) = frame.project(p).expect("in front");
+            assert!(
+                (x - px).abs() < 1e-2 && (y - py).abs() < 1e-2,
+                "{x},{y} vs {px},{py}"
+            );
+            assert!((0.0..=1.0).contains(&ndc_z), "depth {ndc_z}");
+        }
+    }
+
+    fn camera() -> Camera {
+        Camera {
+            position: Vec3::new(0.0, 0.0, 5.0),
+            look_at: Vec3::ZERO,
+            up: Vec3::Y,
+            fov_y_deg: 45.0,
+        }
+    }
+
+    #[test]
+    fn primary_ray_of_sample_zero_is_the_pixel_centre() {
+        let frame = CameraFrame::new(&camera(), 64, 48);
+        assert_eq!(primary_ray(&frame, 10, 20, 0), frame.ray(10.5, 20.5));
+        let (u, v) = sample_offset(10, 20, 3);
+        assert_eq!(
+            primary_ray(&frame, 10, 20, 3),
+            frame.ray(10.0 + u, 20.0 + v)
+        );
+    }
+
+    #[test]
+    fn orbit_keeps_the_distance_and_turns_by_the_angle() {
+        let mut c = camera();
+        c.orbit(std::f32::consts::FRAC_PI_2, 0.0);
+        // A quarter turn about +y, seen from above clockwise: the eye goes from +z to -x.
+        assert!(
+            c.position.abs_diff_eq(Vec3::new(-5.0, 0.0, 0.0), 1e-5),
+            "{}",
+            c.position
+        );
+        assert_eq!(c.look_at, Vec3::ZERO);
+        let mut c = camera();
+        c.orbit(0.0, 0.3);
+        assert!((c.position.length() - 5.0).abs() < 1e-5);
+        let angle = c.position.normalize().dot(Vec3::Z).acos();
+        assert!((angle - 0.3).abs() < 1e-5, "{angle}");
+        // Pitching past the pole stops short of it instead of flipping.
+        let mut c = camera();
+        c.orbit(0.0, 2.0);
+        assert!(c.position.normalize().dot(Vec3::Y).abs() < 0.9998);
+        assert!(c.position.is_finite());
+    }
+
+    #[test]
+    fn pan_moves_eye_and_target_by_fractions_of_the_view() {
+        let mut c = camera();
+        c.pan(0.5, 0.0);
+        // Half the image height at distance 5 and 45°: 0.5 · 2 · 5 · tan(22.5°).
+        let span = 5.0 * (22.5f32).to_radians().tan();
+        assert!(
+            c.look_at.abs_diff_eq(Vec3::new(-span, 0.0, 0.0), 1e-5),
+            "{}",
+            c.look_at
+        );
+        assert!((c.position - c.look_at).abs_diff_eq(Vec3::new(0.0, 0.0, 5.0), 1e-5));
+        let mut c = camera();
+        c.pan(0.0, 0.25);
+        assert!(c.look_at.y > 0.0 && c.look_at.x.abs() < 1e-6);
+    }
+
+    #[test]
+    fn zoom_scales_the_distance_within_bounds() {
+        let mut c = camera();
+        c.zoom(0.5);
+        assert!(c.position.abs_diff_eq(Vec3::new(0.0, 0.0, 2.5), 1e-6));
+        c.zoom(1e-12);
+        assert!((c.position.length() - 1e-4).abs() < 1e-9);
+        c.zoom(1e30);
+        assert!((c.position.length() - 1e7).abs() < 1.0);
+    }
+
+    #[test]
+    fn framing_puts_the_whole_bounding_sphere_in_view() {
+        let (lo, hi) = (Vec3::new(-1.0, -2.0, -3.0), Vec3::new(3.0, 2.0, 1.0));
+        let c = camera().framing_all(lo, hi);
+        assert_eq!(c.look_at, Vec3::new(1.0, 0.0, -1.0));
+        let radius = 0.5 * (hi - lo).length();
+        // The bounding sphere subtends the field of view less the margin.
+        let dist = c.position.distance(c.look_at);
+        let half_angle = (radius / dist).asin().to_degrees();
+        assert!(
+            (half_angle * 2.0 - 45.0 / FRAME_MARGIN).abs() < 2.5,
+            "{half_angle}"
+        );
+        assert!((dist * (22.5f32).to_radians().sin() / radius - FRAME_MARGIN).abs() < 1e-5);
+        // From the direction it looked before.
+        assert!(
+            (c.position - c.look_at)
+                .normalize()
+                .abs_diff_eq(Vec3::Z, 1e-6)
+        );
+        // Every corner projects inside the image.
+        let frame = CameraFrame::new(&c, 64, 48);
+        for i in 0..8 {
+            let p = Vec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            );
+            let (x, y) = frame.project(p).expect("in front");
+            assert!(
+                (0.0..64.0).contains(&x) && (0.0..48.0).contains(&y),
+                "{p}: {x} {y}"
+            );
+        }
+    }
+}

@@ -1,0 +1,145 @@
+//! What the scene loaders say about bad input: the error type, `FILE:LINE:COLUMN` places,
+//! one-sentence phrasing, shortened user text and "did you mean" hints. Shared by the TOML
+//! loader, the OBJ loader and the file reader.
+
+use std::ops::Range;
+
+/// A scene that could not be loaded: one sentence naming the file, the place and the field.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct SceneError(pub String);
+
+/// The scene text and its name, to turn byte offsets into `FILE:LINE:COLUMN`.
+pub(crate) struct Src<'a> {
+    pub file: &'a str,
+    pub text: &'a str,
+}
+
+impl Src<'_> {
+    /// 1-based line and column (in characters) of a byte offset.
+    pub fn line_col(&self, offset: usize) -> (usize, usize) {
+        let mut offset = offset.min(self.text.len());
+        while !self.text.is_char_boundary(offset) {
+            offset -= 1;
+        }
+        let before = &self.text[..offset];
+        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        let line = before.matches('\n').count() + 1;
+        let column = before[line_start..].chars().count() + 1;
+        (line, column)
+    }
+
+    /// An error at `span`: `FILE:LINE:COLUMN: message.`
+    pub fn error(&self, span: &Range<usize>, message: impl AsRef<str>) -> SceneError {
+        let (line, column) = self.line_col(span.start);
+        SceneError(format!(
+            "{}:{line}:{column}: {}",
+            self.file,
+            sentence(message.as_ref())
+        ))
+    }
+
+    /// The source text of a value, as the user wrote it, for "got ..." in messages.
+    /// At most 40 characters of it, so that a message stays a sentence.
+    pub fn slice(&self, span: &Range<usize>) -> String {
+        short(self.text.get(span.clone()).unwrap_or("?"))
+    }
+}
+
+/// Makes one sentence of a message: one line, ending in a full stop.
+pub(crate) fn sentence(message: &str) -> String {
+    let mut s: String = message
+        .trim()
+        .chars()
+        .map(|c| if c.is_control() { ' ' } else { c })
+        .collect();
+    if !s.ends_with(['.', '?', '!']) {
+        s.push('.');
+    }
+    s
+}
+
+/// At most 40 characters of user text, so that a message stays a sentence.
+pub(crate) fn short(text: &str) -> String {
+    match text.char_indices().nth(40) {
+        Some((i, _)) => format!("{}…", &text[..i]),
+        None => text.to_string(),
+    }
+}
+
+/// A path as written, cut to its last 80 characters: the file name is the part that matters.
+pub(crate) fn short_path(path: &str) -> String {
+    let count = path.chars().count();
+    if count <= 80 {
+        return path.to_string();
+    }
+    let tail: String = path.chars().skip(count - 79).collect();
+    format!("…{tail}")
+}
+
+/// The closest of `known` to `word` if it is a plausible typo, for "did you mean" hints.
+pub(crate) fn suggest<'k>(word: &str, known: impl IntoIterator<Item = &'k str>) -> Option<&'k str> {
+    let word = word.to_ascii_lowercase();
+    known
+        .into_iter()
+        .map(|k| (edit_distance(&word, &k.to_ascii_lowercase()), k))
+        .filter(|&(d, k)| d <= 2.max(k.len() / 4) && d < k.len())
+        .min_by_key(|&(d, _)| d)
+        .map(|(_, k)| k)
+}
+
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let above = row[j + 1];
+            row[j + 1] = (diagonal + usize::from(ca != cb))
+                .min(row[j] + 1)
+                .min(above + 1);
+            diagonal = above;
+        }
+    }
+    row[b.len()]
+}
+
+/// `a`, `b` and `c` (each already formatted).
+pub(crate) fn list_and(items: &[String]) -> String {
+    match items {
+        [] => String::new(),
+        [one] => one.clone(),
+        [init @ .., last] => format!("{} and {last}", init.join(", ")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn line_col_counts_characters_from_one() {
+        let src = Src {
+            file: "f",
+            text: "ab\nçd = 1\n",
+        };
+        assert_eq!(src.line_col(0), (1, 1));
+        assert_eq!(src.line_col(3), (2, 1));
+        assert_eq!(src.line_col(5), (2, 2)); // after the two-byte 'ç'
+    }
+
+    #[test]
+    fn suggestions_catch_typos_only() {
+        const KEYS: [&str; 4] = ["name", "center", "radius", "material"];
+        assert_eq!(suggest("radus", KEYS), Some("radius"));
+        assert_eq!(suggest("colour", ["name", "color"]), Some("color"));
+        assert_eq!(suggest("zzz", KEYS), None);
+    }
+
+    #[test]
+    fn sentences_are_one_line_with_a_full_stop() {
+        assert_eq!(sentence("a\nb "), "a b.");
+        assert_eq!(sentence("done."), "done.");
+    }
+}

@@ -1,0 +1,117 @@
+//! Scene input from disk: a `.toml` scene or a bare `.obj` mesh chosen by extension, meshes and
+//! material libraries resolved next to the scene, size caps, regular files only; and the scene
+//! argument of the CLI and the viewer (a file, or the name of a built-in scene).
+
+use std::path::{Path, PathBuf};
+
+use super::diag::{SceneError, short_path};
+use super::rules::{MAX_MESH_FILE_BYTES, MAX_SCENE_FILE_BYTES};
+use super::{Scene, builtin, load::load_scene_str_with, obj};
+
+/// A scene file, OBJ, or built-in scene name, as given on the command line or to the viewer:
+/// a file of that name wins over a built-in scene.
+pub fn open_scene_arg(arg: &str) -> Result<Scene, SceneError> {
+    let path = Path::new(arg);
+    if !path.exists() && builtin::NAMES.contains(&arg) {
+        return builtin::load_builtin(arg);
+    }
+    load_scene_file(path)
+}
+
+/// Loads a `.toml` scene or a bare `.obj` mesh (chosen by the extension, in any case). Meshes
+/// and material libraries are resolved relative to the file's folder. Sets [`Scene::source`].
+pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
+    let file = path.display().to_string();
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let is_obj = match extension.as_deref() {
+        Some("toml") => false,
+        Some("obj") => true,
+        _ => {
+            return Err(SceneError(format!(
+                "{file}: cannot open this kind of file; a scene is a `.toml` file or a bare `.obj` mesh."
+            )));
+        }
+    };
+    let max_bytes = if is_obj {
+        MAX_MESH_FILE_BYTES
+    } else {
+        MAX_SCENE_FILE_BYTES
+    };
+    let text = read_text(path, max_bytes)
+        .map_err(|reason| SceneError(format!("{file}: cannot read the scene file: {reason}.")))?;
+    let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let resolve = fs_resolver(folder);
+    let mut scene = if is_obj {
+        let key = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| file.clone());
+        obj::load_obj_scene(&text, &file, &key, &resolve)?
+    } else {
+        load_scene_str_with(&text, &file, &resolve)?
+    };
+    scene.source = Some(path.to_path_buf());
+    Ok(scene)
+}
+
+/// Parses scene TOML; `name` stands for the file in messages. Meshes are resolved relative to
+/// the current directory.
+pub fn load_scene_str(text: &str, name: &str) -> Result<Scene, SceneError> {
+    load_scene_str_with(text, name, &fs_resolver(PathBuf::new()))
+}
+
+/// A resolver reading files relative to `folder`.
+pub fn fs_resolver(folder: PathBuf) -> impl Fn(&str) -> Result<String, String> {
+    move |path: &str| {
+        read_text(&folder.join(path), MAX_MESH_FILE_BYTES)
+            .map_err(|reason| format!("{}: {reason}", short_path(path)))
+    }
+}
+
+/// Reads a text file of at most `max_bytes`, tolerating stray non-UTF-8 bytes (old MTL files
+/// carry Latin-1 comments). Only regular files are read: a device such as `/dev/zero` or a
+/// pipe would never end (or block), and a folder is never what was meant.
+fn read_text(path: &Path, max_bytes: u64) -> Result<String, String> {
+    use std::io::Read;
+    let meta = std::fs::metadata(path).map_err(|e| os_reason(&e))?;
+    if meta.is_dir() {
+        return Err("it is a folder, not a file".into());
+    }
+    if !meta.is_file() {
+        return Err("it is not a regular file (a device, a pipe or a socket)".into());
+    }
+    let too_big = |size: u64| {
+        format!(
+            "it is {}, more than the {} a file may have",
+            super::budget::format_bytes(size),
+            super::budget::format_bytes(max_bytes)
+        )
+    };
+    if meta.len() > max_bytes {
+        return Err(too_big(meta.len()));
+    }
+    let file = std::fs::File::open(path).map_err(|e| os_reason(&e))?;
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    // `take` also stops a file that grows while it is read.
+    file.take(max_bytes + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| os_reason(&e))?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(too_big(bytes.len() as u64));
+    }
+    // Valid UTF-8 is taken as it is, without the copy `from_utf8_lossy` would make.
+    Ok(String::from_utf8(bytes)
+        .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned()))
+}
+
+/// The OS's reason without the platform-specific "(os error N)" tail, for stable messages.
+fn os_reason(e: &std::io::Error) -> String {
+    let text = e.to_string();
+    match text.find(" (os error") {
+        Some(i) => text[..i].to_string(),
+        None => text,
+    }
+}
