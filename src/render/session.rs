@@ -5,8 +5,9 @@
 //! at once; finished tiles go over a bounded channel tagged with their generation, so the UI
 //! can never mix passes of two generations. The UI only ever calls `try_recv`.
 //!
-//! Each pixel's samples are added to its running sum in index order, exactly as
-//! [`super::render`] does, so the converged image equals the headless render bit for bit.
+//! Each pixel's samples are added to its running sum in index order by
+//! [`super::accumulate_tile`], the loop [`super::render`] runs too, so the converged image
+//! equals the headless render bit for bit.
 
 use std::cell::Cell;
 use std::panic::{AssertUnwindSafe, catch_unwind};
