@@ -7,7 +7,10 @@ use std::path::Path;
 
 use glam::Vec3;
 
+use crate::accel::AccelKind;
 use crate::render::Image;
+use crate::scene::RenderParams;
+use crate::trace::TraceSettings;
 
 /// A write that failed: one sentence naming the file.
 #[derive(Debug, thiserror::Error)]
@@ -93,6 +96,38 @@ pub fn write_atomically(
     Ok(())
 }
 
+/// The PNG text chunks (keyword, value) that say how an image was made: the program, the scene
+/// (a file or a built-in name), the samples done of the target, and as JSON the settings that
+/// shaped it. The CLI's render and the viewer's export both stamp through here, so a PNG says
+/// the same whichever wrote it.
+pub fn stamp(
+    scene_label: &str,
+    samples_done: u32,
+    samples_target: u32,
+    render: &RenderParams,
+    trace: &TraceSettings,
+    accel_used: AccelKind,
+) -> Vec<(String, String)> {
+    // `json!` builds a map sorted by key (serde_json without `preserve_order`): the settings
+    // read in that order, whatever the order written here.
+    let settings = serde_json::json!({
+        "width": render.width, "height": render.height, "max_depth": render.max_depth,
+        "shading": render.shading, "trace": trace, "accel_used": accel_used,
+    });
+    vec![
+        (
+            "Software".to_string(),
+            format!("raytree {}", env!("CARGO_PKG_VERSION")),
+        ),
+        ("raytree.scene".to_string(), scene_label.to_string()),
+        (
+            "raytree.samples".to_string(),
+            format!("{samples_done}/{samples_target}"),
+        ),
+        ("raytree.settings".to_string(), settings.to_string()),
+    ]
+}
+
 /// Writes an 8-bit sRGB PNG with `text` as `tEXt` chunks (keyword, value).
 pub fn write_png(path: &Path, image: &Image, text: &[(String, String)]) -> Result<(), ExportError> {
     let bytes = srgb8_bytes(image);
@@ -172,6 +207,39 @@ mod tests {
         // Below the linear segment's end: 12.92 · 0.002 = 0.02584 → 6.59 → 7.
         assert_eq!(to_srgb8(Vec3::splat(0.002)), [7, 7, 7]);
         assert_eq!(to_srgb8(Vec3::splat(f32::NAN)), [0, 0, 0]);
+    }
+
+    /// The stamp is pinned byte for byte: PNGs written before and after read the same.
+    #[test]
+    fn stamp_keys_values_and_settings_json() {
+        let scene = crate::scene::builtin::load_builtin("quiz").expect("quiz");
+        let text = stamp(
+            "quiz",
+            2,
+            4,
+            &scene.render,
+            &TraceSettings::default(),
+            AccelKind::Bvh,
+        );
+        let keys: Vec<&str> = text.iter().map(|(k, _)| k.as_str()).collect();
+        assert_eq!(
+            keys,
+            [
+                "Software",
+                "raytree.scene",
+                "raytree.samples",
+                "raytree.settings"
+            ]
+        );
+        assert_eq!(text[0].1, format!("raytree {}", env!("CARGO_PKG_VERSION")));
+        assert_eq!((text[1].1.as_str(), text[2].1.as_str()), ("quiz", "2/4"));
+        // Keys sorted: `json!` builds serde_json's default (sorted) map.
+        assert_eq!(
+            text[3].1,
+            "{\"accel_used\":\"bvh\",\"height\":201,\"max_depth\":5,\"shading\":\"blinn-phong\",\
+             \"trace\":{\"accel\":\"auto\",\"cutoff\":0.0,\"methods\":{\"offset\":\"error-bound\",\
+             \"sphere\":\"robust\",\"triangle\":\"watertight\"}},\"width\":201}"
+        );
     }
 
     #[test]

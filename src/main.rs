@@ -327,21 +327,14 @@ fn run_render(args: &RenderArgs) -> Result<()> {
     })?;
     bar.finish_and_clear();
 
-    let text =
-        vec![
-        ("Software".to_string(), format!("raytree {}", env!("CARGO_PKG_VERSION"))),
-        ("raytree.scene".to_string(), args.scene.clone()),
-        ("raytree.samples".to_string(), format!("{samples}/{samples}")),
-        (
-            "raytree.settings".to_string(),
-            serde_json::json!({
-                "width": stats.width, "height": stats.height, "max_depth": scene.render.max_depth,
-                "shading": scene.render.shading, "trace": settings.trace,
-                "accel_used": stats.accel,
-            })
-            .to_string(),
-        ),
-    ];
+    let text = export::stamp(
+        &args.scene,
+        samples,
+        samples,
+        &scene.render,
+        &settings.trace,
+        tracer.accel.kind(),
+    );
     export::write_image(&args.output, &image, &text)?;
     if let Some(path) = &args.stats_json {
         let memory = raytree::render::MemoryStats::of(&tracer);

@@ -1,6 +1,7 @@
 //! The viewer's progressive render session, headless: the converged image equals the batch
 //! render bit for bit, a restart in the middle of a pass never mixes generations, and a worker
-//! that panics is reported without stopping the session.
+//! that panics, or a render thread that cannot be spawned, is reported without stopping the
+//! session.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -176,4 +177,38 @@ fn panicking_worker_is_reported_and_the_next_start_renders() {
         img == batch,
         "the render after the failure differs from the batch render"
     );
+}
+
+/// A start whose thread cannot be spawned (the spawn hook stands in for a system out of
+/// threads) is reported as that generation's `Failed` with the reason, instead of a render that
+/// waits for tiles forever; the next start, with threads to spare, renders as the batch does.
+#[test]
+fn a_failed_thread_spawn_is_reported_and_the_next_start_renders() {
+    let t = tracer("default", 64, 48, 3);
+    let mut session = Session::new(2).expect("pool");
+    session.set_spawn_hook(Some(Arc::new(|| {
+        Err(std::io::Error::other("injected spawn failure"))
+    })));
+    let failed = session.start(t.clone(), 2, None);
+    match session.try_next() {
+        Some(SessionEvent::Failed {
+            generation,
+            message,
+        }) => {
+            assert_eq!(generation, failed);
+            assert_eq!(
+                message,
+                "cannot start the render thread: injected spawn failure"
+            );
+        }
+        other => panic!("expected Failed at once, got {other:?}"),
+    }
+    assert!(session.try_next().is_none(), "a failed start sent more");
+    session.set_spawn_hook(None);
+    let next = session.start(t.clone(), 2, None);
+    assert!(next > failed);
+    let (img, passes) = collect(&session, next, 64, 48);
+    assert_eq!(passes, vec![1, 2]);
+    let (batch, _) = render(&t, 2, 1, &|_, _| {}).expect("render");
+    assert!(img == batch, "the render after the failure differs");
 }

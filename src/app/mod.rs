@@ -6,6 +6,8 @@
 //! end of the frame, where any edit restarts the progressive render with a new generation.
 
 mod file_browser;
+mod film;
+mod input;
 pub mod modes;
 mod panels;
 pub mod sweep;
@@ -17,19 +19,19 @@ use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use eframe::egui;
-use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use crate::accel::Accel;
 use crate::export;
 use crate::ray_tree::{RayTree, pixel_tree};
-use crate::render::session::{Pass, PixelAux, Session, SessionEvent};
+use crate::render::session::{Pass, Session, SessionEvent};
 use crate::render::{Image, RenderSettings};
 use crate::scene::{self, Scene};
 use crate::trace::{TraceSettings, Tracer};
 use file_browser::{BrowseFor, FileBrowser};
-use modes::{ImageMode, mode_color};
-use viewport::{DisplayCallback, DisplayState, GpuDisplay, SharedDisplay};
+use film::Film;
+use modes::ImageMode;
+use viewport::{DisplayState, GpuDisplay, SharedDisplay};
 
 /// UI state kept between runs.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -79,7 +81,7 @@ struct Progress {
     samples_done: u32,
     preview_done: bool,
     finished_secs: Option<f64>,
-    /// Rays of the generation when it finished, for a steady Mrays/s readout.
+    /// What the status bar says of the pass under way: "preview", "4 samples", "stopped".
     pass_label: String,
 }
 
@@ -96,8 +98,7 @@ pub struct ViewerApp {
     generation: u64,
     progress: Progress,
     /// The film as the latest tiles left it: linear colour and sample-0 facts per pixel.
-    beauty: Vec<Vec3>,
-    aux: Vec<PixelAux>,
+    film: Film,
     display: SharedDisplay,
     /// Errors and notices, newest last; shown until dismissed.
     pub messages: Vec<(bool, String)>,
@@ -190,8 +191,7 @@ impl ViewerApp {
             session,
             generation: 0,
             progress: Progress::default(),
-            beauty: vec![Vec3::ZERO; (w * h) as usize],
-            aux: vec![PixelAux::default(); (w * h) as usize],
+            film: Film::new(w, h),
             display: Arc::new(Mutex::new(DisplayState::new(w, h))),
             messages: Vec::new(),
             selected_material: None,
@@ -232,11 +232,7 @@ impl ViewerApp {
 
     /// The film as it stands: the mean of the samples done so far.
     pub fn image(&self) -> Image {
-        Image {
-            width: self.scene.render.width,
-            height: self.scene.render.height,
-            pixels: self.beauty.clone(),
-        }
+        self.film.image()
     }
 
     /// Queues a command, as a panel would.
@@ -296,10 +292,7 @@ impl ViewerApp {
             )
         };
         self.tracer = Arc::new(tracer);
-        if (w, h) != (self.scene.render.width, self.scene.render.height) {
-            self.beauty = vec![Vec3::ZERO; (w * h) as usize];
-            self.aux = vec![PixelAux::default(); (w * h) as usize];
-        }
+        self.film.resize(w, h);
         self.scene = scene;
         self.display
             .lock()
@@ -326,7 +319,6 @@ impl ViewerApp {
         let mut display = self.display.lock().unwrap_or_else(|p| p.into_inner());
         let mode = self.prefs.mode;
         let max_depth = self.scene.render.max_depth;
-        let w = self.scene.render.width;
         while budget.elapsed().as_millis() < 8 {
             let Some(event) = self.session.try_next() else {
                 break;
@@ -336,24 +328,7 @@ impl ViewerApp {
             }
             match event {
                 SessionEvent::Tile(tile) => {
-                    let r = tile.rect;
-                    for j in 0..r.height {
-                        for i in 0..r.width {
-                            let src = (j * r.width + i) as usize;
-                            let dst = ((r.y + j) * w + r.x + i) as usize;
-                            self.beauty[dst] = tile.pixels[src];
-                            if let Some(aux) = &tile.aux {
-                                self.aux[dst] = aux[src];
-                            }
-                            let c = if mode == ImageMode::Render {
-                                tile.pixels[src]
-                            } else {
-                                mode_color(mode, &self.aux[dst], max_depth)
-                            };
-                            display.rgba[dst] = [c.x, c.y, c.z, 1.0];
-                        }
-                    }
-                    display.mark(r);
+                    self.film.write_tile(&tile, mode, max_depth, &mut display);
                 }
                 SessionEvent::PassDone { pass, .. } => match pass {
                     Pass::Preview => {
@@ -370,6 +345,7 @@ impl ViewerApp {
                 }
                 SessionEvent::Failed { message, .. } => {
                     drop(display);
+                    self.progress.pass_label = "stopped".into();
                     self.error(format!("{message}; the render stopped"));
                     return;
                 }
@@ -381,15 +357,8 @@ impl ViewerApp {
     fn refresh_display(&mut self) {
         let mut display = self.display.lock().unwrap_or_else(|p| p.into_inner());
         let mode = self.prefs.mode;
-        let max_depth = self.scene.render.max_depth;
-        for (i, px) in display.rgba.iter_mut().enumerate() {
-            let c = if mode == ImageMode::Render {
-                self.beauty[i]
-            } else {
-                mode_color(mode, &self.aux[i], max_depth)
-            };
-            *px = [c.x, c.y, c.z, 1.0];
-        }
+        self.film
+            .paint(mode, self.scene.render.max_depth, &mut display);
         display.params.exposure = self.prefs.exposure;
         display.params.tonemap = self.prefs.tonemap;
         display.params.raw = mode != ImageMode::Render;
@@ -489,24 +458,14 @@ impl ViewerApp {
     /// Writes the film at full resolution (never a window grab), stamped with its progress.
     fn export(&mut self, path: &Path) {
         let target = self.scene.render.samples;
-        let text =
-            vec![
-            ("Software".to_string(), format!("raytree {}", env!("CARGO_PKG_VERSION"))),
-            ("raytree.scene".to_string(), self.scene_label.clone()),
-            (
-                "raytree.samples".to_string(),
-                format!("{}/{}", self.progress.samples_done, target),
-            ),
-            (
-                "raytree.settings".to_string(),
-                serde_json::json!({
-                    "width": self.scene.render.width, "height": self.scene.render.height,
-                    "max_depth": self.scene.render.max_depth, "shading": self.scene.render.shading,
-                    "trace": self.settings.trace, "accel_used": self.tracer.accel.kind(),
-                })
-                .to_string(),
-            ),
-        ];
+        let text = export::stamp(
+            &self.scene_label,
+            self.progress.samples_done,
+            target,
+            &self.scene.render,
+            &self.settings.trace,
+            self.tracer.accel.kind(),
+        );
         match export::write_image(path, &self.image(), &text) {
             Ok(()) => self.messages.push((
                 false,
@@ -518,43 +477,6 @@ impl ViewerApp {
                 ),
             )),
             Err(e) => self.error(e.to_string()),
-        }
-    }
-
-    fn shortcuts(&mut self, ctx: &egui::Context) {
-        use egui::{Key, KeyboardShortcut, Modifiers};
-        let save = KeyboardShortcut::new(Modifiers::COMMAND, Key::S);
-        let open = KeyboardShortcut::new(Modifiers::COMMAND, Key::O);
-        let (do_save, do_open, help, stop) = ctx.input_mut(|i| {
-            (
-                i.consume_shortcut(&save),
-                i.consume_shortcut(&open),
-                i.consume_key(Modifiers::NONE, Key::F1),
-                i.consume_key(Modifiers::NONE, Key::Escape),
-            )
-        });
-        if do_save {
-            let name = format!("{}.png", self.file_stem());
-            self.browser = Some(FileBrowser::new(BrowseFor::Export, self.start_dir(), &name));
-        }
-        if do_open {
-            self.browser = Some(FileBrowser::new(BrowseFor::Open, self.start_dir(), ""));
-        }
-        if help {
-            self.show_help = !self.show_help;
-        }
-        if stop {
-            self.pending.push(Command::Stop);
-        }
-        let dropped: Vec<PathBuf> = ctx.input(|i| {
-            i.raw
-                .dropped_files
-                .iter()
-                .map(|f| f.path().to_path_buf())
-                .collect()
-        });
-        if let Some(path) = dropped.into_iter().next() {
-            self.pending.push(Command::OpenFile(path));
         }
     }
 
@@ -572,81 +494,6 @@ impl ViewerApp {
             .clone()
             .or_else(|| std::env::current_dir().ok())
             .unwrap_or_else(|| PathBuf::from("."))
-    }
-
-    /// Draws the render fitted into `ui`'s space and handles orbit, pan, zoom, click and hover.
-    fn viewport(&mut self, ui: &mut egui::Ui) {
-        let (w, h) = (
-            self.scene.render.width as f32,
-            self.scene.render.height as f32,
-        );
-        let avail = ui.available_rect_before_wrap();
-        if avail.width() < 1.0 || avail.height() < 1.0 {
-            return; // a zero-area window: nothing to draw
-        }
-        let scale = (avail.width() / w).min(avail.height() / h);
-        let size = egui::vec2(w * scale, h * scale);
-        let rect = egui::Rect::from_center_size(avail.center(), size);
-        let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
-        response
-            .widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, "render viewport"));
-        // The tree's rays over the image: drawn by shaders/overlay.wgsl with the render
-        // camera's projection, one colour per ray kind, the hovered or selected node in white.
-        let overlay = self.tree.as_ref().map(|tree| {
-            let extent = self
-                .scene
-                .bounds()
-                .map(|(lo, hi)| (hi - lo).length())
-                .unwrap_or(10.0)
-                .max(1e-3);
-            let frame = crate::scene::CameraFrame::new(
-                &self.scene.camera,
-                self.scene.render.width,
-                self.scene.render.height,
-            );
-            Arc::new(viewport::Overlay {
-                clip_from_world: frame.clip_from_world(extent * 1e-5, extent * 1e5),
-                vertices: tree_view::overlay_vertices(tree, &self.tree_state, extent),
-            })
-        });
-        ui.painter()
-            .add(eframe::egui_wgpu::Callback::new_paint_callback(
-                rect,
-                DisplayCallback {
-                    shared: self.display.clone(),
-                    overlay,
-                },
-            ));
-        let to_pixel = |p: egui::Pos2| {
-            let x = ((p.x - rect.min.x) / scale).floor();
-            let y = ((p.y - rect.min.y) / scale).floor();
-            (x >= 0.0 && y >= 0.0 && x < w && y < h).then_some((x as u32, y as u32))
-        };
-        self.hover = response.hover_pos().and_then(to_pixel);
-        if response.clicked()
-            && let Some((x, y)) = response.interact_pointer_pos().and_then(to_pixel)
-        {
-            self.pending.push(Command::Pick(x, y));
-        }
-        let delta = response.drag_delta();
-        if delta != egui::Vec2::ZERO {
-            if response.dragged_by(egui::PointerButton::Primary) {
-                self.edit.camera.orbit(delta.x * 0.01, delta.y * 0.01);
-                self.pending.push(Command::Restart);
-            } else if response.dragged_by(egui::PointerButton::Secondary)
-                || response.dragged_by(egui::PointerButton::Middle)
-            {
-                self.edit.camera.pan(delta.x / size.y, delta.y / size.y);
-                self.pending.push(Command::Restart);
-            }
-        }
-        if response.hovered() {
-            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
-            if scroll != 0.0 {
-                self.edit.camera.zoom((-scroll * 0.002).exp());
-                self.pending.push(Command::Restart);
-            }
-        }
     }
 }
 

@@ -4,8 +4,7 @@
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use crate::render::session::PixelAux;
-use crate::trace::EndReason;
+use crate::trace::{EndReason, SampleInfo};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum ImageMode {
@@ -84,7 +83,7 @@ fn has(ends: u8, reason: EndReason) -> bool {
 }
 
 /// The colour of a pixel in `mode` (`Render` is not handled here).
-pub fn mode_color(mode: ImageMode, aux: &PixelAux, max_depth: u32) -> Vec3 {
+pub fn mode_color(mode: ImageMode, aux: &SampleInfo, max_depth: u32) -> Vec3 {
     match mode {
         ImageMode::Render => Vec3::ZERO,
         ImageMode::Depth => ramp(aux.depth_reached as f32 / max_depth.max(1) as f32),
@@ -125,10 +124,10 @@ mod tests {
 
     #[test]
     fn termination_prefers_max_depth() {
-        let aux = PixelAux {
+        let aux = SampleInfo {
             ends: (1 << EndReason::NoHit as u8) | (1 << EndReason::MaxDepth as u8),
             normal: Vec3::Y,
-            ..PixelAux::default()
+            ..SampleInfo::default()
         };
         let (r, g, b) = TERMINATION_LEGEND[0].1;
         assert_eq!(mode_color(ImageMode::Termination, &aux, 5), srgb(r, g, b));

@@ -179,9 +179,7 @@ pub fn status_bar(app: &mut ViewerApp, ui: &mut Ui) {
         });
         ui.horizontal(|ui| {
             if let Some((x, y)) = app.hover {
-                let i = (y * app.scene.render.width + x) as usize;
-                let c = app.beauty[i];
-                let a = app.aux[i];
+                let (c, a) = app.film.pixel(x, y);
                 ui.monospace(format!(
                     "pixel ({x}, {y})  rgb ({:.4}, {:.4}, {:.4})  depth {}  rays {}  normal ({:.2}, {:.2}, {:.2})",
                     c.x, c.y, c.z, a.depth_reached, a.rays, a.normal.x, a.normal.y, a.normal.z

@@ -97,16 +97,40 @@ pub fn trace_tile(
     sums: &mut [Vec3],
 ) -> RayCounts {
     let mut counts = RayCounts::default();
+    accumulate_tile(tracer, frame, rect, samples, sums, &mut counts, None);
+    counts
+}
+
+/// The one tile loop of the batch render ([`trace_tile`]) and the viewer's session: adds
+/// samples `samples` of every pixel of `rect` to its running sum in `sums` (row-major within
+/// the rect), one pixel after another and each pixel's samples in index order, so a pixel's sum
+/// never depends on how the samples were split into passes. Rays traced are added to `counts`;
+/// when `samples` holds sample 0, each pixel's [`SampleInfo`] of that sample is pushed to
+/// `first` (row-major), for the viewer's image modes.
+pub fn accumulate_tile(
+    tracer: &Tracer,
+    frame: &CameraFrame,
+    rect: Rect,
+    samples: Range<u32>,
+    sums: &mut [Vec3],
+    counts: &mut RayCounts,
+    mut first: Option<&mut Vec<SampleInfo>>,
+) {
     for j in 0..rect.height {
         for i in 0..rect.width {
             let (x, y) = (rect.x + i, rect.y + j);
             let sum = &mut sums[(j * rect.width + i) as usize];
             for s in samples.clone() {
-                *sum += trace_sample(tracer, frame, x, y, s, &mut counts).0;
+                let (c, info) = trace_sample(tracer, frame, x, y, s, counts);
+                *sum += c;
+                if s == 0
+                    && let Some(first) = first.as_mut()
+                {
+                    first.push(info);
+                }
             }
         }
     }
-    counts
 }
 
 /// Sample `s` of pixel (`x`, `y`): its colour and the facts the image modes show.
@@ -281,17 +305,10 @@ pub fn render_with(
                 }));
                 let n = rect.width as u64 * rect.height as u64;
                 progress(done.fetch_add(n, Ordering::Relaxed) + n, total);
-                outcome.map_err(|panic| {
-                    let message = panic
-                        .downcast_ref::<&str>()
-                        .map(|s| s.to_string())
-                        .or_else(|| panic.downcast_ref::<String>().cloned())
-                        .unwrap_or_else(|| "unknown panic".into());
-                    RenderError::WorkerPanicked {
-                        x: rect.x,
-                        y: rect.y,
-                        message,
-                    }
+                outcome.map_err(|panic| RenderError::WorkerPanicked {
+                    x: rect.x,
+                    y: rect.y,
+                    message: panic_message(panic.as_ref()),
                 })
             })
             .collect()
@@ -328,9 +345,30 @@ pub fn render_with(
     Ok((image, stats))
 }
 
+/// The message a caught panic carries: `panic!` with a literal gives a `&str`, with a format
+/// a `String`; anything else (`panic_any`) has no text to show.
+pub(crate) fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".into())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn panic_messages_of_str_string_and_other_payloads() {
+        let caught = |f: fn()| {
+            let payload = catch_unwind(f).expect_err("f panics");
+            panic_message(payload.as_ref())
+        };
+        assert_eq!(caught(|| panic!("literal")), "literal");
+        assert_eq!(caught(|| panic!("formatted {}", 7)), "formatted 7");
+        assert_eq!(caught(|| std::panic::panic_any(7_u8)), "unknown panic");
+    }
 
     #[test]
     fn tiles_cover_image_once() {

@@ -5,9 +5,11 @@
 //! at once; finished tiles go over a bounded channel tagged with their generation, so the UI
 //! can never mix passes of two generations. The UI only ever calls `try_recv`.
 //!
-//! Each pixel's samples are added to its running sum in index order, exactly as
-//! [`super::render`] does, so the converged image equals the headless render bit for bit.
+//! Each pixel's samples are added to its running sum in index order by
+//! [`super::accumulate_tile`], the loop [`super::render`] runs too, so the converged image
+//! equals the headless render bit for bit.
 
+use std::cell::Cell;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, sync_channel};
@@ -17,7 +19,7 @@ use std::time::Instant;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::{Rect, TILE_SIZE, tiles, trace_sample};
+use super::{Rect, TILE_SIZE, accumulate_tile, panic_message, tiles, trace_sample};
 use crate::scene::CameraFrame;
 use crate::trace::{RayCounts, SampleInfo, Tracer};
 
@@ -26,26 +28,6 @@ pub const PREVIEW_BLOCK: u32 = 8;
 
 /// Capacity of the tile channel: enough for several passes of a large image between frames.
 const CHANNEL_CAPACITY: usize = 4096;
-
-/// Per-pixel facts from sample 0, for the image modes.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PixelAux {
-    pub depth_reached: u32,
-    pub rays: u32,
-    pub ends: u8,
-    pub normal: Vec3,
-}
-
-impl From<SampleInfo> for PixelAux {
-    fn from(info: SampleInfo) -> Self {
-        Self {
-            depth_reached: info.depth_reached,
-            rays: info.rays,
-            ends: info.ends,
-            normal: info.normal,
-        }
-    }
-}
 
 /// Which pass a tile belongs to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -65,7 +47,7 @@ pub struct TileUpdate {
     /// Linear colours, row-major within `rect`.
     pub pixels: Vec<Vec3>,
     /// Image-mode facts, sent with the preview (block-filled) and the first full pass only.
-    pub aux: Option<Vec<PixelAux>>,
+    pub aux: Option<Vec<SampleInfo>>,
 }
 
 /// What the session reports to the UI.
@@ -148,6 +130,12 @@ pub fn sample_batches(target: u32) -> Vec<std::ops::Range<u32>> {
 /// [`super::render_with`] does for the batch render. The viewer sets none.
 pub type TileHook = dyn Fn(Pass, Rect) + Send + Sync;
 
+/// Called on the caller's thread just before [`Session::start`] spawns the render's
+/// coordinator thread; an error stands for a failed spawn (the system out of threads or
+/// memory): the fault tests use it to check that such a failure reaches the UI as
+/// [`SessionEvent::Failed`]. The viewer sets none.
+pub type SpawnHook = dyn Fn() -> std::io::Result<()> + Send + Sync;
+
 /// Owns the worker pool and the channel; one per viewer.
 pub struct Session {
     generation: Arc<AtomicU64>,
@@ -157,8 +145,12 @@ pub struct Session {
     threads: usize,
     stats: Arc<LiveStats>,
     /// Events of older generations dropped on receipt.
-    stale_dropped: std::cell::Cell<u64>,
+    stale_dropped: Cell<u64>,
     tile_hook: Option<Arc<TileHook>>,
+    spawn_hook: Option<Arc<SpawnHook>>,
+    /// A start that could not spawn its thread: handed out by [`Self::try_next`], since no
+    /// worker exists to send it.
+    start_failure: Cell<Option<SessionEvent>>,
 }
 
 impl Session {
@@ -172,14 +164,21 @@ impl Session {
             pool: Arc::new(build_pool(threads)?),
             threads,
             stats: Arc::new(LiveStats::default()),
-            stale_dropped: std::cell::Cell::new(0),
+            stale_dropped: Cell::new(0),
             tile_hook: None,
+            spawn_hook: None,
+            start_failure: Cell::new(None),
         })
     }
 
     /// Sets (or with `None` removes) the [`TileHook`]; takes effect at the next start.
     pub fn set_tile_hook(&mut self, hook: Option<Arc<TileHook>>) {
         self.tile_hook = hook;
+    }
+
+    /// Sets (or with `None` removes) the [`SpawnHook`]; takes effect at the next start.
+    pub fn set_spawn_hook(&mut self, hook: Option<Arc<SpawnHook>>) {
+        self.spawn_hook = hook;
     }
 
     /// Changes the worker count (takes effect at the next start).
@@ -209,9 +208,11 @@ impl Session {
     }
 
     /// Starts rendering the tracer's scene up to `target` samples, tiles nearest `focus`
-    /// (pixels; `None`: the image centre) first. Returns the new generation.
+    /// (pixels; `None`: the image centre) first. Returns the new generation; when its thread
+    /// cannot be spawned, that generation's first event is [`SessionEvent::Failed`].
     pub fn start(&mut self, tracer: Arc<Tracer>, target: u32, focus: Option<(f32, f32)>) -> u64 {
         let generation = self.stop();
+        self.start_failure.set(None);
         self.stats = Arc::new(LiveStats::default());
         let job = Job {
             tracer,
@@ -227,11 +228,23 @@ impl Session {
         let pool = self.pool.clone();
         // The coordinator runs on its own thread so the UI never waits; it only hands passes to
         // the pool and stops as soon as the generation moves on.
-        std::thread::Builder::new()
-            .name(format!("raytree-render-{generation}"))
-            .spawn(move || pool.install(|| job.run()))
-            .map(|_| generation)
-            .unwrap_or(generation)
+        let spawned = match &self.spawn_hook {
+            Some(hook) => hook(),
+            None => Ok(()),
+        }
+        .and_then(|()| {
+            std::thread::Builder::new()
+                .name(format!("raytree-render-{generation}"))
+                .spawn(move || pool.install(|| job.run()))
+        });
+        // Without its thread the generation would wait for tiles forever: say so instead.
+        if let Err(e) = spawned {
+            self.start_failure.set(Some(SessionEvent::Failed {
+                generation,
+                message: format!("cannot start the render thread: {e}"),
+            }));
+        }
+        generation
     }
 
     /// Events of older generations that arrived after a restart and were dropped.
@@ -241,6 +254,12 @@ impl Session {
 
     /// The next event, if one is waiting; stale generations are dropped here too.
     pub fn try_next(&self) -> Option<SessionEvent> {
+        if let Some(ev) = self.start_failure.take() {
+            if ev.generation() == self.generation() {
+                return Some(ev);
+            }
+            self.stale_dropped.set(self.stale_dropped.get() + 1);
+        }
         loop {
             match self.receiver.try_recv() {
                 Ok(ev) if ev.generation() == self.generation() => return Some(ev),
@@ -316,22 +335,15 @@ impl Job {
                 let mut tile_sums = sums[i].lock().unwrap_or_else(|p| p.into_inner());
                 let mut counts = RayCounts::default();
                 let mut aux = (batch.start == 0).then(Vec::new);
-                for j in 0..rect.height {
-                    for k in 0..rect.width {
-                        let (x, y) = (rect.x + k, rect.y + j);
-                        let sum = &mut tile_sums[(j * rect.width + k) as usize];
-                        for s in batch.clone() {
-                            let (c, info) =
-                                trace_sample(&self.tracer, &frame, x, y, s, &mut counts);
-                            *sum += c;
-                            if s == 0
-                                && let Some(aux) = aux.as_mut()
-                            {
-                                aux.push(PixelAux::from(info));
-                            }
-                        }
-                    }
-                }
+                accumulate_tile(
+                    &self.tracer,
+                    &frame,
+                    rect,
+                    batch.clone(),
+                    &mut tile_sums,
+                    &mut counts,
+                    aux.as_mut(),
+                );
                 self.stats.add(&counts);
                 let n = batch.end as f32;
                 (tile_sums.iter().map(|s| *s / n).collect(), aux)
@@ -350,7 +362,7 @@ impl Job {
         &self,
         order: &[Rect],
         pass: Pass,
-        work: impl Fn(Rect, usize) -> (Vec<Vec3>, Option<Vec<PixelAux>>) + Sync,
+        work: impl Fn(Rect, usize) -> (Vec<Vec3>, Option<Vec<SampleInfo>>) + Sync,
     ) {
         order.par_iter().enumerate().for_each(|(i, &rect)| {
             if self.stale() {
@@ -378,11 +390,7 @@ impl Job {
                     }));
                 }
                 Err(panic) => {
-                    let message = panic
-                        .downcast_ref::<&str>()
-                        .map(|s| s.to_string())
-                        .or_else(|| panic.downcast_ref::<String>().cloned())
-                        .unwrap_or_else(|| "unknown panic".into());
+                    let message = panic_message(panic.as_ref());
                     if !self.failed.swap(true, Ordering::Relaxed) {
                         self.send(SessionEvent::Failed {
                             generation: self.generation,
@@ -404,19 +412,22 @@ impl Job {
     }
 
     /// One centre sample per 8×8 block, copied to the whole block.
-    fn preview_tile(&self, frame: &CameraFrame, rect: Rect) -> (Vec<Vec3>, Option<Vec<PixelAux>>) {
+    fn preview_tile(
+        &self,
+        frame: &CameraFrame,
+        rect: Rect,
+    ) -> (Vec<Vec3>, Option<Vec<SampleInfo>>) {
         let scene = &self.tracer.scene;
         let (w, h) = (scene.render.width, scene.render.height);
         let n = (rect.width * rect.height) as usize;
         let mut pixels = vec![Vec3::ZERO; n];
-        let mut aux = vec![PixelAux::default(); n];
+        let mut aux = vec![SampleInfo::default(); n];
         let mut counts = RayCounts::default();
         for by in (0..rect.height).step_by(PREVIEW_BLOCK as usize) {
             for bx in (0..rect.width).step_by(PREVIEW_BLOCK as usize) {
                 let x = (rect.x + bx + PREVIEW_BLOCK / 2).min(w - 1);
                 let y = (rect.y + by + PREVIEW_BLOCK / 2).min(h - 1);
-                let (c, info) = trace_sample(&self.tracer, frame, x, y, 0, &mut counts);
-                let a = PixelAux::from(info);
+                let (c, a) = trace_sample(&self.tracer, frame, x, y, 0, &mut counts);
                 for j in by..(by + PREVIEW_BLOCK).min(rect.height) {
                     for i in bx..(bx + PREVIEW_BLOCK).min(rect.width) {
                         pixels[(j * rect.width + i) as usize] = c;
