@@ -10,7 +10,7 @@ use clap::{Args, Parser, Subcommand};
 use raytree::accel::AccelKind;
 use raytree::experiments::{bench, rows};
 use raytree::geometry::{Methods, OffsetMethod, SphereMethod, TriangleMethod};
-use raytree::render::{RenderSettings, render};
+use raytree::render::{MemoryStats, RenderSettings, render};
 use raytree::scene::{self, Scene, Shading};
 use raytree::trace::{TraceSettings, Tracer};
 use raytree::{export, ray_tree};
@@ -306,8 +306,8 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         ),
     ];
     export::write_image(&args.output, &image, &text)?;
+    let memory = MemoryStats::of(&tracer);
     if let Some(path) = &args.stats_json {
-        let memory = raytree::render::MemoryStats::of(&tracer);
         let json = serde_json::to_string_pretty(&serde_json::json!({
             "stats": stats, "mrays_per_sec": stats.mrays_per_sec(),
             "triangles": scene.triangles.len(), "spheres": scene.spheres.len(),
@@ -344,15 +344,15 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         stats.mrays_per_sec()
     );
     if args.stats {
-        let m = bench::MemoryStats::of(&tracer);
+        let m = &memory;
         out!(
             "memory: accelerator {} B + scene records {} B for {} triangles and {} spheres = \
              {:.1} B per primitive ({} skipped{})",
             m.accel_bytes,
-            m.scene_bytes,
+            m.scene_geometry_bytes,
             m.triangles,
             m.spheres,
-            m.bytes_per_prim(),
+            m.bytes_per_primitive(),
             tracer.accel.skipped_prims(),
             tracer
                 .accel

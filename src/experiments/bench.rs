@@ -1065,32 +1065,3 @@ pub fn crossover_lines(points: &[ScalingPoint]) -> Vec<String> {
         })
         .collect()
 }
-
-/// Memory a traced scene holds for its geometry.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct MemoryStats {
-    pub triangles: usize,
-    pub spheres: usize,
-    /// The accelerator's own heap memory (its compact primitive copy included).
-    pub accel_bytes: usize,
-    /// The scene's triangle and sphere records.
-    pub scene_bytes: usize,
-}
-
-impl MemoryStats {
-    pub fn of(tracer: &Tracer) -> Self {
-        let s = &tracer.scene;
-        Self {
-            triangles: s.triangles.len(),
-            spheres: s.spheres.len(),
-            accel_bytes: tracer.accel.memory_bytes(),
-            scene_bytes: s.triangles.len() * size_of::<crate::scene::Triangle>()
-                + s.spheres.len() * size_of::<crate::scene::Sphere>(),
-        }
-    }
-
-    /// Bytes per primitive (triangles and spheres), accelerator and scene storage together.
-    pub fn bytes_per_prim(&self) -> f64 {
-        (self.accel_bytes + self.scene_bytes) as f64 / (self.triangles + self.spheres).max(1) as f64
-    }
-}
