@@ -344,15 +344,18 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         stats.mrays_per_sec()
     );
     if args.stats {
-        let m = &memory;
         out!(
             "memory: accelerator {} B + scene records {} B for {} triangles and {} spheres = \
-             {:.1} B per primitive ({} skipped{})",
-            m.accel_bytes,
-            m.scene_geometry_bytes,
-            m.triangles,
-            m.spheres,
-            m.bytes_per_primitive(),
+             {:.1} B per primitive{} ({} skipped{})",
+            memory.accel_bytes,
+            memory.scene_geometry_bytes,
+            memory.triangles,
+            memory.spheres,
+            memory.bytes_per_primitive(),
+            memory
+                .bytes_per_triangle
+                .map(|b| format!(", {b:.1} B per triangle"))
+                .unwrap_or_default(),
             tracer.accel.skipped_prims(),
             tracer
                 .accel
