@@ -9,14 +9,15 @@
 //! raytree through `raytree render bench.toml --stats-json`, the peer from a binary copy of the
 //! very scene raytree loaded, runs alternating. Reported: render-phase Mrays/s (median of the
 //! runs), their ratio (the median, smallest and largest of the ratios of each raytree run to
-//! the Embree run after it), load and build seconds, bytes per triangle, peak memory, rays by kind (which must
-//! agree within a few percent) and how many pixels differ between the two images.
+//! the Embree run after it), load and build seconds, bytes per triangle, peak memory, rays by
+//! kind (which must agree within a few percent) and how many pixels differ between the two
+//! images.
 //!
 //! Run: `cargo bench --bench peer` (80k and 320k triangles, 2 threads, 7 runs each), or e.g.
 //! `cargo bench --bench peer -- --sizes 1000,1000000 --threads 1 --runs 5 --keep /tmp/b`.
 //! `--size 1280x960` renders more rays than the scene's 640×480 (a longer, steadier render
-//! phase on a noisy machine). `--embree-quality high` (or `low`) builds Embree's BVH at that quality instead of its
-//! default, medium. `--scaling` instead prints raytree's build and render time against
+//! phase on a noisy machine). `--embree-quality high` (or `low`) builds Embree's BVH at that
+//! quality instead of its default, medium. `--scaling` instead prints raytree's build and render time against
 //! triangle count (1k to 4M) on 1 and 2 threads, and with `--chart FILE.png` draws it.
 
 use std::io::Write as _;

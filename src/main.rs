@@ -11,9 +11,9 @@ use clap::{Args, Parser, Subcommand};
 use raytree::accel::AccelKind;
 use raytree::choice::Choice;
 #[cfg(feature = "lab")]
-use raytree::experiments::{bench, rows};
+use raytree::experiments::{measure, report, rows, scaling, sweep};
 use raytree::geometry::{Methods, OffsetMethod, SphereMethod, TriangleMethod};
-use raytree::render::{RenderSettings, render};
+use raytree::render::{MemoryStats, RenderSettings, render};
 use raytree::scene::{self, Scene, Shading, rules};
 use raytree::trace::{TraceSettings, Tracer};
 use raytree::{export, ray_tree};
@@ -336,8 +336,8 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         tracer.accel.kind(),
     );
     export::write_image(&args.output, &image, &text)?;
+    let memory = MemoryStats::of(&tracer);
     if let Some(path) = &args.stats_json {
-        let memory = raytree::render::MemoryStats::of(&tracer);
         let json = serde_json::to_string_pretty(&serde_json::json!({
             "stats": stats, "mrays_per_sec": stats.mrays_per_sec(),
             "triangles": scene.triangles.len(), "spheres": scene.spheres.len(),
@@ -374,15 +374,18 @@ fn run_render(args: &RenderArgs) -> Result<()> {
         stats.mrays_per_sec()
     );
     if args.stats {
-        let m = bench::MemoryStats::of(&tracer);
         out!(
             "memory: accelerator {} B + scene records {} B for {} triangles and {} spheres = \
-             {:.1} B per primitive ({} skipped{})",
-            m.accel_bytes,
-            m.scene_bytes,
-            m.triangles,
-            m.spheres,
-            m.bytes_per_prim(),
+             {:.1} B per primitive{} ({} skipped{})",
+            memory.accel_bytes,
+            memory.scene_geometry_bytes,
+            memory.triangles,
+            memory.spheres,
+            memory.bytes_per_primitive(),
+            memory
+                .bytes_per_triangle
+                .map(|b| format!(", {b:.1} B per triangle"))
+                .unwrap_or_default(),
             tracer.accel.skipped_prims(),
             tracer
                 .accel
@@ -409,7 +412,7 @@ fn sweep_bar() -> indicatif::ProgressBar {
 
 #[cfg(feature = "lab")]
 /// A progress callback that moves `bar`.
-fn show_on(bar: &indicatif::ProgressBar) -> impl Fn(&bench::BenchProgress) + '_ {
+fn show_on(bar: &indicatif::ProgressBar) -> impl Fn(&measure::BenchProgress) + '_ {
     move |p| {
         bar.set_length(p.steps as u64);
         bar.set_position(p.step as u64);
@@ -423,14 +426,17 @@ fn run_bench(args: &BenchArgs) -> Result<()> {
     let scene = load_scene(&args.scene)?;
     print_warnings(&scene);
     let (mut opts, scaling) = if args.quick {
-        (bench::BenchOptions::quick(), bench::ScalingOptions::quick())
+        (
+            sweep::BenchOptions::quick(),
+            scaling::ScalingOptions::quick(),
+        )
     } else {
-        (bench::BenchOptions::full(), bench::ScalingOptions::full())
+        (sweep::BenchOptions::full(), scaling::ScalingOptions::full())
     };
     opts.width = args.width.or(opts.width);
     opts.height = args.height.or(opts.height);
     opts.threads = args.threads;
-    let scaling = bench::ScalingOptions {
+    let scaling = scaling::ScalingOptions {
         threads: args.threads,
         ..scaling
     };
@@ -440,9 +446,9 @@ fn run_bench(args: &BenchArgs) -> Result<()> {
     let mut changed: Vec<String> = Vec::new();
     if !args.no_sweep {
         let bar = sweep_bar();
-        let report = bench::run_sweep(&scene, &opts, &show_on(&bar), &cancel)?;
+        let report = sweep::run_sweep(&scene, &opts, &show_on(&bar), &cancel)?;
         bar.finish_and_clear();
-        bench::write_bench(&args.out, &report, &args.scene)?;
+        report::write_bench(&args.out, &report, &args.scene)?;
         out!(
             "wrote {} and bench.svg/.png ({} points, reference {}x{} at {} spp, depth {}, {:.1} s)",
             args.out.join("bench.csv").display(),
@@ -454,13 +460,14 @@ fn run_bench(args: &BenchArgs) -> Result<()> {
             report.reference.secs
         );
         out!("Pareto-optimal settings (time against mean FLIP):");
-        for line in bench::pareto_lines(&report) {
+        for line in report::pareto_lines(&report) {
             out!("  {line}");
         }
-        changed = bench::accel_changes(&report)
+        changed = report
+            .accel_changes()
             .iter()
             .filter(|(_, n)| *n > 0)
-            .map(|(k, n)| format!("{} changed {n} pixels", bench::value_name(k)))
+            .map(|(k, n)| format!("{} changed {n} pixels", measure::value_name(k)))
             .collect();
         if changed.is_empty() {
             out!("accelerators: none, grid and bvh give the identical image (0 differing pixels)");
@@ -468,14 +475,14 @@ fn run_bench(args: &BenchArgs) -> Result<()> {
     }
     if !args.no_scaling {
         let bar = sweep_bar();
-        let points = bench::run_scaling(&scaling, &show_on(&bar), &cancel)?;
+        let points = scaling::run_scaling(&scaling, &show_on(&bar), &cancel)?;
         bar.finish_and_clear();
-        bench::write_scaling(&args.out, &points, &scaling)?;
+        report::write_scaling(&args.out, &points, &scaling)?;
         out!(
             "wrote {} and scaling.svg/.png",
             args.out.join("scaling.csv").display()
         );
-        for line in bench::crossover_lines(&points) {
+        for line in report::crossover_lines(&points) {
             out!("  {line}");
         }
     }

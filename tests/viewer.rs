@@ -258,7 +258,7 @@ fn speed_vs_accuracy_window_runs_the_sweep_and_a_point_applies() {
     let p = report
         .points
         .iter()
-        .find(|p| p.knob == raytree::experiments::bench::Knob::Samples && p.settings.samples == 4)
+        .find(|p| p.knob == raytree::experiments::sweep::Knob::Samples && p.settings.samples == 4)
         .expect("a 4-sample point");
     let at = [
         p.secs.max(1e-6).log10(),

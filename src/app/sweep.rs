@@ -1,4 +1,4 @@
-//! The "Speed vs accuracy" window: runs the sweep of `experiments::bench` on the current scene
+//! The "Speed vs accuracy" window: runs the sweep of `experiments::sweep` on the current scene
 //! in a background thread (progress, cancel), plots error against time on log axes with
 //! `egui_plot`, one series per knob and the Pareto front, and applies a point's settings when it
 //! is clicked.
@@ -10,9 +10,8 @@ use std::sync::{Arc, Mutex};
 use eframe::egui::{self, Color32, Ui};
 use egui_plot::{Legend, Line, Plot, PlotPoints, Points};
 
-use crate::experiments::bench::{
-    BenchError, BenchOptions, BenchProgress, BenchReport, Knob, PointSettings, run_sweep,
-};
+use crate::experiments::measure::{BenchError, BenchProgress};
+use crate::experiments::sweep::{BenchOptions, BenchReport, Knob, PointSettings, run_sweep};
 use crate::scene::Scene;
 
 enum Message {

@@ -1,5 +1,5 @@
-//! Charts of the sweeps as plain data ([`Chart`]: what the viewer can also plot with
-//! `egui_plot`) and their rendering to SVG and PNG with `plotters`. Text uses the Ubuntu Light
+//! Charts of the sweeps as plain data ([`Chart`]: titled, labelled axes, linear or log, and
+//! named series) and their rendering to SVG and PNG with `plotters`. Text uses the Ubuntu Light
 //! font compiled into `epaint_default_fonts`, registered with plotters' `ab_glyph` backend, so
 //! no system font (fontconfig) is needed and the PNG looks the same on every machine.
 

@@ -5,8 +5,8 @@
 
 use serde::Serialize;
 
-use super::bench::value_name;
 use super::chart::{Chart, Series, write_chart};
+use super::measure::value_name;
 use super::rng::Pcg;
 use super::stability::*;
 use crate::accel::AccelKind;

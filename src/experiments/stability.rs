@@ -603,7 +603,7 @@ pub fn bad_triangles(fraction: f32, n_rays: usize, rng: &mut Pcg) -> BadTriangle
             Err(_) => cell.panics += 1,
         }
         let outcome = catch_unwind(AssertUnwindSafe(|| {
-            let mut scene = super::bench::scaling_scene(8, 48, 36);
+            let mut scene = super::scaling::scaling_scene(8, 48, 36);
             scene.triangles = dirty
                 .iter()
                 .map(|&vertices| crate::scene::Triangle {

@@ -3,6 +3,7 @@
 //! thread count or the tile order), and statistics.
 
 pub mod session;
+pub mod stats;
 
 use std::ops::Range;
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -13,10 +14,10 @@ use glam::Vec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::accel::AccelKind;
 use crate::scene::budget::{MemoryError, batch_memory_estimate, memory_limit};
 use crate::scene::{CameraFrame, primary_ray};
 use crate::trace::{NoRecord, RayCounts, RayKind, SampleInfo, TraceSettings, Tracer};
+pub use stats::{MemoryStats, RenderStats, peak_memory_bytes};
 
 /// Side of a square tile in pixels.
 pub const TILE_SIZE: u32 = 32;
@@ -156,73 +157,8 @@ pub fn trace_sample(
     (c, info)
 }
 
-/// Figures of one render.
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct RenderStats {
-    pub width: u32,
-    pub height: u32,
-    pub samples: u32,
-    pub threads: usize,
-    /// The accelerator actually used (`auto` resolved).
-    pub accel: Option<AccelKind>,
-    pub rays: RayCounts,
-    pub build_secs: f64,
-    pub render_secs: f64,
-}
-
-impl RenderStats {
-    /// Millions of rays (all kinds) per second of the render phase.
-    pub fn mrays_per_sec(&self) -> f64 {
-        self.rays.total() as f64 / self.render_secs.max(1e-9) / 1e6
-    }
-}
-
-/// Memory figures of a tracer, for `--stats-json` and the benchmarks.
-#[derive(Clone, Copy, Debug, Default, Serialize)]
-pub struct MemoryStats {
-    /// The process's peak resident set (`VmHWM` of `/proc/self/status`); `None` where that
-    /// file does not exist.
-    pub peak_bytes: Option<u64>,
-    /// The scene's spheres and triangles as the scene stores them.
-    pub scene_geometry_bytes: u64,
-    /// The accelerator, its own compact copy of the primitives included.
-    pub accel_bytes: u64,
-    /// `(scene_geometry_bytes + accel_bytes) / triangles`: what tracing costs per triangle
-    /// (the spheres' few bytes included); `None` without triangles.
-    pub bytes_per_triangle: Option<f64>,
-}
-
-impl MemoryStats {
-    pub fn of(tracer: &Tracer) -> Self {
-        let scene = &tracer.scene;
-        let scene_geometry_bytes = (scene.triangles.len() * size_of::<crate::scene::Triangle>()
-            + scene.spheres.len() * size_of::<crate::scene::Sphere>())
-            as u64;
-        let accel_bytes = tracer.accel.memory_bytes() as u64;
-        let triangles = scene.triangles.len();
-        Self {
-            peak_bytes: peak_memory_bytes(),
-            scene_geometry_bytes,
-            accel_bytes,
-            bytes_per_triangle: (triangles > 0)
-                .then(|| (scene_geometry_bytes + accel_bytes) as f64 / triangles as f64),
-        }
-    }
-}
-
-/// The process's peak resident set in bytes (`VmHWM`), where `/proc/self/status` has it.
-pub fn peak_memory_bytes() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: u64 = line
-        .trim_start_matches("VmHWM:")
-        .trim()
-        .trim_end_matches("kB")
-        .trim()
-        .parse()
-        .ok()?;
-    Some(kb * 1024)
-}
+// The figures of a render (time, rays, memory) live in `stats`; [`render`] returns them, so
+// they are re-exported beside it.
 
 /// A render that could not complete.
 #[derive(Debug, thiserror::Error)]
