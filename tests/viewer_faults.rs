@@ -255,11 +255,14 @@ fn a_scene_wider_than_the_largest_texture_is_refused() {
 }
 
 /// Edits are held to the loader's ±1e15 bound (a BVH build over a primitive near f32::MAX
-/// panics in obvhs): the far spheres are refused and the scene stays.
+/// panics in obvhs): the far spheres are refused with a message, the edit is undone, and the
+/// scene stays and renders.
 #[test]
-fn an_edit_far_beyond_the_scene_size_limit_does_not_panic() {
+fn an_edit_far_beyond_the_scene_size_limit_is_refused() {
     let mut app =
         ViewerApp::headless(small("default", 32, 24, 1), "far".into()).expect("the viewer starts");
+    let spheres = app.scene().spheres.clone();
+    let messages = app.messages.len();
     let mut far = app.edit.spheres[0];
     far.center = Vec3::new(3e38, 0.0, 0.0);
     for _ in 0..8 {
@@ -267,5 +270,11 @@ fn an_edit_far_beyond_the_scene_size_limit_does_not_panic() {
     }
     app.command(Command::Rebuild);
     app.apply();
+    assert_eq!(app.messages.len(), messages + 1, "{:?}", app.messages);
+    let (error, message) = app.messages.last().cloned().expect("a message");
+    assert!(error, "{message}");
+    assert_eq!(app.scene().spheres, spheres, "the scene stays");
+    assert_eq!(app.edit.spheres, spheres, "the edit is undone");
     settle(&mut app);
+    assert_converged(&app);
 }
