@@ -237,7 +237,7 @@ impl Tracer {
         &self.settings.methods
     }
 
-    /// Closest object or visible light along the ray, strictly after `t_min`.
+    /// Closest object or visible light along the ray, strictly after its origin (`t > 0`).
     fn intersect(&self, ray: &Ray) -> Found {
         let mut found = Found::Nothing;
         let mut t_max = f32::INFINITY;

@@ -78,7 +78,8 @@ const SPHERE_COST: f32 = 1.0;
 
 impl Bvh {
     pub(in crate::accel) fn build(prims: Vec<Prim>) -> Bvh {
-        // `Accel` refuses to build this far (see there); ids would not fit a leaf word.
+        // Loaded scenes stay far below (the file-size caps and the memory budget bound them);
+        // beyond this, ids would not fit a leaf word.
         assert!(prims.len() <= MAX_PRIMS, "more than 2^28 primitives");
         let bounds = |prims: &[Prim]| -> Vec<Aabb> {
             prims
