@@ -60,15 +60,16 @@ fn assert_converged(app: &ViewerApp) {
     );
 }
 
-/// Hundreds of edits a second, of every kind that restarts the render: camera, depth, light
+/// Edits as fast as they come, of every kind that restarts the render: camera, depth, light
 /// colour, material, image size (so stale tiles of another size are in flight), accelerator
-/// rebuilds. Then the film converges to the final scene exactly.
+/// rebuilds. No edit waits for a render, and then the film converges to the final scene exactly.
 #[test]
 fn bursts_of_edits_never_deadlock_or_leave_stale_tiles() {
     let mut app = ViewerApp::headless(small("default", 48, 36, 4), "burst".into())
         .expect("the viewer starts");
     let start = Instant::now();
     let edits = 400;
+    let mut finished_at_once = 0u32;
     for i in 0..edits {
         let e = &mut app.edit;
         e.camera.position.x += 0.002;
@@ -88,10 +89,16 @@ fn bursts_of_edits_never_deadlock_or_leave_stale_tiles() {
         });
         app.apply();
         app.poll_session();
+        finished_at_once += u32::from(app.is_finished());
     }
     let per_second = edits as f64 / start.elapsed().as_secs_f64();
     eprintln!("{edits} edits at {per_second:.0} a second");
-    assert!(per_second > 100.0, "only {per_second:.0} edits a second");
+    // An edit returns while its render runs on the workers. Were the render done on the UI
+    // thread, every edit would find its render finished.
+    assert!(
+        finished_at_once < edits / 2,
+        "{finished_at_once} of {edits} edits waited for their render"
+    );
     settle(&mut app);
     assert_eq!(app.scene().render.width, 40 + (edits - 1) % 17);
     assert_converged(&app);
