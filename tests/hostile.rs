@@ -110,6 +110,7 @@ fn cli_refuses_each_hostile_file_with_one_line_and_no_output() {
             // 1 GiB: `all_maximum.toml` (16384², 10 GiB to render) is refused the same way on
             // every machine.
             .env("RAYTREE_MEMORY_LIMIT", "1024")
+            // A hang guard, not a measure of speed: a render that never ends fails here.
             .timeout(Duration::from_secs(60))
             .output()
             .expect("runs");

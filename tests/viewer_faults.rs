@@ -37,7 +37,8 @@ fn batch(scene: &Scene, trace: TraceSettings) -> Image {
         .0
 }
 
-/// Polls until the current generation finishes; a deadlock fails here instead of hanging.
+/// Polls until the current generation finishes. The deadline is a hang guard, not a measure of
+/// speed: a deadlock fails here instead of hanging the suite.
 fn settle(app: &mut ViewerApp) {
     let deadline = Instant::now() + Duration::from_secs(120);
     while !app.is_finished() {
@@ -173,6 +174,17 @@ fn harness(scene: Scene, size: egui::Vec2) -> Harness<'static, ViewerApp> {
         .build_eframe(|cc| ViewerApp::new(cc, scene, "faults".into()).expect("the viewer starts"))
 }
 
+/// Steps the window until its render finishes. The deadline is a hang guard, not a measure of
+/// speed: a render that stopped making progress fails here instead of hanging the suite.
+fn settle_window(h: &mut Harness<'static, ViewerApp>, what: &str) {
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while !h.state().is_finished() {
+        assert!(Instant::now() < deadline, "{what}");
+        h.step();
+        std::thread::sleep(Duration::from_millis(2));
+    }
+}
+
 /// A window of no area, or of one pixel, and shrinking to nothing mid-render: frames still run,
 /// the render still finishes, and growing the window back shows it.
 #[test]
@@ -186,15 +198,7 @@ fn zero_and_tiny_windows_survive() {
         for _ in 0..5 {
             h.step();
         }
-        let deadline = Instant::now() + Duration::from_secs(60);
-        while !h.state().is_finished() {
-            assert!(
-                Instant::now() < deadline,
-                "no progress in a {size:?} window"
-            );
-            h.step();
-            std::thread::sleep(Duration::from_millis(2));
-        }
+        settle_window(&mut h, &format!("no progress in a {size:?} window"));
     }
     let mut h = harness(small("quiz", 40, 30, 2), egui::vec2(800.0, 500.0));
     h.step();
@@ -224,12 +228,7 @@ fn slider_bursts_through_the_window() {
         "{edits} slider edits through the window in {:.2} s",
         start.elapsed().as_secs_f64()
     );
-    let deadline = Instant::now() + Duration::from_secs(60);
-    while !h.state().is_finished() {
-        assert!(Instant::now() < deadline, "the render did not finish");
-        h.step();
-        std::thread::sleep(Duration::from_millis(2));
-    }
+    settle_window(&mut h, "the render did not finish");
     assert_eq!(h.state().scene().render.max_depth, (edits - 1) % 9);
     assert_converged(h.state());
 }
