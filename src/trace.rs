@@ -26,7 +26,7 @@ use crate::scene::{MaterialId, ObjectId, Scene};
 use crate::shade::{LightTerms, ambient_term, light_terms, reflect, refract};
 
 /// Rays (shadow rays included) one sample may trace; past it, branches end as
-/// [`EndReason::Cutoff`]. Natural scenes use a few dozen; the budget bounds the work of
+/// [`EndReason::Budget`]. Natural scenes use a few dozen; the budget bounds the work of
 /// pathological ones (a glass ball in a box of mirrors at depth 64 would otherwise trace
 /// millions of rays for one pixel) while the tree and the image still agree exactly.
 pub const MAX_RAYS_PER_SAMPLE: u32 = 1 << 16;
@@ -53,10 +53,16 @@ pub enum EndReason {
     MaxDepth,
     /// The ray's weight fell below the cutoff (adaptive depth): background, without being traced.
     Cutoff,
+    /// The sample had traced [`MAX_RAYS_PER_SAMPLE`] rays already: background, without being
+    /// traced.
+    Budget,
 }
 
-/// Rays traced, by kind. Children past `max_depth` or below the cutoff are not traced and not
-/// counted.
+// `SampleInfo::ends` holds one bit per reason.
+const _: () = assert!((EndReason::Budget as u32) < u8::BITS);
+
+/// Rays traced, by kind. Children past `max_depth`, below the cutoff or past the ray budget are
+/// not traced and not counted.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct RayCounts {
     pub primary: u64,
@@ -231,7 +237,7 @@ impl Tracer {
         &self.settings.methods
     }
 
-    /// Closest object or visible light along the ray, strictly after `t_min`.
+    /// Closest object or visible light along the ray, strictly after its origin (`t > 0`).
     fn intersect(&self, ray: &Ray) -> Found {
         let mut found = Found::Nothing;
         let mut t_max = f32::INFINITY;
@@ -288,11 +294,17 @@ impl Tracer {
             info.ends |= 1 << EndReason::MaxDepth as u8;
             return background;
         }
-        // Adaptive depth: a weight below the cutoff, or a sample that has used its ray budget
-        // (glass between mirrors doubles its rays every few levels), ends the branch.
-        if weight.max_element() < self.settings.cutoff || info.rays >= MAX_RAYS_PER_SAMPLE {
+        // Adaptive depth: a weight below the cutoff ends the branch.
+        if weight.max_element() < self.settings.cutoff {
             rec.end(EndReason::Cutoff);
             info.ends |= 1 << EndReason::Cutoff as u8;
+            return background;
+        }
+        // So does a sample that has used its ray budget (glass between mirrors doubles its rays
+        // every few levels).
+        if info.rays >= MAX_RAYS_PER_SAMPLE {
+            rec.end(EndReason::Budget);
+            info.ends |= 1 << EndReason::Budget as u8;
             return background;
         }
         counts.count(kind);

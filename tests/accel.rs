@@ -555,7 +555,7 @@ fn closed_mesh_has_no_leaks_through_any_accelerator() {
     }
 }
 
-/// From `accel::bvh::FAST_BUILD_MIN_PRIMS` (500k) primitives on the BVH is built with obvhs's
+/// From `accel::bvh::build::FAST_BUILD_MIN_PRIMS` (500k) primitives on the BVH is built with obvhs's
 /// faster preset (and PLOC runs in parallel): its hits must still equal the grid's (testing
 /// every primitive is too slow at this size; the grid is itself checked against it above).
 #[test]

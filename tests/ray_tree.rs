@@ -10,7 +10,7 @@ use common::{Build, close, floor, looking, mat, wall_z};
 use glam::Vec3;
 use raytree::ray_tree::{MAX_NODES, Node, RayTree, pixel_tree};
 use raytree::scene::Material;
-use raytree::trace::{EndReason, RayKind};
+use raytree::trace::{EndReason, MAX_RAYS_PER_SAMPLE, RayKind, TraceSettings};
 
 fn glass(name: &str, kr: f32, kt: f32) -> Material {
     Material {
@@ -250,6 +250,75 @@ fn trees_are_capped_but_colours_stay_exact() {
     assert!(t.rays.total() as usize > MAX_NODES);
     let (image, _) = raytree::render::render(&tracer, 1, 1, &|_, _| {}).expect("render");
     assert_eq!(t.color, image.get(2, 2), "the cap never changes the colour");
+}
+
+/// Every `end` of a tree in its JSON form, depth first.
+fn json_ends(node: &serde_json::Value, out: &mut Vec<String>) {
+    if let Some(end) = node["end"].as_str() {
+        out.push(end.to_string());
+    }
+    for child in node["children"].as_array().into_iter().flatten() {
+        json_ends(child, out);
+    }
+}
+
+fn tree_json_ends(t: &RayTree) -> Vec<String> {
+    let json = serde_json::to_value(t).expect("json");
+    let mut ends = Vec::new();
+    json_ends(&json["root"], &mut ends);
+    ends
+}
+
+/// Glass between mirrors at depth 64 (weight cutoff 0): the sample spends its ray budget, and
+/// the branches cut short by it say `budget`, never `cutoff`. With the fixture's one light the
+/// budget runs out far beyond the tree's node cap; 32 lights make every hit cost dozens of
+/// shadow rays, so it runs out within the recorded part of the tree.
+#[test]
+fn a_branch_past_the_ray_budget_ends_as_budget() {
+    let mut scene = raytree::scene::load_scene_file(std::path::Path::new(
+        "tests/fixtures/hostile/glass_between_mirrors.toml",
+    ))
+    .expect("loads");
+    let light = scene.lights[0].clone();
+    scene.lights = (0..32)
+        .map(|i| {
+            let a = i as f32 * std::f32::consts::TAU / 32.0;
+            raytree::scene::Light {
+                name: format!("light {i}"),
+                position: Vec3::new(1.5 * a.cos(), 1.5, 1.5 * a.sin()),
+                ..light.clone()
+            }
+        })
+        .collect();
+    let lights = scene.lights.len() as u64;
+    let tracer = raytree::trace::Tracer::new(std::sync::Arc::new(scene), Default::default());
+    let t = pixel_tree(&tracer, 16, 12).expect("centre pixel");
+    // The budget stops new rays; the shadow rays of the last hit are still traced.
+    let budget = u64::from(MAX_RAYS_PER_SAMPLE);
+    assert!(
+        (budget..=budget + lights).contains(&t.rays.total()),
+        "{:?}",
+        t.rays
+    );
+    let ends = tree_json_ends(&t);
+    assert!(t.nodes < MAX_NODES, "{} nodes", t.nodes);
+    assert!(ends.iter().any(|e| e == "budget"), "{ends:?}");
+    assert!(!ends.iter().any(|e| e == "cutoff"), "{ends:?}");
+}
+
+/// A weight below the cutoff still ends as `cutoff`: mirrors of reflectivity 0.5 with a cutoff
+/// of 0.2 trace depths 0 to 2 (weights 1, 0.5, 0.25) and end the depth-3 ray (0.125).
+#[test]
+fn a_branch_below_the_weight_cutoff_ends_as_cutoff() {
+    let b = mirrors(10);
+    let settings = TraceSettings {
+        cutoff: 0.2,
+        ..TraceSettings::default()
+    };
+    let tracer = raytree::trace::Tracer::new(std::sync::Arc::new(b.0.clone()), settings);
+    let t = pixel_tree(&tracer, 2, 2).expect("pixel");
+    assert_eq!(tree_json_ends(&t), ["cutoff"]);
+    assert_eq!(t.rays.primary + t.rays.reflected, 3);
 }
 
 /// Rounds every float of a JSON value, so the snapshot does not hang on the last ulp.

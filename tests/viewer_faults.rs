@@ -37,7 +37,8 @@ fn batch(scene: &Scene, trace: TraceSettings) -> Image {
         .0
 }
 
-/// Polls until the current generation finishes; a deadlock fails here instead of hanging.
+/// Polls until the current generation finishes. The deadline is a hang guard, not a measure of
+/// speed: a deadlock fails here instead of hanging the suite.
 fn settle(app: &mut ViewerApp) {
     let deadline = Instant::now() + Duration::from_secs(120);
     while !app.is_finished() {
@@ -60,15 +61,16 @@ fn assert_converged(app: &ViewerApp) {
     );
 }
 
-/// Hundreds of edits a second, of every kind that restarts the render: camera, depth, light
+/// Edits as fast as they come, of every kind that restarts the render: camera, depth, light
 /// colour, material, image size (so stale tiles of another size are in flight), accelerator
-/// rebuilds. Then the film converges to the final scene exactly.
+/// rebuilds. No edit waits for a render, and then the film converges to the final scene exactly.
 #[test]
 fn bursts_of_edits_never_deadlock_or_leave_stale_tiles() {
     let mut app = ViewerApp::headless(small("default", 48, 36, 4), "burst".into())
         .expect("the viewer starts");
     let start = Instant::now();
     let edits = 400;
+    let mut finished_at_once = 0u32;
     for i in 0..edits {
         let e = &mut app.edit;
         e.camera.position.x += 0.002;
@@ -88,10 +90,16 @@ fn bursts_of_edits_never_deadlock_or_leave_stale_tiles() {
         });
         app.apply();
         app.poll_session();
+        finished_at_once += u32::from(app.is_finished());
     }
     let per_second = edits as f64 / start.elapsed().as_secs_f64();
     eprintln!("{edits} edits at {per_second:.0} a second");
-    assert!(per_second > 100.0, "only {per_second:.0} edits a second");
+    // An edit returns while its render runs on the workers. Were the render done on the UI
+    // thread, every edit would find its render finished.
+    assert!(
+        finished_at_once < edits / 2,
+        "{finished_at_once} of {edits} edits waited for their render"
+    );
     settle(&mut app);
     assert_eq!(app.scene().render.width, 40 + (edits - 1) % 17);
     assert_converged(&app);
@@ -166,6 +174,17 @@ fn harness(scene: Scene, size: egui::Vec2) -> Harness<'static, ViewerApp> {
         .build_eframe(|cc| ViewerApp::new(cc, scene, "faults".into()).expect("the viewer starts"))
 }
 
+/// Steps the window until its render finishes. The deadline is a hang guard, not a measure of
+/// speed: a render that stopped making progress fails here instead of hanging the suite.
+fn settle_window(h: &mut Harness<'static, ViewerApp>, what: &str) {
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while !h.state().is_finished() {
+        assert!(Instant::now() < deadline, "{what}");
+        h.step();
+        std::thread::sleep(Duration::from_millis(2));
+    }
+}
+
 /// A window of no area, or of one pixel, and shrinking to nothing mid-render: frames still run,
 /// the render still finishes, and growing the window back shows it.
 #[test]
@@ -179,15 +198,7 @@ fn zero_and_tiny_windows_survive() {
         for _ in 0..5 {
             h.step();
         }
-        let deadline = Instant::now() + Duration::from_secs(60);
-        while !h.state().is_finished() {
-            assert!(
-                Instant::now() < deadline,
-                "no progress in a {size:?} window"
-            );
-            h.step();
-            std::thread::sleep(Duration::from_millis(2));
-        }
+        settle_window(&mut h, &format!("no progress in a {size:?} window"));
     }
     let mut h = harness(small("quiz", 40, 30, 2), egui::vec2(800.0, 500.0));
     h.step();
@@ -217,12 +228,7 @@ fn slider_bursts_through_the_window() {
         "{edits} slider edits through the window in {:.2} s",
         start.elapsed().as_secs_f64()
     );
-    let deadline = Instant::now() + Duration::from_secs(60);
-    while !h.state().is_finished() {
-        assert!(Instant::now() < deadline, "the render did not finish");
-        h.step();
-        std::thread::sleep(Duration::from_millis(2));
-    }
+    settle_window(&mut h, "the render did not finish");
     assert_eq!(h.state().scene().render.max_depth, (edits - 1) % 9);
     assert_converged(h.state());
 }
@@ -255,11 +261,14 @@ fn a_scene_wider_than_the_largest_texture_is_refused() {
 }
 
 /// Edits are held to the loader's ±1e15 bound (a BVH build over a primitive near f32::MAX
-/// panics in obvhs): the far spheres are refused and the scene stays.
+/// panics in obvhs): the far spheres are refused with a message, the edit is undone, and the
+/// scene stays and renders.
 #[test]
-fn an_edit_far_beyond_the_scene_size_limit_does_not_panic() {
+fn an_edit_far_beyond_the_scene_size_limit_is_refused() {
     let mut app =
         ViewerApp::headless(small("default", 32, 24, 1), "far".into()).expect("the viewer starts");
+    let spheres = app.scene().spheres.clone();
+    let messages = app.messages.len();
     let mut far = app.edit.spheres[0];
     far.center = Vec3::new(3e38, 0.0, 0.0);
     for _ in 0..8 {
@@ -267,5 +276,11 @@ fn an_edit_far_beyond_the_scene_size_limit_does_not_panic() {
     }
     app.command(Command::Rebuild);
     app.apply();
+    assert_eq!(app.messages.len(), messages + 1, "{:?}", app.messages);
+    let (error, message) = app.messages.last().cloned().expect("a message");
+    assert!(error, "{message}");
+    assert_eq!(app.scene().spheres, spheres, "the scene stays");
+    assert_eq!(app.edit.spheres, spheres, "the edit is undone");
     settle(&mut app);
+    assert_converged(&app);
 }

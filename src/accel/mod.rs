@@ -477,8 +477,8 @@ fn safe_inv(d: Vec3) -> Vec3 {
     Vec3::new(f(d.x), f(d.y), f(d.z))
 }
 
-/// Relative widening of a slab test's far `t` (pbrt-v4: `tFar *= 1 + 2γ(3)`), covering the
-/// rounding of `(plane − o)·(1/d)`.
+/// Relative widening of both ends of a slab test's `t` interval (pbrt-v4 widens the far end:
+/// `tFar *= 1 + 2γ(3)`), covering the rounding of `(plane − o)·(1/d)`.
 #[inline]
 fn box_t_slack() -> f32 {
     2.0 * crate::geometry::gamma(3)

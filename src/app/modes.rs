@@ -70,7 +70,8 @@ fn ramp(t: f32) -> Vec3 {
 }
 
 /// The legend of the termination mode: the most telling reason wins.
-pub const TERMINATION_LEGEND: [(&str, (u8, u8, u8)); 5] = [
+pub const TERMINATION_LEGEND: [(&str, (u8, u8, u8)); 6] = [
+    ("ray budget used up", (157, 78, 221)),
     ("max depth reached", (230, 57, 70)),
     ("weight cutoff", (244, 162, 97)),
     ("hit a light", (255, 221, 87)),
@@ -88,16 +89,18 @@ pub fn mode_color(mode: ImageMode, aux: &SampleInfo, max_depth: u32) -> Vec3 {
         ImageMode::Render => Vec3::ZERO,
         ImageMode::Depth => ramp(aux.depth_reached as f32 / max_depth.max(1) as f32),
         ImageMode::Termination => {
-            let pick = if has(aux.ends, EndReason::MaxDepth) {
+            let pick = if has(aux.ends, EndReason::Budget) {
                 0
-            } else if has(aux.ends, EndReason::Cutoff) {
+            } else if has(aux.ends, EndReason::MaxDepth) {
                 1
-            } else if has(aux.ends, EndReason::HitLight) {
+            } else if has(aux.ends, EndReason::Cutoff) {
                 2
-            } else if has(aux.ends, EndReason::NoHit) && aux.normal != Vec3::ZERO {
+            } else if has(aux.ends, EndReason::HitLight) {
                 3
-            } else {
+            } else if has(aux.ends, EndReason::NoHit) && aux.normal != Vec3::ZERO {
                 4
+            } else {
+                5
             };
             let (r, g, b) = TERMINATION_LEGEND[pick].1;
             srgb(r, g, b)
@@ -129,8 +132,38 @@ mod tests {
             normal: Vec3::Y,
             ..SampleInfo::default()
         };
-        let (r, g, b) = TERMINATION_LEGEND[0].1;
+        let (r, g, b) = TERMINATION_LEGEND[1].1;
         assert_eq!(mode_color(ImageMode::Termination, &aux, 5), srgb(r, g, b));
+    }
+
+    /// A sample cut short by its ray budget has its own colour, apart from the weight cutoff's,
+    /// and wins over every other reason.
+    #[test]
+    fn termination_tells_the_budget_from_the_cutoff() {
+        let color = |ends: &[EndReason]| {
+            let aux = PixelAux {
+                ends: ends.iter().fold(0, |bits, &e| bits | 1 << e as u8),
+                normal: Vec3::Y,
+                ..PixelAux::default()
+            };
+            mode_color(ImageMode::Termination, &aux, 5)
+        };
+        let legend = |i: usize| {
+            let (r, g, b) = TERMINATION_LEGEND[i].1;
+            srgb(r, g, b)
+        };
+        assert_eq!(color(&[EndReason::Cutoff]), legend(2));
+        assert_eq!(
+            color(&[EndReason::Budget, EndReason::MaxDepth, EndReason::Cutoff]),
+            legend(0)
+        );
+        let colours: std::collections::HashSet<_> =
+            TERMINATION_LEGEND.iter().map(|(_, c)| *c).collect();
+        assert_eq!(
+            colours.len(),
+            TERMINATION_LEGEND.len(),
+            "two reasons share a colour"
+        );
     }
 
     #[test]

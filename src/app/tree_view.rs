@@ -74,6 +74,7 @@ pub fn end_label(end: EndReason) -> &'static str {
         EndReason::HitLight => "hit light",
         EndReason::MaxDepth => "max depth",
         EndReason::Cutoff => "cutoff",
+        EndReason::Budget => "ray budget",
     }
 }
 
@@ -588,8 +589,9 @@ pub fn overlay_vertices(
                     kind,
                 );
             }
-            // Not traced (past max depth or below the cutoff): a short, faint stub.
-            (None, Some(EndReason::MaxDepth | EndReason::Cutoff)) => {
+            // Not traced (past max depth, below the cutoff or past the ray budget): a short,
+            // faint stub.
+            (None, Some(EndReason::MaxDepth | EndReason::Cutoff | EndReason::Budget)) => {
                 let mut faint = kind;
                 faint[3] = 0.45;
                 segment(

@@ -1,5 +1,5 @@
-//! BVH (the lecture's "Bounding Volume Hierarchy"): a 4-wide BVH with `f32` child boxes over
-//! spheres and triangles in one tree, built from a binary BVH made with `obvhs`.
+//! Construction of the 4-wide [`Bvh`]: a binary BVH from `obvhs`, collapsed to four children
+//! per node, and the build presets.
 //!
 //! Build: `obvhs`' PLOC with the parameters of [`build_params`] (its `medium_build` preset,
 //! `fast_build` from [`FAST_BUILD_MIN_PRIMS`] primitives on), then its
@@ -9,14 +9,6 @@
 //! children of its binary node and keeps opening the largest inner child until it has four
 //! (the way Embree and Wald et al. 2008 collapse). The primitives are then copied in leaf
 //! order, each keeping its original id, so a leaf reads a contiguous run.
-//!
-//! Why not `obvhs`' compressed wide BVH (CWBVH, Ylitie et al. 2017), which this module used
-//! first: its child boxes are quantised to 8 bits, so every node visit decodes 48 bytes to
-//! floats before the slab test (a third of the render's instructions went there), its stock
-//! traversal has the pitfalls listed below, and its build converts with an `O(n·k²)` cost
-//! table. Four `f32` boxes are one SSE slab test of six loads, six subtractions and six
-//! multiplications; the node is 128 bytes (two cache lines) against CWBVH's 80, for
-//! about a third as many nodes as leaves.
 //!
 //! Pathological input (STABILITY B2). PLOC pairs neighbours whose union is cheapest and breaks
 //! equal costs one way, so regular input (many identical boxes, boxes in a row, nested boxes
@@ -28,24 +20,6 @@
 //!   [`MAX_STACKED`] primitives share one box centre, or when PLOC's tree is deeper than
 //!   [`MAX_BVH2_DEPTH`], or when its wide tree could need more than [`STACK_SIZE`] traversal
 //!   stack entries.
-//!
-//! Traversal, and what it must guarantee (the accelerators agree bit for bit with brute
-//! force): child boxes are padded by a few ulp of their magnitude in every axis
-//! ([`NODE_PAD_REL`]), slab `t` values use `1/d` clamped to `±2⁶⁰` (no NaN), both ends of the
-//! interval are widened by `2γ(3)` of their magnitude (pbrt-v4 widens the far end; the near
-//! end too so that a primitive whose computed `t` is an ulp before its box's computed entry
-//! is not culled), and the interval is clipped to the caller's `(t_min, best t]`, inclusive so
-//! an equal `t` with a lower id is still found. Closest-hit queries visit the hit children
-//! nearest first and keep each pushed child's entry `t`, so a child is skipped when it is
-//! popped behind the best hit found since; occlusion queries push in any order and stop at
-//! the first hit. The stack is a plain array that the build guarantees is deep enough.
-//!
-//! Pitfalls of `obvhs`' stock traversals that this avoids (found while this module used them):
-//! `CwBvhNode::intersect_ray` clamps every box's entry `t` to an absolute `1e-4` and ignores
-//! `ray.tmin` (misses at scene scales of `1e-3` and below); `Ray::new` replaces small direction
-//! components by `±1/EPSILON` (not conservative); `ray_traverse` accepts only `t < tmax` (no
-//! tie-break by id); `ray_traverse_anyhit` never stops early; the fixed traversal stack
-//! (`StackStack<_, 32>`) silently overwrites its top entry when full.
 use glam::{Vec3, Vec3A, Vec4};
 use obvhs::{
     BvhBuildParams,
@@ -55,13 +29,9 @@ use obvhs::{
 };
 use rayon::prelude::*;
 
-use super::{Prim, Shape, Visitor, box_t_slack};
-use crate::geometry::{Ray, Triangles4};
-
-/// Padding of child boxes in every axis, relative to the largest coordinate magnitude of the
-/// box: a primitive's computed hit point is off by a few ulp of its largest coordinate in
-/// *every* axis, even along an axis where the box is flat (a plane at z = 0).
-pub const NODE_PAD_REL: f32 = 8.0 * f32::EPSILON;
+use super::{Bvh, LEAF, MAX_LEAF, MAX_PRIMS, NODE_PAD_REL, Node, Packet, SPHERE, STACK_SIZE};
+use crate::accel::{Prim, Shape};
+use crate::geometry::Triangles4;
 
 /// More primitives than this with exactly the same box centre (duplicates, concentric spheres)
 /// make PLOC chain; the median-split builder is used instead.
@@ -70,15 +40,6 @@ pub const MAX_STACKED: usize = 64;
 /// A binary tree deeper than this is replaced by the median-split one. Real scenes stay far
 /// below (PLOC gives about `1.5·log2(N)`: 24 for 1e5 random boxes).
 pub const MAX_BVH2_DEPTH: usize = 96;
-
-/// Traversal stack capacity in entries. The build checks the worst case of the tree (on any
-/// root-to-leaf path, the sum of each node's children but one, plus 3 for the fixed-length
-/// push) against it; the median-split
-/// tree of up to 2²⁸ primitives needs at most 3 per level for about 13 levels.
-pub const STACK_SIZE: usize = 64;
-
-/// Entries of the stack a query starts with; deeper queries continue on a [`STACK_SIZE`] one.
-const SHORT_STACK: usize = 16;
 
 /// From this many primitives on the build uses obvhs's `fast_build` preset instead of
 /// `medium_build`.
@@ -109,55 +70,16 @@ pub fn build_params(prims: usize) -> BvhBuildParams {
     }
 }
 
-/// Most triangles in one leaf: one four-lane test. A leaf holds triangles or one sphere.
-pub const MAX_LEAF: usize = 4;
-
 /// Costs of a visit relative to each other, for the surface-area leaf decision: a node (four
 /// box tests), a leaf of up to four triangles (one four-lane test), a sphere.
 const NODE_COST: f32 = 1.0;
 const PACKET_COST: f32 = 1.5;
 const SPHERE_COST: f32 = 1.0;
 
-/// A child word with this bit is a leaf, otherwise a node index. A triangle leaf is
-/// `LEAF | packet << 2 | (count − 1)`, a sphere leaf `LEAF | SPHERE | index`.
-const LEAF: u32 = 0x8000_0000;
-const SPHERE: u32 = 0x4000_0000;
-
-/// Most primitives the leaf words can address (2²⁸ packets of up to four triangles).
-pub const MAX_PRIMS: usize = 1 << 28;
-
-/// Up to four triangles of a leaf, one per lane, and their primitive ids.
-#[derive(Clone, Copy, Debug)]
-struct Packet {
-    tris: Triangles4,
-    ids: [u32; 4],
-}
-
-/// One node of the 4-wide tree: two cache lines.
-#[derive(Clone, Copy, Debug)]
-#[repr(C, align(64))]
-struct Node {
-    /// Child boxes by plane, one lane per child: min x, max x, min y, max y, min z, max z.
-    /// Padded by [`NODE_PAD_REL`]; empty slots hold zeros and are masked by `valid`.
-    planes: [Vec4; 6],
-    /// Child words (see [`LEAF`]).
-    child: [u32; 4],
-    /// Bit `i` set when slot `i` holds a child.
-    valid: u32,
-}
-
-pub(super) struct Bvh {
-    nodes: Vec<Node>,
-    /// Triangle leaves, in tree order.
-    packets: Vec<Packet>,
-    /// Sphere leaves.
-    spheres: Vec<Prim>,
-    depth: usize,
-}
-
 impl Bvh {
-    pub(super) fn build(prims: Vec<Prim>) -> Bvh {
-        // `Accel` refuses to build this far (see there); ids would not fit a leaf word.
+    pub(in crate::accel) fn build(prims: Vec<Prim>) -> Bvh {
+        // Loaded scenes stay far below (the file-size caps and the memory budget bound them);
+        // beyond this, ids would not fit a leaf word.
         assert!(prims.len() <= MAX_PRIMS, "more than 2^28 primitives");
         let bounds = |prims: &[Prim]| -> Vec<Aabb> {
             prims
@@ -204,178 +126,7 @@ impl Bvh {
             b
         })
     }
-
-    pub(super) fn memory_bytes(&self) -> usize {
-        self.nodes.capacity() * size_of::<Node>()
-            + self.packets.capacity() * size_of::<Packet>()
-            + self.spheres.capacity() * size_of::<Prim>()
-    }
-
-    pub(super) fn depth(&self) -> usize {
-        self.depth
-    }
-
-    /// Visits every primitive whose padded box the ray's `(t_min, v.limit()]` interval meets;
-    /// nearest child first when [`Visitor::ORDERED`].
-    #[inline]
-    pub(super) fn walk<V: Visitor>(&self, ray: &Ray, t_min: f32, v: &mut V) {
-        if self.nodes.is_empty() {
-            return;
-        }
-        let r = TravRay::new(ray, t_min);
-        self.walk_from::<V, SHORT_STACK>(&r, v, &[], 0);
-    }
-
-    /// The traversal loop from child word `word` with `seed` on a stack of `N` entries. A
-    /// query starts on a short stack (clearing it is part of every query's cost) and, in the
-    /// rare case it would overflow, continues on a [`STACK_SIZE`] one.
-    #[inline(always)]
-    fn walk_from<V: Visitor, const N: usize>(
-        &self,
-        r: &TravRay,
-        v: &mut V,
-        seed: &[(u32, f32)],
-        mut word: u32,
-    ) {
-        let mut stack = [(0u32, 0f32); N];
-        // Element by element: these copies are short, and `copy_from_slice` of a variable
-        // length calls `memcpy`.
-        for (to, from) in stack.iter_mut().zip(seed) {
-            *to = *from;
-        }
-        let mut sp = seed.len();
-        let (nx, ny, nz) = (r.near[0], r.near[1], r.near[2]);
-        let (fx, fy, fz) = (nx ^ 1, ny ^ 1, nz ^ 1);
-        loop {
-            if word & LEAF != 0 {
-                let stop = if word & SPHERE != 0 {
-                    v.visit(&self.spheres[(word & !(LEAF | SPHERE)) as usize])
-                } else {
-                    let packet = &self.packets[((word & !LEAF) >> 2) as usize];
-                    v.visit_triangles(&packet.tris, &packet.ids, (word & 3) as usize + 1)
-                };
-                if stop {
-                    return;
-                }
-            } else {
-                let node = &self.nodes[word as usize];
-                let p = &node.planes;
-                let t_near = ((p[nx] - r.ox) * r.ix)
-                    .max((p[ny] - r.oy) * r.iy)
-                    .max((p[nz] - r.oz) * r.iz);
-                let t_far = ((p[fx] - r.ox) * r.ix)
-                    .min((p[fy] - r.oy) * r.iy)
-                    .min((p[fz] - r.oz) * r.iz);
-                // Widen both ends by the rounding of the slab arithmetic *and* of the
-                // primitives' own t: a tie (equal t, lower id) in a flat box must not be
-                // culled by an ulp.
-                let slack = Vec4::splat(box_t_slack());
-                let t_near = (t_near - t_near.abs() * slack).max(r.t_min);
-                let t_far = (t_far + t_far.abs() * slack).min(Vec4::splat(v.limit()));
-                let mut mask = t_near.cmple(t_far).bitmask() & node.valid;
-                if mask != 0 {
-                    if mask & (mask - 1) == 0 {
-                        word = node.child[mask.trailing_zeros() as usize];
-                        continue;
-                    }
-                    let t = t_near.to_array();
-                    // Up to four hits; all but the one taken next are pushed with their
-                    // entry t (sorted farthest first when ordered, so the nearest is next).
-                    let mut hits = [(0u32, 0f32); 4];
-                    let mut k = 0;
-                    while mask != 0 {
-                        let i = mask.trailing_zeros() as usize;
-                        mask &= mask - 1;
-                        let mut j = k;
-                        if V::ORDERED {
-                            while j > 0 && hits[j - 1].1 < t[i] {
-                                hits[j] = hits[j - 1];
-                                j -= 1;
-                            }
-                        }
-                        hits[j] = (node.child[i], t[i]);
-                        k += 1;
-                    }
-                    word = hits[k - 1].0;
-                    // Three entries are always written (only `k − 1` are kept): a fixed-length
-                    // copy, where a loop of 1 to 3 would mispredict.
-                    if N < STACK_SIZE && sp + 3 > N {
-                        let mut deeper = [(0u32, 0f32); STACK_SIZE];
-                        deeper[..sp].copy_from_slice(&stack[..sp]);
-                        deeper[sp..sp + k - 1].copy_from_slice(&hits[..k - 1]);
-                        let seed = &deeper[..sp + k - 1];
-                        return self.walk_from::<V, STACK_SIZE>(r, v, seed, word);
-                    }
-                    stack[sp] = hits[0];
-                    stack[sp + 1] = hits[1];
-                    stack[sp + 2] = hits[2];
-                    sp += k - 1;
-                    continue;
-                }
-            }
-            // Pop the next child whose entry is not behind the best hit found since.
-            loop {
-                if sp == 0 {
-                    return;
-                }
-                sp -= 1;
-                let (w, t) = stack[sp];
-                if t <= v.limit() {
-                    word = w;
-                    break;
-                }
-            }
-        }
-    }
 }
-
-/// A ray prepared for the node test.
-struct TravRay {
-    ox: Vec4,
-    oy: Vec4,
-    oz: Vec4,
-    ix: Vec4,
-    iy: Vec4,
-    iz: Vec4,
-    /// Per axis, the plane index entered first: `2·axis`, `+1` (the max plane) for a
-    /// negative direction.
-    near: [usize; 3],
-    t_min: Vec4,
-}
-
-impl TravRay {
-    #[inline(always)]
-    fn new(ray: &Ray, t_min: f32) -> Self {
-        let inv = trav_inv(ray.dir);
-        let o = ray.origin;
-        let near = |i: f32, axis: usize| 2 * axis + usize::from(i < 0.0);
-        TravRay {
-            ox: Vec4::splat(o.x),
-            oy: Vec4::splat(o.y),
-            oz: Vec4::splat(o.z),
-            ix: Vec4::splat(inv.x),
-            iy: Vec4::splat(inv.y),
-            iz: Vec4::splat(inv.z),
-            near: [near(inv.x, 0), near(inv.y, 1), near(inv.z, 2)],
-            t_min: Vec4::splat(t_min),
-        }
-    }
-}
-
-/// `1/d`, clamped to `±2⁶⁰` (zero components keep their sign): the node test multiplies it by
-/// box offsets, and the clamp keeps those products finite for any scene below about `1e17` in
-/// size, so no `0·∞` NaN can appear. Treating `|d| < 2⁻⁶⁰` as `2⁻⁶⁰` is harmless: child boxes
-/// are padded, so an origin on an unpadded face is strictly inside.
-#[inline(always)]
-fn trav_inv(d: Vec3) -> Vec3A {
-    let d = Vec3A::from(d);
-    let i = Vec3A::ONE / d;
-    let clamp = Vec3A::splat(INV_DIR_CLAMP);
-    Vec3A::select(i.abs().cmplt(clamp), i, clamp.copysign(d))
-}
-
-/// Bound of `|1/d|` in [`trav_inv`].
-const INV_DIR_CLAMP: f32 = (1u64 << 60) as f32;
 
 /// The box of a binary node, padded by [`NODE_PAD_REL`] of its largest magnitude.
 fn padded(b: &Aabb) -> (Vec3A, Vec3A) {
@@ -622,7 +373,7 @@ fn empty_node() -> Node {
 
 /// The most stack entries a traversal of `nodes` can need: on the worst root-to-leaf path,
 /// each node pushes all its children but one.
-fn stack_need(nodes: &[Node]) -> usize {
+pub(super) fn stack_need(nodes: &[Node]) -> usize {
     if nodes.is_empty() {
         return 0;
     }
@@ -745,8 +496,6 @@ fn median_bvh2(boxes: &[Aabb]) -> Bvh2 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accel::Closest;
-    use crate::geometry::Methods;
 
     #[test]
     fn the_preset_follows_the_scene_size() {
@@ -760,47 +509,5 @@ mod tests {
         assert_eq!(ratio(FAST_BUILD_MIN_PRIMS - 1), medium);
         assert_eq!(ratio(FAST_BUILD_MIN_PRIMS), fast);
         assert_eq!(ratio(MAX_PRIMS), fast);
-    }
-
-    /// A query that overflows the short stack continues on the long one and finds what brute
-    /// force finds: a one-entry short stack overflows on nearly every query.
-    #[test]
-    fn overflow_to_the_long_stack_finds_the_same_hits() {
-        let mut seed = 7u32;
-        let mut rnd = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 17;
-            seed ^= seed << 5;
-            seed as f32 / u32::MAX as f32 * 2.0 - 1.0
-        };
-        let mut prims = Vec::new();
-        for id in 0..3000u32 {
-            let c = Vec3::new(rnd(), rnd(), rnd()) * 2.0;
-            let v = [0, 1, 2].map(|_| c + Vec3::new(rnd(), rnd(), rnd()) * 0.3);
-            prims.push(Prim {
-                shape: Shape::Triangle(v),
-                id,
-            });
-        }
-        let bvh = Bvh::build(prims.clone());
-        assert!(stack_need(&bvh.nodes) > 1);
-        let m = Methods::default();
-        let mut hits = 0;
-        for _ in 0..2000 {
-            let o = Vec3::new(rnd(), rnd(), rnd()) * 4.0;
-            let ray = Ray::new(o, (Vec3::new(rnd(), rnd(), rnd()) - o).normalize());
-            let mut brute = Closest::new(&m, &ray, 0.0, f32::INFINITY);
-            for p in &prims {
-                brute.visit(p);
-            }
-            let mut tiny = Closest::new(&m, &ray, 0.0, f32::INFINITY);
-            bvh.walk_from::<_, 1>(&TravRay::new(&ray, 0.0), &mut tiny, &[], 0);
-            let mut short = Closest::new(&m, &ray, 0.0, f32::INFINITY);
-            bvh.walk(&ray, 0.0, &mut short);
-            assert_eq!(tiny.hit(), brute.hit());
-            assert_eq!(short.hit(), brute.hit());
-            hits += usize::from(brute.hit().is_some());
-        }
-        assert!(hits > 1000, "{hits}");
     }
 }

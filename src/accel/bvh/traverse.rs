@@ -1,0 +1,241 @@
+//! Traversal of the 4-wide [`Bvh`]: the closest-hit and any-hit walks over one stack and the
+//! SIMD test of a node's four child boxes.
+//!
+//! Traversal, and what it must guarantee (the accelerators agree bit for bit with brute force):
+//! child boxes are padded by a few ulp of their magnitude in every axis
+//! ([`NODE_PAD_REL`](super::NODE_PAD_REL)), slab `t` values use `1/d` clamped to `±2⁶⁰` (no NaN),
+//! both ends of the interval are widened by `2γ(3)` of their magnitude (pbrt-v4 widens the far end;
+//! the near end too so that a primitive whose computed `t` is an ulp before its box's computed
+//! entry is not culled), and the interval is clipped to the caller's `(t_min, best t]`, inclusive
+//! so an equal `t` with a lower id is still found. Closest-hit queries visit the hit children
+//! nearest first and keep each pushed child's entry `t`, so a child is skipped when it is popped
+//! behind the best hit found since; occlusion queries push in any order and stop at the first hit.
+//! The stack is a plain array that the build guarantees is deep enough.
+//!
+//! Pitfalls of `obvhs`' stock traversals that this avoids (found while this module used them):
+//! `CwBvhNode::intersect_ray` clamps every box's entry `t` to an absolute `1e-4` and ignores
+//! `ray.tmin` (misses at scene scales of `1e-3` and below); `Ray::new` replaces small direction
+//! components by `±1/EPSILON` (not conservative); `ray_traverse` accepts only `t < tmax` (no
+//! tie-break by id); `ray_traverse_anyhit` never stops early; the fixed traversal stack
+//! (`StackStack<_, 32>`) silently overwrites its top entry when full.
+use glam::{Vec3, Vec3A, Vec4};
+
+use super::{Bvh, LEAF, SPHERE, STACK_SIZE};
+use crate::accel::{Visitor, box_t_slack};
+use crate::geometry::Ray;
+
+/// Entries of the stack a query starts with; deeper queries continue on a [`STACK_SIZE`] one.
+const SHORT_STACK: usize = 16;
+
+impl Bvh {
+    /// Visits every primitive whose padded box the ray's `(t_min, v.limit()]` interval meets;
+    /// nearest child first when [`Visitor::ORDERED`].
+    #[inline]
+    pub(in crate::accel) fn walk<V: Visitor>(&self, ray: &Ray, t_min: f32, v: &mut V) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let r = TravRay::new(ray, t_min);
+        self.walk_from::<V, SHORT_STACK>(&r, v, &[], 0);
+    }
+
+    /// The traversal loop from child word `word` with `seed` on a stack of `N` entries. A
+    /// query starts on a short stack (clearing it is part of every query's cost) and, in the
+    /// rare case it would overflow, continues on a [`STACK_SIZE`] one.
+    #[inline(always)]
+    fn walk_from<V: Visitor, const N: usize>(
+        &self,
+        r: &TravRay,
+        v: &mut V,
+        seed: &[(u32, f32)],
+        mut word: u32,
+    ) {
+        let mut stack = [(0u32, 0f32); N];
+        // Element by element: these copies are short, and `copy_from_slice` of a variable
+        // length calls `memcpy`.
+        for (to, from) in stack.iter_mut().zip(seed) {
+            *to = *from;
+        }
+        let mut sp = seed.len();
+        let (nx, ny, nz) = (r.near[0], r.near[1], r.near[2]);
+        let (fx, fy, fz) = (nx ^ 1, ny ^ 1, nz ^ 1);
+        loop {
+            if word & LEAF != 0 {
+                let stop = if word & SPHERE != 0 {
+                    v.visit(&self.spheres[(word & !(LEAF | SPHERE)) as usize])
+                } else {
+                    let packet = &self.packets[((word & !LEAF) >> 2) as usize];
+                    v.visit_triangles(&packet.tris, &packet.ids, (word & 3) as usize + 1)
+                };
+                if stop {
+                    return;
+                }
+            } else {
+                let node = &self.nodes[word as usize];
+                let p = &node.planes;
+                let t_near = ((p[nx] - r.ox) * r.ix)
+                    .max((p[ny] - r.oy) * r.iy)
+                    .max((p[nz] - r.oz) * r.iz);
+                let t_far = ((p[fx] - r.ox) * r.ix)
+                    .min((p[fy] - r.oy) * r.iy)
+                    .min((p[fz] - r.oz) * r.iz);
+                // Widen both ends by the rounding of the slab arithmetic *and* of the
+                // primitives' own t: a tie (equal t, lower id) in a flat box must not be
+                // culled by an ulp.
+                let slack = Vec4::splat(box_t_slack());
+                let t_near = (t_near - t_near.abs() * slack).max(r.t_min);
+                let t_far = (t_far + t_far.abs() * slack).min(Vec4::splat(v.limit()));
+                let mut mask = t_near.cmple(t_far).bitmask() & node.valid;
+                if mask != 0 {
+                    if mask & (mask - 1) == 0 {
+                        word = node.child[mask.trailing_zeros() as usize];
+                        continue;
+                    }
+                    let t = t_near.to_array();
+                    // Up to four hits; all but the one taken next are pushed with their
+                    // entry t (sorted farthest first when ordered, so the nearest is next).
+                    let mut hits = [(0u32, 0f32); 4];
+                    let mut k = 0;
+                    while mask != 0 {
+                        let i = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        let mut j = k;
+                        if V::ORDERED {
+                            while j > 0 && hits[j - 1].1 < t[i] {
+                                hits[j] = hits[j - 1];
+                                j -= 1;
+                            }
+                        }
+                        hits[j] = (node.child[i], t[i]);
+                        k += 1;
+                    }
+                    word = hits[k - 1].0;
+                    // Three entries are always written (only `k − 1` are kept): a fixed-length
+                    // copy, where a loop of 1 to 3 would mispredict.
+                    if N < STACK_SIZE && sp + 3 > N {
+                        let mut deeper = [(0u32, 0f32); STACK_SIZE];
+                        deeper[..sp].copy_from_slice(&stack[..sp]);
+                        deeper[sp..sp + k - 1].copy_from_slice(&hits[..k - 1]);
+                        let seed = &deeper[..sp + k - 1];
+                        return self.walk_from::<V, STACK_SIZE>(r, v, seed, word);
+                    }
+                    stack[sp] = hits[0];
+                    stack[sp + 1] = hits[1];
+                    stack[sp + 2] = hits[2];
+                    sp += k - 1;
+                    continue;
+                }
+            }
+            // Pop the next child whose entry is not behind the best hit found since.
+            loop {
+                if sp == 0 {
+                    return;
+                }
+                sp -= 1;
+                let (w, t) = stack[sp];
+                if t <= v.limit() {
+                    word = w;
+                    break;
+                }
+            }
+        }
+    }
+}
+
+/// A ray prepared for the node test.
+struct TravRay {
+    ox: Vec4,
+    oy: Vec4,
+    oz: Vec4,
+    ix: Vec4,
+    iy: Vec4,
+    iz: Vec4,
+    /// Per axis, the plane index entered first: `2·axis`, `+1` (the max plane) for a
+    /// negative direction.
+    near: [usize; 3],
+    t_min: Vec4,
+}
+
+impl TravRay {
+    #[inline(always)]
+    fn new(ray: &Ray, t_min: f32) -> Self {
+        let inv = trav_inv(ray.dir);
+        let o = ray.origin;
+        let near = |i: f32, axis: usize| 2 * axis + usize::from(i < 0.0);
+        TravRay {
+            ox: Vec4::splat(o.x),
+            oy: Vec4::splat(o.y),
+            oz: Vec4::splat(o.z),
+            ix: Vec4::splat(inv.x),
+            iy: Vec4::splat(inv.y),
+            iz: Vec4::splat(inv.z),
+            near: [near(inv.x, 0), near(inv.y, 1), near(inv.z, 2)],
+            t_min: Vec4::splat(t_min),
+        }
+    }
+}
+
+/// `1/d`, clamped to `±2⁶⁰` (zero components keep their sign): the node test multiplies it by
+/// box offsets, and the clamp keeps those products finite for any scene below about `1e17` in
+/// size, so no `0·∞` NaN can appear. Treating `|d| < 2⁻⁶⁰` as `2⁻⁶⁰` is harmless: child boxes
+/// are padded, so an origin on an unpadded face is strictly inside.
+#[inline(always)]
+fn trav_inv(d: Vec3) -> Vec3A {
+    let d = Vec3A::from(d);
+    let i = Vec3A::ONE / d;
+    let clamp = Vec3A::splat(INV_DIR_CLAMP);
+    Vec3A::select(i.abs().cmplt(clamp), i, clamp.copysign(d))
+}
+
+/// Bound of `|1/d|` in [`trav_inv`].
+const INV_DIR_CLAMP: f32 = (1u64 << 60) as f32;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::bvh::build::stack_need;
+    use crate::accel::{Closest, Prim, Shape};
+    use crate::geometry::Methods;
+
+    /// A query that overflows the short stack continues on the long one and finds what brute
+    /// force finds: a one-entry short stack overflows on nearly every query.
+    #[test]
+    fn overflow_to_the_long_stack_finds_the_same_hits() {
+        let mut seed = 7u32;
+        let mut rnd = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed as f32 / u32::MAX as f32 * 2.0 - 1.0
+        };
+        let mut prims = Vec::new();
+        for id in 0..3000u32 {
+            let c = Vec3::new(rnd(), rnd(), rnd()) * 2.0;
+            let v = [0, 1, 2].map(|_| c + Vec3::new(rnd(), rnd(), rnd()) * 0.3);
+            prims.push(Prim {
+                shape: Shape::Triangle(v),
+                id,
+            });
+        }
+        let bvh = Bvh::build(prims.clone());
+        assert!(stack_need(&bvh.nodes) > 1);
+        let m = Methods::default();
+        let mut hits = 0;
+        for _ in 0..2000 {
+            let o = Vec3::new(rnd(), rnd(), rnd()) * 4.0;
+            let ray = Ray::new(o, (Vec3::new(rnd(), rnd(), rnd()) - o).normalize());
+            let mut brute = Closest::new(&m, &ray, 0.0, f32::INFINITY);
+            for p in &prims {
+                brute.visit(p);
+            }
+            let mut tiny = Closest::new(&m, &ray, 0.0, f32::INFINITY);
+            bvh.walk_from::<_, 1>(&TravRay::new(&ray, 0.0), &mut tiny, &[], 0);
+            let mut short = Closest::new(&m, &ray, 0.0, f32::INFINITY);
+            bvh.walk(&ray, 0.0, &mut short);
+            assert_eq!(tiny.hit(), brute.hit());
+            assert_eq!(short.hit(), brute.hit());
+            hits += usize::from(brute.hit().is_some());
+        }
+        assert!(hits > 1000, "{hits}");
+    }
+}
