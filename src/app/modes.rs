@@ -141,10 +141,10 @@ mod tests {
     #[test]
     fn termination_tells_the_budget_from_the_cutoff() {
         let color = |ends: &[EndReason]| {
-            let aux = PixelAux {
+            let aux = SampleInfo {
                 ends: ends.iter().fold(0, |bits, &e| bits | 1 << e as u8),
                 normal: Vec3::Y,
-                ..PixelAux::default()
+                ..SampleInfo::default()
             };
             mode_color(ImageMode::Termination, &aux, 5)
         };
