@@ -19,6 +19,9 @@ const LAYERS: &[&[&str]] = &[
     &["shade", "trace", "ray_tree"],
     &["render", "export"],
     &["experiments", "app"],
+    // The `raytree` binary's subcommands (src/main.rs and src/cli/ are the binary crate; they
+    // use the library as `raytree::`).
+    &["cli"],
 ];
 
 fn layer_of(module: &str) -> Option<usize> {
