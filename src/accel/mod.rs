@@ -73,7 +73,7 @@ pub struct PrimHit {
 /// the BVH from here on, at every size.
 ///
 /// Measured with `raytree bench default --no-sweep --out DIR` (the scaling sweep of
-/// `experiments::bench`: a tessellated sphere filling a 640×480 image, one sample, primary and
+/// `experiments::scaling`: a tessellated sphere filling a 640×480 image, one sample, primary and
 /// shadow rays, build + render, median of 3 runs, 2 shared cores): at 1–4 triangles the three
 /// kinds are within noise of each other (15–68 ms), from 8 on the BVH is faster than none
 /// (44–72 ms against 61–93 ms; 84–92 ms against 230–260 ms at 32). Three runs put the
