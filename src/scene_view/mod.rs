@@ -1,0 +1,379 @@
+//! The ray tree in 3D (SPEC §5c), as data every view draws the same way: the tree's rays as
+//! world-space segments with a style (the one palette of ray kinds), the render camera as a
+//! frustum with its image plane and the clicked pixel, the lights as markers, and the filters
+//! (generation, ray kind, end reason) that hide segments. The viewer's render overlay and scene
+//! view and the headless `raytree tree --scene-view` draw these, so their rules cannot drift.
+
+use glam::Vec3;
+
+use crate::ray_tree::{Node, RayTree};
+use crate::scene::{CameraFrame, Scene};
+use crate::trace::{EndReason, RayKind};
+
+/// A node's place in its tree: the child indices from the root.
+pub type NodePath = Vec<usize>;
+
+/// How a segment is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Style {
+    /// A ray of the tree, to its hit, to the light it met, or out of the scene.
+    Ray(RayKind),
+    /// A ray that was not traced (past max depth, below the cutoff, past the ray budget): a
+    /// short stub.
+    NotTraced(RayKind),
+    /// A shadow ray that reached its light.
+    ShadowLit,
+    /// A blocked shadow ray, up to its blocker.
+    ShadowBlocked,
+    /// A blocked shadow ray, past its blocker to the light (faded).
+    ShadowPastBlocker,
+    /// The surface normal at a hit, a short tick.
+    Normal,
+    /// The render camera's frustum edges.
+    Frustum,
+    /// The render camera's image plane outline.
+    ImagePlane,
+    /// The clicked pixel on the image plane.
+    Pixel,
+}
+
+/// sRGB colour and opacity of each style: the one palette of ray kinds, used by the tree's
+/// list and diagram, the overlay, the scene view and the headless scene view.
+pub fn style_rgba(style: Style) -> [u8; 4] {
+    match style {
+        Style::Ray(kind) => {
+            let [r, g, b] = kind_rgb(kind);
+            [r, g, b, 255]
+        }
+        Style::NotTraced(kind) => {
+            let [r, g, b] = kind_rgb(kind);
+            [r, g, b, 115]
+        }
+        Style::ShadowLit => {
+            let [r, g, b] = kind_rgb(RayKind::Shadow);
+            [r, g, b, 230]
+        }
+        Style::ShadowBlocked => [220, 60, 60, 255],
+        Style::ShadowPastBlocker => [90, 30, 30, 204],
+        Style::Normal => [255, 0, 255, 255],
+        Style::Frustum => [150, 150, 150, 200],
+        Style::ImagePlane => [200, 200, 200, 230],
+        Style::Pixel => [255, 255, 255, 255],
+    }
+}
+
+/// The colour of each ray kind (sRGB).
+pub fn kind_rgb(kind: RayKind) -> [u8; 3] {
+    match kind {
+        RayKind::Primary => [235, 235, 235],
+        RayKind::Reflected => [80, 170, 255],
+        RayKind::Refracted => [90, 220, 120],
+        RayKind::Shadow => [255, 200, 60],
+    }
+}
+
+/// The hovered or selected node, drawn over its style.
+pub const HIGHLIGHT_RGB: [u8; 3] = [255, 120, 255];
+
+/// One straight piece to draw, in world space.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Segment {
+    pub a: Vec3,
+    pub b: Vec3,
+    pub style: Style,
+    /// The node it belongs to (empty for camera and light markers).
+    pub path: NodePath,
+    /// The node's depth (0 for the primary ray): the step-through reveals generation by
+    /// generation. Shadow rays and normals belong to their node's generation.
+    pub generation: u32,
+    /// How the node's branch ended, for the end-reason filter.
+    pub end: Option<EndReason>,
+}
+
+/// Which segments to show.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Filter {
+    /// Show generations `0..=max_generation`.
+    pub max_generation: u32,
+    pub primary: bool,
+    pub reflected: bool,
+    pub refracted: bool,
+    pub shadow: bool,
+    pub normals: bool,
+    /// Hide rays whose branch ended this way (`None`: the ray hit a surface).
+    pub hidden_ends: Vec<EndReason>,
+}
+
+impl Default for Filter {
+    fn default() -> Self {
+        Self {
+            max_generation: u32::MAX,
+            primary: true,
+            reflected: true,
+            refracted: true,
+            shadow: true,
+            normals: true,
+            hidden_ends: Vec::new(),
+        }
+    }
+}
+
+impl Filter {
+    /// Whether `s` is shown.
+    pub fn shows(&self, s: &Segment) -> bool {
+        if s.generation > self.max_generation {
+            return false;
+        }
+        if s.end.is_some_and(|e| self.hidden_ends.contains(&e)) {
+            return false;
+        }
+        match s.style {
+            Style::Ray(kind) | Style::NotTraced(kind) => match kind {
+                RayKind::Primary => self.primary,
+                RayKind::Reflected => self.reflected,
+                RayKind::Refracted => self.refracted,
+                RayKind::Shadow => self.shadow,
+            },
+            Style::ShadowLit | Style::ShadowBlocked | Style::ShadowPastBlocker => self.shadow,
+            Style::Normal => self.normals,
+            Style::Frustum | Style::ImagePlane | Style::Pixel => true,
+        }
+    }
+}
+
+/// The node at `path` below `root`.
+pub fn node_at<'a>(root: &'a Node, path: &[usize]) -> Option<&'a Node> {
+    let mut node = root;
+    for &i in path {
+        node = node.children.get(i)?;
+    }
+    Some(node)
+}
+
+/// The scene's size (the diagonal of its bounds, at least 1e-3; 10 for an empty scene): how
+/// long rays that hit nothing, stubs and normal ticks are drawn.
+pub fn extent(scene: &Scene) -> f32 {
+    scene
+        .bounds()
+        .map(|(lo, hi)| (hi - lo).length())
+        .unwrap_or(10.0)
+        .max(1e-3)
+}
+
+/// Every ray of `tree` as segments: each ray to its hit (or out of the scene, or to the light it
+/// met), the normal at each hit as a tick, each shadow ray to its light (split at a blocker),
+/// and untraced rays as stubs. `extent` is the scene's size ([`extent`]).
+pub fn tree_segments(tree: &RayTree, extent: f32) -> Vec<Segment> {
+    let mut out = Vec::new();
+    let mut stack: Vec<(NodePath, &Node)> = vec![(Vec::new(), &tree.root)];
+    while let Some((path, node)) = stack.pop() {
+        let mut push = |a: Vec3, b: Vec3, style: Style| {
+            out.push(Segment {
+                a,
+                b,
+                style,
+                path: path.clone(),
+                generation: node.depth,
+                end: node.end,
+            });
+        };
+        match (&node.hit, node.end) {
+            (Some(hit), _) => {
+                push(node.origin, hit.point, Style::Ray(node.kind));
+                push(
+                    hit.point,
+                    hit.point + hit.normal * extent * 0.04,
+                    Style::Normal,
+                );
+                for s in node.shadow_rays.iter().filter(|s| !s.facing_away) {
+                    let light = hit.point + s.to_light * s.distance;
+                    match s.blocked_at {
+                        Some(d) if s.blocked_by.is_some() => {
+                            let blocker = hit.point + s.to_light * d;
+                            push(hit.point, blocker, Style::ShadowBlocked);
+                            push(blocker, light, Style::ShadowPastBlocker);
+                        }
+                        _ => push(hit.point, light, Style::ShadowLit),
+                    }
+                }
+            }
+            (None, Some(EndReason::NoHit)) => {
+                push(
+                    node.origin,
+                    node.origin + node.direction * extent * 2.0,
+                    Style::Ray(node.kind),
+                );
+            }
+            (None, Some(EndReason::MaxDepth | EndReason::Cutoff | EndReason::Budget)) => {
+                push(
+                    node.origin,
+                    node.origin + node.direction * extent * 0.08,
+                    Style::NotTraced(node.kind),
+                );
+            }
+            // A visible light ends the ray at its surface.
+            (None, _) => {
+                let t = node.light.as_ref().map_or(extent * 0.2, |l| l.t);
+                push(
+                    node.origin,
+                    node.origin + node.direction * t,
+                    Style::Ray(node.kind),
+                );
+            }
+        }
+        for (i, child) in node.children.iter().enumerate().rev() {
+            let mut p = path.clone();
+            p.push(i);
+            stack.push((p, child));
+        }
+    }
+    out
+}
+
+/// The render camera of `scene` as segments: the four edges from the eye to the corners of an
+/// image plane at distance `plane` along the view, the plane's outline, and a cross on the
+/// centre of `pixel` (when given).
+pub fn camera_segments(scene: &Scene, plane: f32, pixel: Option<[u32; 2]>) -> Vec<Segment> {
+    let (w, h) = (scene.render.width, scene.render.height);
+    let frame = CameraFrame::new(&scene.camera, w, h);
+    let eye = scene.camera.position;
+    // A point of the image plane: the ray through image position (x, y) at distance `plane`
+    // along the view direction.
+    let view = (scene.camera.look_at - eye).normalize_or(Vec3::NEG_Z);
+    let at = |x: f32, y: f32| {
+        let d = frame.ray(x, y).dir;
+        eye + d * (plane / d.dot(view).max(1e-6))
+    };
+    let (wf, hf) = (w as f32, h as f32);
+    let corners = [at(0.0, 0.0), at(wf, 0.0), at(wf, hf), at(0.0, hf)];
+    let seg = |a: Vec3, b: Vec3, style: Style| Segment {
+        a,
+        b,
+        style,
+        path: Vec::new(),
+        generation: 0,
+        end: None,
+    };
+    let mut out: Vec<Segment> = corners
+        .iter()
+        .map(|&c| seg(eye, c, Style::Frustum))
+        .collect();
+    for i in 0..4 {
+        out.push(seg(corners[i], corners[(i + 1) % 4], Style::ImagePlane));
+    }
+    if let Some([x, y]) = pixel {
+        let (x, y) = (x as f32, y as f32);
+        // The pixel's square, at least a hundredth of the plane wide so it can be seen.
+        let r = (0.5f32).max(wf.max(hf) * 0.005);
+        let (cx, cy) = (x + 0.5, y + 0.5);
+        out.push(seg(at(cx - r, cy - r), at(cx + r, cy + r), Style::Pixel));
+        out.push(seg(at(cx - r, cy + r), at(cx + r, cy - r), Style::Pixel));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use super::*;
+    use crate::ray_tree::pixel_tree;
+    use crate::scene::builtin::load_builtin;
+    use crate::trace::{TraceSettings, Tracer};
+
+    fn tree(name: &str, x: u32, y: u32) -> (Scene, RayTree) {
+        let scene = load_builtin(name).expect("built-in");
+        let tracer = Tracer::new(Arc::new(scene.clone()), TraceSettings::default());
+        let tree = pixel_tree(&tracer, x, y).expect("inside");
+        (scene, tree)
+    }
+
+    #[test]
+    fn every_node_has_its_ray_and_every_ray_starts_where_its_node_does() {
+        let (scene, tree) = tree("glass", 160, 120);
+        let segments = tree_segments(&tree, extent(&scene));
+        let mut count = 0;
+        let mut stack = vec![(Vec::new(), &tree.root)];
+        while let Some((path, node)) = stack.pop() {
+            count += 1;
+            let ray = segments
+                .iter()
+                .find(|s| s.path == path && matches!(s.style, Style::Ray(_) | Style::NotTraced(_)))
+                .unwrap_or_else(|| panic!("no ray for {path:?}"));
+            assert_eq!(ray.a, node.origin);
+            assert_eq!(ray.generation, node.depth);
+            if let Some(hit) = &node.hit {
+                assert_eq!(ray.b, hit.point);
+            }
+            for (i, c) in node.children.iter().enumerate() {
+                let mut p: NodePath = path.clone();
+                p.push(i);
+                stack.push((p, c));
+            }
+        }
+        assert!(count > 3, "the glass sphere's tree has children: {count}");
+    }
+
+    #[test]
+    fn the_filter_hides_by_generation_kind_and_end() {
+        let (scene, tree) = tree("glass", 160, 120);
+        let segments = tree_segments(&tree, extent(&scene));
+        let shown = |f: &Filter| segments.iter().filter(|s| f.shows(s)).count();
+        let all = shown(&Filter::default());
+        let first = Filter {
+            max_generation: 0,
+            ..Filter::default()
+        };
+        assert!(shown(&first) < all);
+        assert!(
+            segments
+                .iter()
+                .filter(|s| first.shows(s))
+                .all(|s| s.generation == 0)
+        );
+        let no_shadow = Filter {
+            shadow: false,
+            ..Filter::default()
+        };
+        assert!(
+            segments
+                .iter()
+                .filter(|s| no_shadow.shows(s))
+                .all(|s| !matches!(
+                    s.style,
+                    Style::ShadowLit | Style::ShadowBlocked | Style::ShadowPastBlocker
+                ))
+        );
+    }
+
+    #[test]
+    fn the_frustum_reaches_the_image_corners_and_the_pixel_lies_on_its_ray() {
+        let (scene, tree) = tree("default", 100, 80);
+        let segments = camera_segments(&scene, 1.0, Some(tree.pixel));
+        let frame = CameraFrame::new(&scene.camera, scene.render.width, scene.render.height);
+        let frustum: Vec<_> = segments
+            .iter()
+            .filter(|s| s.style == Style::Frustum)
+            .collect();
+        assert_eq!(frustum.len(), 4);
+        let (x, y) = frame.project(frustum[2].b).expect("in front");
+        assert!(
+            (x - scene.render.width as f32).abs() < 1e-2
+                && (y - scene.render.height as f32).abs() < 1e-2,
+            "{x} {y}"
+        );
+        // The pixel's cross is centred on the primary ray of the tree.
+        let cross: Vec<_> = segments
+            .iter()
+            .filter(|s| s.style == Style::Pixel)
+            .collect();
+        let centre = (cross[0].a + cross[0].b) * 0.5;
+        let (x, y) = frame.project(centre).expect("in front");
+        assert!(
+            (x - 100.5).abs() < 1e-2 && (y - 80.5).abs() < 1e-2,
+            "{x} {y}"
+        );
+        let dir = (centre - scene.camera.position).normalize();
+        assert!(dir.abs_diff_eq(tree.root.direction, 1e-4));
+    }
+}
