@@ -14,6 +14,10 @@ echo "== cargo fmt --check"
 cargo fmt --all -- --check
 echo "== cargo clippy"
 cargo clippy --release --all-targets --locked -- -D warnings
+# The headless core: without the `viewer` and `lab` features the library and the CLI must
+# build with no window library, so the compiler keeps egui, eframe and wgpu out of the core.
+echo "== cargo clippy --no-default-features (headless core and CLI)"
+cargo clippy --release --no-default-features --locked -- -D warnings
 echo "== cargo test (release)"
 cargo test --release --locked
 echo "== cargo doc"

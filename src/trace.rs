@@ -208,6 +208,13 @@ enum Found {
     Prim(PrimHit),
 }
 
+/// Records that a branch ended, and why, in the tree and in the pixel's facts.
+#[inline(always)]
+fn ended<R: Recorder>(rec: &mut R, info: &mut SampleInfo, reason: EndReason) {
+    rec.end(reason);
+    info.ends |= 1 << reason as u8;
+}
+
 impl Tracer {
     pub fn new(scene: Arc<Scene>, settings: TraceSettings) -> Self {
         let start = std::time::Instant::now();
@@ -272,57 +279,44 @@ impl Tracer {
         rec: &mut R,
     ) -> Vec3 {
         rec.enter(kind, depth, ray, weight);
-        let color = self.trace_inner(ray, kind, depth, weight, counts, info, rec);
+        let background = self.scene.render.background;
+        let color = if let Some(reason) = self.ends_untraced(depth, weight, info) {
+            ended(rec, info, reason);
+            background
+        } else {
+            counts.count(kind);
+            info.rays += 1;
+            info.depth_reached = info.depth_reached.max(depth);
+            match self.intersect(ray) {
+                Found::Nothing => {
+                    ended(rec, info, EndReason::NoHit);
+                    background
+                }
+                Found::Light(i, t) => {
+                    ended(rec, info, EndReason::HitLight);
+                    rec.light(i, t);
+                    self.scene.lights[i].color
+                }
+                Found::Prim(hit) => self.shade(ray, &hit, depth, weight, counts, info, rec),
+            }
+        };
         rec.leave(color);
         color
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn trace_inner<R: Recorder>(
-        &self,
-        ray: &Ray,
-        kind: RayKind,
-        depth: u32,
-        weight: Vec3,
-        counts: &mut RayCounts,
-        info: &mut SampleInfo,
-        rec: &mut R,
-    ) -> Vec3 {
-        let background = self.scene.render.background;
+    /// Why a ray ends before it is traced, if it does: past the maximum depth; below the weight
+    /// cutoff (adaptive depth); or in a sample that has used its ray budget (glass between
+    /// mirrors doubles its rays every few levels).
+    #[inline(always)]
+    fn ends_untraced(&self, depth: u32, weight: Vec3, info: &SampleInfo) -> Option<EndReason> {
         if depth > self.scene.render.max_depth {
-            rec.end(EndReason::MaxDepth);
-            info.ends |= 1 << EndReason::MaxDepth as u8;
-            return background;
-        }
-        // Adaptive depth: a weight below the cutoff ends the branch.
-        if weight.max_element() < self.settings.cutoff {
-            rec.end(EndReason::Cutoff);
-            info.ends |= 1 << EndReason::Cutoff as u8;
-            return background;
-        }
-        // So does a sample that has used its ray budget (glass between mirrors doubles its rays
-        // every few levels).
-        if info.rays >= MAX_RAYS_PER_SAMPLE {
-            rec.end(EndReason::Budget);
-            info.ends |= 1 << EndReason::Budget as u8;
-            return background;
-        }
-        counts.count(kind);
-        info.rays += 1;
-        info.depth_reached = info.depth_reached.max(depth);
-        match self.intersect(ray) {
-            Found::Nothing => {
-                rec.end(EndReason::NoHit);
-                info.ends |= 1 << EndReason::NoHit as u8;
-                background
-            }
-            Found::Light(i, t) => {
-                rec.end(EndReason::HitLight);
-                rec.light(i, t);
-                info.ends |= 1 << EndReason::HitLight as u8;
-                self.scene.lights[i].color
-            }
-            Found::Prim(hit) => self.shade(ray, &hit, depth, weight, counts, info, rec),
+            Some(EndReason::MaxDepth)
+        } else if weight.max_element() < self.settings.cutoff {
+            Some(EndReason::Cutoff)
+        } else if info.rays >= MAX_RAYS_PER_SAMPLE {
+            Some(EndReason::Budget)
+        } else {
+            None
         }
     }
 

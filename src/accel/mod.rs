@@ -28,8 +28,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::geometry::{
-    Methods, Ray, Shear, TriangleMethod, Triangles4, intersect_sphere, intersect_triangle,
-    intersect_triangles4, next_float_up,
+    Methods, Ray, Shear, TriHits4, TriangleMethod, Triangles4, intersect_sphere,
+    intersect_triangle, intersect_triangles4, next_float_up,
 };
 
 /// Which accelerator to build. `Auto` picks from the scene's size.
@@ -73,7 +73,7 @@ pub struct PrimHit {
 /// the BVH from here on, at every size.
 ///
 /// Measured with `raytree bench default --no-sweep --out DIR` (the scaling sweep of
-/// `experiments::bench`: a tessellated sphere filling a 640×480 image, one sample, primary and
+/// `experiments::scaling`: a tessellated sphere filling a 640×480 image, one sample, primary and
 /// shadow rays, build + render, median of 3 runs, 2 shared cores): at 1–4 triangles the three
 /// kinds are within noise of each other (15–68 ms), from 8 on the BVH is faster than none
 /// (44–72 ms against 61–93 ms; 84–92 ms against 230–260 ms at 32). Three runs put the
@@ -164,12 +164,48 @@ trait Visitor {
     fn visit_triangles(&mut self, tris: &Triangles4, ids: &[u32; 4], count: usize) -> bool;
 }
 
-/// Closest hit with the id tie-break.
-struct Closest<'a> {
+/// What every visitor tests primitives with: the methods, the ray, its shear (for the
+/// watertight test) and the near end of the interval.
+struct Query<'a> {
     m: &'a Methods,
     ray: &'a Ray,
     shear: Option<Shear>,
     t_min: f32,
+}
+
+impl<'a> Query<'a> {
+    fn new(m: &'a Methods, ray: &'a Ray, t_min: f32) -> Self {
+        Self {
+            m,
+            ray,
+            shear: Shear::new(ray.dir),
+            t_min,
+        }
+    }
+
+    #[inline(always)]
+    fn prim(&self, prim: &Prim, t_max: f32) -> Option<(f32, f32, f32)> {
+        prim.intersect(self.m, self.ray, &self.shear, self.t_min, t_max)
+    }
+
+    #[inline(always)]
+    fn triangles4(&self, tris: &Triangles4, count: usize, t_max: f32) -> TriHits4 {
+        let shear = self.shear.as_ref();
+        intersect_triangles4(
+            self.m.triangle,
+            shear,
+            tris,
+            count,
+            self.ray,
+            self.t_min,
+            t_max,
+        )
+    }
+}
+
+/// Closest hit with the id tie-break.
+struct Closest<'a> {
+    q: Query<'a>,
     t: f32,
     prim: u32,
     b1: f32,
@@ -179,10 +215,7 @@ struct Closest<'a> {
 impl<'a> Closest<'a> {
     fn new(m: &'a Methods, ray: &'a Ray, t_min: f32, t_max: f32) -> Self {
         Self {
-            m,
-            ray,
-            shear: Shear::new(ray.dir),
-            t_min,
+            q: Query::new(m, ray, t_min),
             t: t_max,
             prim: u32::MAX,
             b1: 0.0,
@@ -215,7 +248,7 @@ impl Visitor for Closest<'_> {
         } else {
             next_float_up(self.t)
         };
-        if let Some((t, b1, b2)) = prim.intersect(self.m, self.ray, &self.shear, self.t_min, limit)
+        if let Some((t, b1, b2)) = self.q.prim(prim, limit)
             && (t < self.t || (t == self.t && prim.id < self.prim))
         {
             self.t = t;
@@ -238,15 +271,7 @@ impl Visitor for Closest<'_> {
         // Each lane's t does not depend on the limit, and the limit only shrinks from lane to
         // lane, so testing all lanes against the first limit and then re-checking each
         // candidate against the current one in lane order is what `visit` one by one does.
-        let hits = intersect_triangles4(
-            self.m.triangle,
-            self.shear.as_ref(),
-            tris,
-            count,
-            self.ray,
-            self.t_min,
-            limit(self),
-        );
+        let hits = self.q.triangles4(tris, count, limit(self));
         let mut mask = hits.mask;
         while mask != 0 {
             let lane = mask.trailing_zeros() as usize;
@@ -265,10 +290,7 @@ impl Visitor for Closest<'_> {
 
 /// Any hit in `(t_min, t_max)`: stops at the first.
 struct AnyHit<'a> {
-    m: &'a Methods,
-    ray: &'a Ray,
-    shear: Option<Shear>,
-    t_min: f32,
+    q: Query<'a>,
     t_max: f32,
     hit: bool,
 }
@@ -283,24 +305,13 @@ impl Visitor for AnyHit<'_> {
 
     #[inline(always)]
     fn visit(&mut self, prim: &Prim) -> bool {
-        self.hit = prim
-            .intersect(self.m, self.ray, &self.shear, self.t_min, self.t_max)
-            .is_some();
+        self.hit = self.q.prim(prim, self.t_max).is_some();
         self.hit
     }
 
     #[inline(always)]
     fn visit_triangles(&mut self, tris: &Triangles4, _ids: &[u32; 4], count: usize) -> bool {
-        let hits = intersect_triangles4(
-            self.m.triangle,
-            self.shear.as_ref(),
-            tris,
-            count,
-            self.ray,
-            self.t_min,
-            self.t_max,
-        );
-        self.hit = hits.mask != 0;
+        self.hit = self.q.triangles4(tris, count, self.t_max).mask != 0;
         self.hit
     }
 }
@@ -430,10 +441,7 @@ impl Accel {
             return false;
         }
         let mut v = AnyHit {
-            m,
-            ray,
-            shear: Shear::new(ray.dir),
-            t_min,
+            q: Query::new(m, ray, t_min),
             t_max,
             hit: false,
         };

@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 use crate::scene::budget::{MemoryError, batch_memory_estimate, memory_limit};
 use crate::scene::{CameraFrame, primary_ray};
 use crate::trace::{NoRecord, RayCounts, RayKind, SampleInfo, TraceSettings, Tracer};
-pub use stats::{MemoryStats, RenderStats, peak_memory_bytes};
+pub use stats::{MemoryStats, RenderStats, RunReport, peak_memory_bytes};
 
 /// Side of a square tile in pixels.
 pub const TILE_SIZE: u32 = 32;

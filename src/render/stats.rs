@@ -90,6 +90,95 @@ pub fn peak_memory_bytes() -> Option<u64> {
     Some(kb * 1024)
 }
 
+/// What `raytree render` reports of one run: `--stats-json` writes it (fields in alphabetical
+/// order, as earlier versions wrote them), and the summary lines are its [`RunReport::lines`].
+#[derive(Clone, Debug, Serialize)]
+pub struct RunReport {
+    /// Threads of rayon's global pool, which builds the accelerator.
+    pub build_threads: usize,
+    pub load_secs: f64,
+    pub memory: MemoryStats,
+    pub mrays_per_sec: f64,
+    pub spheres: usize,
+    pub stats: RenderStats,
+    pub triangles: usize,
+    /// Primitives the accelerator dropped (non-finite, zero area) and its depth, for the
+    /// memory line.
+    #[serde(skip)]
+    pub skipped: usize,
+    #[serde(skip)]
+    pub bvh_depth: Option<usize>,
+    #[serde(skip)]
+    pub max_depth: u32,
+}
+
+impl RunReport {
+    /// The report of a render by `tracer` that took `load_secs` to load.
+    pub fn new(tracer: &Tracer, stats: RenderStats, load_secs: f64) -> Self {
+        let memory = MemoryStats::of(tracer);
+        Self {
+            build_threads: rayon::current_num_threads(),
+            load_secs,
+            memory,
+            mrays_per_sec: stats.mrays_per_sec(),
+            spheres: memory.spheres,
+            stats,
+            triangles: memory.triangles,
+            skipped: tracer.accel.skipped_prims(),
+            bvh_depth: tracer.accel.bvh_depth(),
+            max_depth: tracer.scene.render.max_depth,
+        }
+    }
+
+    /// The summary printed after a render: size and settings, rays by kind, times, and with
+    /// `memory` the geometry's memory.
+    pub fn lines(&self, output: &str, memory: bool) -> Vec<String> {
+        let (s, r, m) = (&self.stats, &self.stats.rays, &self.memory);
+        let mut lines = vec![
+            format!(
+                "wrote {output} ({}x{}, {} spp, max depth {}, {} threads, accel {:?})",
+                s.width,
+                s.height,
+                s.samples,
+                self.max_depth,
+                s.threads,
+                s.accel.unwrap_or_default(),
+            ),
+            format!(
+                "rays: {} primary, {} reflected, {} refracted, {} shadow, {} in all",
+                r.primary,
+                r.reflected,
+                r.refracted,
+                r.shadow,
+                r.total()
+            ),
+            format!(
+                "time: load {:.3} s, build {:.3} s, render {:.3} s, {:.2} Mrays/s",
+                self.load_secs, s.build_secs, s.render_secs, self.mrays_per_sec
+            ),
+        ];
+        if memory {
+            lines.push(format!(
+                "memory: accelerator {} B + scene records {} B for {} triangles and {} spheres = \
+                 {:.1} B per primitive{} ({} skipped{})",
+                m.accel_bytes,
+                m.scene_geometry_bytes,
+                m.triangles,
+                m.spheres,
+                m.bytes_per_primitive(),
+                m.bytes_per_triangle
+                    .map(|b| format!(", {b:.1} B per triangle"))
+                    .unwrap_or_default(),
+                self.skipped,
+                self.bvh_depth
+                    .map(|d| format!(", BVH depth {d}"))
+                    .unwrap_or_default(),
+            ));
+        }
+        lines
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use std::sync::Arc;

@@ -302,6 +302,18 @@ impl SceneBuilder<'_> {
         ))
     }
 
+    /// Adds the object of a sphere or triangle section and returns the material it names.
+    fn add_object(
+        &mut self,
+        s: &Section,
+        name: String,
+        source: ObjectSource,
+    ) -> Result<MaterialId, SceneError> {
+        let material = self.material(s, "material")?;
+        self.scene.objects.push(Object { name, source });
+        Ok(material)
+    }
+
     fn add_sphere(
         &mut self,
         s: &Section,
@@ -311,11 +323,7 @@ impl SceneBuilder<'_> {
         let center = s.vec3("center", Vec3::ZERO)?;
         let radius = s.f32("radius", 1.0)?;
         rules::check_sphere(center, radius).map_err(|v| s.verdict(&v))?;
-        let material = self.material(s, "material")?;
-        self.scene.objects.push(Object {
-            name,
-            source: ObjectSource::Sphere,
-        });
+        let material = self.add_object(s, name, ObjectSource::Sphere)?;
         self.scene.spheres.push(Sphere {
             center,
             radius,
@@ -347,11 +355,7 @@ impl SceneBuilder<'_> {
             *v = s.vec3_of("vertices", corner)?;
         }
         rules::check_triangle(&vertices).map_err(|v| s.verdict(&v))?;
-        let material = self.material(s, "material")?;
-        self.scene.objects.push(Object {
-            name,
-            source: ObjectSource::Triangle,
-        });
+        let material = self.add_object(s, name, ObjectSource::Triangle)?;
         self.scene.triangles.push(Triangle {
             vertices,
             material,

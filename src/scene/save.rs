@@ -9,17 +9,14 @@ use std::fmt::Write;
 
 use glam::Vec3;
 
-use super::{ObjectSource, Scene, Shading};
+use super::{ObjectSource, Scene};
+use crate::choice::Choice;
 
 /// The scene as TOML. Mesh `file` paths are written as they were loaded (relative to the
 /// original scene file), so save next to it or adjust them.
 pub fn scene_to_toml(scene: &Scene) -> String {
     let mut out = String::from("# raytree scene (SPEC §3)\n\n");
     let r = &scene.render;
-    let shading = match r.shading {
-        Shading::Phong => "phong",
-        Shading::BlinnPhong => "blinn-phong",
-    };
     out += "[render]\n";
     line(&mut out, "width", r.width);
     line(&mut out, "height", r.height);
@@ -27,7 +24,7 @@ pub fn scene_to_toml(scene: &Scene) -> String {
     line(&mut out, "samples", r.samples);
     line(&mut out, "background", color(r.background));
     line(&mut out, "ambient_light", color(r.ambient_light));
-    line(&mut out, "shading", string(shading));
+    line(&mut out, "shading", string(r.shading.name()));
 
     let c = &scene.camera;
     out += "\n[camera]\n";
@@ -124,8 +121,16 @@ fn line(out: &mut String, key: &str, value: impl std::fmt::Display) {
 /// The shortest text that reads back as the same `f32`, always in TOML float syntax.
 fn float(x: f32) -> String {
     // `{:?}` prints `1.0` rather than `1` and uses exponents for very large or small values,
-    // so the text is never mistaken for an (overflowing) TOML integer.
-    format!("{x:?}")
+    // so the text is never mistaken for an (overflowing) TOML integer. TOML spells the
+    // non-finite values its own way; a scene holding one is written as valid TOML, so that the
+    // loader, not the TOML parser, says which field is wrong.
+    if x.is_nan() {
+        "nan".into()
+    } else if x.is_infinite() {
+        (if x > 0.0 { "inf" } else { "-inf" }).into()
+    } else {
+        format!("{x:?}")
+    }
 }
 
 fn vec3(v: Vec3) -> String {
@@ -178,6 +183,10 @@ mod tests {
             let back: f32 = text.parse().expect("a float");
             assert_eq!(back.to_bits(), x.to_bits(), "{text}");
         }
+        assert_eq!(
+            [f32::NAN, f32::INFINITY, f32::NEG_INFINITY].map(float),
+            ["nan", "inf", "-inf"]
+        );
     }
 
     #[test]

@@ -127,8 +127,9 @@ impl<'s, 't, 'i> Section<'s, 't, 'i> {
         )
     }
 
-    /// A finite number (integer or float); `expected` is for type errors. The field's own
-    /// rule is checked on the whole section afterwards ([`Section::verdict`]).
+    /// A number (integer or float), as `f32`; `expected` is for type errors. Whether it may be
+    /// infinite, NaN or anything else is the field's rule, checked with the rest of the section
+    /// afterwards ([`Section::verdict`]), in the same order as for a viewer edit.
     pub(crate) fn number(
         &self,
         key: &str,
@@ -143,21 +144,13 @@ impl<'s, 't, 'i> Section<'s, 't, 'i> {
             DeValue::Float(f) => f.as_str().parse::<f32>().ok(),
             _ => return Err(self.type_error(key, value, expected)),
         };
-        let x = parsed.ok_or_else(|| {
+        parsed.ok_or_else(|| {
             self.error(
                 &span,
                 key,
                 format!("is not a number I can read, got {}", self.src.slice(&span)),
             )
-        })?;
-        match rules::number_phrase(x, rules::ANY) {
-            Some(phrase) => Err(self.error(
-                &span,
-                key,
-                format!("{phrase}, got {}", self.src.slice(&span)),
-            )),
-            None => Ok(x),
-        }
+        })
     }
 
     pub(crate) fn f32(&self, key: &str, default: f32) -> Result<f32, SceneError> {
