@@ -9,7 +9,7 @@ use clap::Args;
 use raytree::experiments::{measure, report, rows, scaling, sweep};
 use raytree::scene::rules;
 
-use super::{count, load_scene, print_warnings, use_threads};
+use super::{count, load_scene, print_warnings, threads, use_threads};
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
@@ -29,7 +29,7 @@ pub struct BenchArgs {
     height: Option<u32>,
     /// Worker threads for the builds and renders; 0 uses every core (at most 1024).
     #[arg(long, default_value_t = 0,
-          value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1024))]
+          value_parser = threads())]
     threads: usize,
     /// Skip the accelerator scaling sweep.
     #[arg(long)]

@@ -53,8 +53,9 @@ pub struct SceneOverrides {
     #[arg(long, value_parser = ChoiceParser::<OffsetMethod>::default(),
           default_value = OffsetMethod::default().name())]
     offset: OffsetMethod,
-    /// Skip rays whose weight (product of kr/kt) is below this (adaptive depth); 0 = off.
-    #[arg(long, default_value_t = 0.0)]
+    /// Skip rays whose weight (product of kr/kt) is below this (adaptive depth); 0 = off,
+    /// below 1.
+    #[arg(long, default_value_t = 0.0, value_parser = cutoff)]
     cutoff: f32,
 }
 
@@ -91,6 +92,23 @@ impl<T: Choice> clap::builder::TypedValueParser for ChoiceParser<T> {
             clap::builder::PossibleValue::new(c.name()).help(c.help())
         })))
     }
+}
+
+/// `--cutoff`, held to [`rules::CUTOFF`].
+fn cutoff(text: &str) -> Result<f32, String> {
+    let x: f32 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number"))?;
+    match rules::number_phrase(x, rules::CUTOFF) {
+        None => Ok(x),
+        Some(phrase) => Err(format!("{phrase}, got {text}")),
+    }
+}
+
+/// `--threads`: 0 (every core) to [`rules::MAX_THREADS`].
+pub fn threads() -> clap::builder::RangedU64ValueParser<usize> {
+    clap::builder::RangedU64ValueParser::<usize>::new().range(0..=rules::MAX_THREADS as u64)
 }
 
 /// A whole-number option held to a scene rule's range.

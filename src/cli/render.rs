@@ -11,7 +11,9 @@ use raytree::render::{RenderSettings, RunReport, render};
 use raytree::scene::rules;
 use raytree::trace::Tracer;
 
-use super::{SceneOverrides, apply_overrides, count, load_scene, print_warnings, use_threads};
+use super::{
+    SceneOverrides, apply_overrides, count, load_scene, print_warnings, threads, use_threads,
+};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -25,7 +27,7 @@ pub struct RenderArgs {
     samples: Option<u32>,
     /// Worker threads for the BVH build and the render; 0 uses every core (at most 1024).
     #[arg(long, default_value_t = 0,
-          value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(0..=1024))]
+          value_parser = threads())]
     threads: usize,
     /// No progress bar.
     #[arg(short, long)]
@@ -48,9 +50,6 @@ pub fn run_render(args: &RenderArgs) -> Result<()> {
     let load_secs = load_start.elapsed().as_secs_f64();
     print_warnings(&scene);
     let trace = apply_overrides(&mut scene, &args.overrides);
-    if !(0.0..1.0).contains(&trace.cutoff) {
-        bail!("--cutoff must be in [0, 1), got {}", trace.cutoff);
-    }
     if let Some(s) = args.samples {
         scene.render.samples = s;
     }

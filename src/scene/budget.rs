@@ -3,7 +3,7 @@
 //! gets a sentence instead of an out-of-memory kill. The loader (meshes), the batch render and
 //! the viewer's buffers all ask this one budget.
 
-/// Peak bytes per pixel of [`render`] and an export: the tile sums of every tile held until the
+/// Peak bytes per pixel of `render::render` and an export: the tile sums of every tile held until the
 /// image is assembled (12), the image (12), and the encoder's copy (3 for PNG, about 12 for EXR
 /// written to memory first), rounded up.
 pub const BATCH_BYTES_PER_PIXEL: u64 = 40;

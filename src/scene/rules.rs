@@ -61,6 +61,13 @@ pub const LIGHT_RADIUS: Rule = |x| match NON_NEGATIVE(x) {
 pub const FOV: Rule =
     |x| (x <= 0.0 || x >= 180.0).then_some("must be between 0 and 180 degrees (both excluded)");
 
+/// Worker threads a render or a sweep may ask for (0: every core).
+pub const MAX_THREADS: usize = 1024;
+
+/// The weight cutoff of adaptive depth (a render setting, not a scene field): a ray whose
+/// weight falls below it is not traced. 1 or more would cut the primary ray itself.
+pub const CUTOFF: Rule = |x| (!(0.0..1.0).contains(&x)).then_some("must be at least 0 and below 1");
+
 /// `rule` on `x`, after `x` is known to be finite.
 pub fn number_phrase(x: f32, rule: Rule) -> Option<&'static str> {
     if x.is_finite() {

@@ -6,7 +6,7 @@
 //! tree knows which section and field each value belongs to, so every error is one sentence
 //! `FILE:LINE:COLUMN: what field `key` ...` (serde's messages do not name the field of a wrong
 //! type, and `deny_unknown_fields` cannot suggest the key that was meant). What each field must
-//! be is not decided here but in [`super::rules`]; [`Section::verdict`] places its verdicts.
+//! be is not decided here but in [`super::rules`]; `Section::verdict` places its verdicts.
 
 use std::ops::{Range, RangeInclusive};
 
