@@ -1,11 +1,16 @@
-//! `raytree tree`: the ray tracing tree of one pixel's centre sample, as text or JSON.
+//! `raytree tree`: the ray tracing tree of one pixel's centre sample, as text or JSON, and
+//! (`--scene-view`) drawn in 3D over the scene seen from another camera, as a PNG.
 
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use raytree::ray_tree;
-use raytree::trace::Tracer;
+use glam::Vec3;
+use raytree::ray_tree::{self, RayTree};
+use raytree::scene::{Camera, rules};
+use raytree::scene_view::{Filter, headless};
+use raytree::{export, trace::Tracer};
 
 use super::{SceneOverrides, apply_overrides, load_scene, parse_pixel, print_warnings};
 
@@ -21,6 +26,8 @@ pub struct TreeArgs {
     json: bool,
     #[command(flatten)]
     overrides: SceneOverrides,
+    #[command(flatten)]
+    view: SceneViewArgs,
 }
 
 pub fn run_tree(args: &TreeArgs) -> Result<()> {
@@ -48,5 +55,93 @@ pub fn run_tree(args: &TreeArgs) -> Result<()> {
             let _ = write!(std::io::stdout(), "{}", ray_tree::tree_text(&tree));
         }
     }
+    if let Some(path) = &args.view.scene_view {
+        write_scene_view(&args.scene, &tracer, &tree, &args.view, path)?;
+    }
+    Ok(())
+}
+
+/// `--scene-view` and its camera. The tree is printed as without it (text, or JSON with
+/// `--json`): the picture is written besides, never instead.
+#[derive(Args, Debug)]
+pub struct SceneViewArgs {
+    /// Also draw the tree in 3D over the scene seen from --eye towards --target, with the
+    /// render camera and the lights, as a PNG of the scene's size (--width, --height).
+    #[arg(long, value_name = "OUT.png", requires_all = ["eye", "target"])]
+    scene_view: Option<PathBuf>,
+    /// The scene view's eye, as X,Y,Z.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true, requires = "scene_view")]
+    eye: Option<Vec3>,
+    /// The point the scene view looks at, as X,Y,Z.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true, requires = "scene_view")]
+    target: Option<Vec3>,
+    /// The scene view's up direction, as X,Y,Z.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,1,0", requires = "scene_view")]
+    up: Vec3,
+    /// The scene view's vertical field of view in degrees [default: the scene camera's].
+    #[arg(
+        long,
+        value_name = "DEG",
+        allow_hyphen_values = true,
+        requires = "scene_view"
+    )]
+    fov: Option<f32>,
+}
+
+/// A point or direction written X,Y,Z.
+pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    let [x, y, z] = parts.as_slice() else {
+        return Err(format!("expected X,Y,Z such as 4,1.5,-2, got `{s}`"));
+    };
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<f32>()
+            .map_err(|_| format!("`{v}` is not a number"))
+    };
+    Ok(Vec3::new(parse(x)?, parse(y)?, parse(z)?))
+}
+
+fn write_scene_view(
+    label: &str,
+    tracer: &Tracer,
+    tree: &RayTree,
+    args: &SceneViewArgs,
+    path: &std::path::Path,
+) -> Result<()> {
+    let scene = &tracer.scene;
+    let view = Camera {
+        position: args.eye.unwrap_or_default(),
+        look_at: args.target.unwrap_or_default(),
+        up: args.up,
+        fov_y_deg: args.fov.unwrap_or(scene.camera.fov_y_deg),
+    };
+    // The scene file's rule, in the words of the flags.
+    if let Err(v) = rules::check_camera(&view) {
+        let flag = match v.field {
+            "position" => "--eye",
+            "look_at" => "--target",
+            "up" => "--up",
+            _ => "--fov",
+        };
+        let phrase = v
+            .phrase
+            .replace("`position`", "--eye")
+            .replace("`look_at`", "--target");
+        let got = v.value.map(|x| format!(", got {x}")).unwrap_or_default();
+        bail!("the scene view's {flag} {phrase}{got}");
+    }
+    let (w, h) = (scene.render.width, scene.render.height);
+    let filter = Filter::default();
+    let canvas = headless::scene_view_image(scene, tracer.settings, tree, &view, w, h, &filter)?;
+    let text = export::stamp(
+        label,
+        1,
+        1,
+        &scene.render,
+        &tracer.settings,
+        tracer.accel.kind(),
+    );
+    export::write_png_rgba8(path, w, h, canvas.rgba(), &text)?;
     Ok(())
 }
