@@ -1,14 +1,14 @@
 //! `raytree tree`: the ray tracing tree of one pixel's centre sample, as text or JSON, and
 //! (`--scene-view`) drawn in 3D over the scene seen from another camera, as a PNG.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use glam::Vec3;
 use raytree::ray_tree::{self, RayTree};
-use raytree::scene::{Camera, rules};
+use raytree::scene::{Camera, Scene, rules};
 use raytree::scene_view::{Filter, headless};
 use raytree::{export, trace::Tracer};
 
@@ -42,6 +42,7 @@ pub fn run_tree(args: &TreeArgs) -> Result<()> {
             args.scene
         );
     }
+    let view = args.view.camera(&scene)?;
     let tracer = Tracer::new(Arc::new(scene), trace);
     let tree = ray_tree::pixel_tree(&tracer, x, y).context("the pixel has no tree")?;
     if args.json {
@@ -55,8 +56,8 @@ pub fn run_tree(args: &TreeArgs) -> Result<()> {
             let _ = write!(std::io::stdout(), "{}", ray_tree::tree_text(&tree));
         }
     }
-    if let Some(path) = &args.view.scene_view {
-        write_scene_view(&args.scene, &tracer, &tree, &args.view, path)?;
+    if let (Some(path), Some(view)) = (&args.view.scene_view, view) {
+        write_scene_view(&args.scene, &tracer, &tree, &view, path)?;
     }
     Ok(())
 }
@@ -102,38 +103,60 @@ pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
     Ok(Vec3::new(parse(x)?, parse(y)?, parse(z)?))
 }
 
+impl SceneViewArgs {
+    /// The view camera of `--scene-view` (`None` without it), held to the scene file's rule
+    /// in the words of the flags; the file name is checked too, all before any work is done.
+    fn camera(&self, scene: &Scene) -> Result<Option<Camera>> {
+        let Some(path) = &self.scene_view else {
+            return Ok(None);
+        };
+        let png = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        if !png {
+            bail!(
+                "cannot write {}: a scene view is a PNG, so the file name must end in .png",
+                path.display()
+            );
+        }
+        let view = Camera {
+            position: self.eye.unwrap_or_default(),
+            look_at: self.target.unwrap_or_default(),
+            up: self.up,
+            fov_y_deg: self.fov.unwrap_or(scene.camera.fov_y_deg),
+        };
+        if let Err(v) = rules::check_camera(&view) {
+            let flag = match v.field {
+                "position" => "--eye",
+                "look_at" => "--target",
+                "up" => "--up",
+                _ => "--fov",
+            };
+            let phrase = v
+                .phrase
+                .replace("`position`", "--eye")
+                .replace("`look_at`", "--target");
+            let got = v.value.map(|x| format!(", got {x}")).unwrap_or_default();
+            bail!("the scene view's {flag} {phrase}{got}");
+        }
+        Ok(Some(view))
+    }
+}
+
+/// Renders the scene view of `tree` from `view` at the scene's size and writes it as a PNG
+/// stamped like a render.
 fn write_scene_view(
     label: &str,
     tracer: &Tracer,
     tree: &RayTree,
-    args: &SceneViewArgs,
-    path: &std::path::Path,
+    view: &Camera,
+    path: &Path,
 ) -> Result<()> {
     let scene = &tracer.scene;
-    let view = Camera {
-        position: args.eye.unwrap_or_default(),
-        look_at: args.target.unwrap_or_default(),
-        up: args.up,
-        fov_y_deg: args.fov.unwrap_or(scene.camera.fov_y_deg),
-    };
-    // The scene file's rule, in the words of the flags.
-    if let Err(v) = rules::check_camera(&view) {
-        let flag = match v.field {
-            "position" => "--eye",
-            "look_at" => "--target",
-            "up" => "--up",
-            _ => "--fov",
-        };
-        let phrase = v
-            .phrase
-            .replace("`position`", "--eye")
-            .replace("`look_at`", "--target");
-        let got = v.value.map(|x| format!(", got {x}")).unwrap_or_default();
-        bail!("the scene view's {flag} {phrase}{got}");
-    }
     let (w, h) = (scene.render.width, scene.render.height);
     let filter = Filter::default();
-    let canvas = headless::scene_view_image(scene, tracer.settings, tree, &view, w, h, &filter)?;
+    let canvas = headless::scene_view_image(scene, tracer.settings, tree, view, w, h, &filter)?;
     let text = export::stamp(
         label,
         1,
