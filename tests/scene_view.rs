@@ -90,6 +90,23 @@ fn a_segment_is_drawn_where_the_view_camera_projects_it() {
 }
 
 #[test]
+fn a_highlighted_node_is_drawn_wider() {
+    let (frame, depth) = view(Scene::default());
+    let line = segment(Vec3::new(-1.5, 1.0, 0.5), Vec3::new(1.0, -0.5, -1.0));
+    let drawn = |highlight: Option<&[usize]>| {
+        let mut canvas = Canvas::from_srgb8(200, 150, &[0; 200 * 150 * 3]).expect("canvas");
+        canvas.draw_segments(&frame, &depth, &[&line], highlight);
+        lit(&canvas, 100).len()
+    };
+    let (plain, wide) = (drawn(None), drawn(Some(&[])));
+    assert!(
+        wide as f32 > 1.8 * plain as f32,
+        "{plain} pixels, {wide} highlighted"
+    );
+    assert_eq!(drawn(Some(&[0])), plain, "another node's highlight");
+}
+
+#[test]
 fn the_part_behind_a_sphere_is_drawn_dimmed_not_left_out() {
     let mut scene = Scene::default();
     let material = scene.default_material();

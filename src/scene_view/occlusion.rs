@@ -277,6 +277,29 @@ mod tests {
     }
 
     #[test]
+    fn a_visible_light_is_a_surface_a_point_light_is_not() {
+        let frame = CameraFrame::new(&Camera::default(), 17, 13);
+        let mut scene = Scene::default();
+        for (radius, x) in [(0.5, 0.0), (0.0, 1.5)] {
+            scene.lights.push(crate::scene::Light {
+                name: format!("light at {x}"),
+                position: Vec3::new(x, 0.0, 0.0),
+                color: Vec3::ONE,
+                radius,
+            });
+        }
+        let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());
+        let depth = DepthImage::of(&tracer, &frame, 17, 13);
+        // The centre pixel looks straight at the ball, 5 − 0.5 away.
+        let centre = depth.t[6 * 17 + 8];
+        assert!((centre - 4.5).abs() < 1e-4, "{centre}");
+        // The point light at x = 1.5 projects to pixel (13, 6): nothing there.
+        let (x, y) = frame.project(Vec3::new(1.5, 0.0, 0.0)).expect("in front");
+        assert_eq!((x as usize, y as usize), (13, 6));
+        assert_eq!(depth.t[6 * 17 + 13], f32::INFINITY);
+    }
+
+    #[test]
     fn in_front_is_visible_behind_is_hidden_on_the_surface_is_visible() {
         let (_, frame, depth) = view();
         // Across the sphere, in front of it.
