@@ -131,9 +131,41 @@ pub fn stamp(
 /// Writes an 8-bit sRGB PNG with `text` as `tEXt` chunks (keyword, value).
 pub fn write_png(path: &Path, image: &Image, text: &[(String, String)]) -> Result<(), ExportError> {
     let bytes = srgb8_bytes(image);
+    encode_png(
+        path,
+        image.width,
+        image.height,
+        png::ColorType::Rgb,
+        &bytes,
+        text,
+    )
+}
+
+/// Writes 8-bit sRGB RGBA pixels (row-major, straight alpha) as a PNG with `text`, like
+/// [`write_png`]: the scene view's pictures, drawn in 8 bits.
+pub fn write_png_rgba8(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgba: &[u8],
+    text: &[(String, String)],
+) -> Result<(), ExportError> {
+    encode_png(path, width, height, png::ColorType::Rgba, rgba, text)
+}
+
+/// The one PNG encoder: 8 bits a channel, marked sRGB, `text` as `tEXt` chunks, written
+/// atomically.
+fn encode_png(
+    path: &Path,
+    width: u32,
+    height: u32,
+    color: png::ColorType,
+    bytes: &[u8],
+    text: &[(String, String)],
+) -> Result<(), ExportError> {
     write_atomically(path, |out| {
-        let mut encoder = png::Encoder::new(out, image.width, image.height);
-        encoder.set_color(png::ColorType::Rgb);
+        let mut encoder = png::Encoder::new(out, width, height);
+        encoder.set_color(color);
         encoder.set_depth(png::BitDepth::Eight);
         encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
         for (key, value) in text {
@@ -142,7 +174,7 @@ pub fn write_png(path: &Path, image: &Image, text: &[(String, String)]) -> Resul
                 .map_err(|e| e.to_string())?;
         }
         let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
-        writer.write_image_data(&bytes).map_err(|e| e.to_string())?;
+        writer.write_image_data(bytes).map_err(|e| e.to_string())?;
         writer.finish().map_err(|e| e.to_string())
     })
 }

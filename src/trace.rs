@@ -244,6 +244,16 @@ impl Tracer {
         &self.settings.methods
     }
 
+    /// The distance along the ray to the closest object or visible light, as a traced ray
+    /// would meet it: the scene view's depth image.
+    pub fn first_hit_t(&self, ray: &Ray) -> Option<f32> {
+        match self.intersect(ray) {
+            Found::Nothing => None,
+            Found::Light(_, t) => Some(t),
+            Found::Prim(hit) => Some(hit.t),
+        }
+    }
+
     /// Closest object or visible light along the ray, strictly after its origin (`t > 0`).
     fn intersect(&self, ray: &Ray) -> Found {
         let mut found = Found::Nothing;

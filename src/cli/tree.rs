@@ -1,11 +1,16 @@
-//! `raytree tree`: the ray tracing tree of one pixel's centre sample, as text or JSON.
+//! `raytree tree`: the ray tracing tree of one pixel's centre sample, as text or JSON, and
+//! (`--scene-view`) drawn in 3D over the scene seen from another camera, as a PNG.
 
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use raytree::ray_tree;
-use raytree::trace::Tracer;
+use glam::Vec3;
+use raytree::ray_tree::{self, RayTree};
+use raytree::scene::{Camera, Scene, rules};
+use raytree::scene_view::{Filter, headless};
+use raytree::{export, trace::Tracer};
 
 use super::{SceneOverrides, apply_overrides, load_scene, parse_pixel, print_warnings};
 
@@ -21,6 +26,8 @@ pub struct TreeArgs {
     json: bool,
     #[command(flatten)]
     overrides: SceneOverrides,
+    #[command(flatten)]
+    view: SceneViewArgs,
 }
 
 pub fn run_tree(args: &TreeArgs) -> Result<()> {
@@ -35,6 +42,7 @@ pub fn run_tree(args: &TreeArgs) -> Result<()> {
             args.scene
         );
     }
+    let view = args.view.camera(&scene)?;
     let tracer = Tracer::new(Arc::new(scene), trace);
     let tree = ray_tree::pixel_tree(&tracer, x, y).context("the pixel has no tree")?;
     if args.json {
@@ -48,5 +56,115 @@ pub fn run_tree(args: &TreeArgs) -> Result<()> {
             let _ = write!(std::io::stdout(), "{}", ray_tree::tree_text(&tree));
         }
     }
+    if let (Some(path), Some(view)) = (&args.view.scene_view, view) {
+        write_scene_view(&args.scene, &tracer, &tree, &view, path)?;
+    }
+    Ok(())
+}
+
+/// `--scene-view` and its camera. The tree is printed as without it (text, or JSON with
+/// `--json`): the picture is written besides, never instead.
+#[derive(Args, Debug)]
+pub struct SceneViewArgs {
+    /// Also draw the tree in 3D over the scene seen from --eye towards --target, with the
+    /// render camera and the lights, as a PNG of the scene's size (--width, --height).
+    #[arg(long, value_name = "OUT.png", requires_all = ["eye", "target"])]
+    scene_view: Option<PathBuf>,
+    /// The scene view's eye, as X,Y,Z.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true, requires = "scene_view")]
+    eye: Option<Vec3>,
+    /// The point the scene view looks at, as X,Y,Z.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true, requires = "scene_view")]
+    target: Option<Vec3>,
+    /// The scene view's up direction, as X,Y,Z.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,1,0", requires = "scene_view")]
+    up: Vec3,
+    /// The scene view's vertical field of view in degrees [default: the scene camera's].
+    #[arg(
+        long,
+        value_name = "DEG",
+        allow_hyphen_values = true,
+        requires = "scene_view"
+    )]
+    fov: Option<f32>,
+}
+
+/// A point or direction written X,Y,Z.
+pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    let [x, y, z] = parts.as_slice() else {
+        return Err(format!("expected X,Y,Z such as 4,1.5,-2, got `{s}`"));
+    };
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<f32>()
+            .map_err(|_| format!("`{v}` is not a number"))
+    };
+    Ok(Vec3::new(parse(x)?, parse(y)?, parse(z)?))
+}
+
+impl SceneViewArgs {
+    /// The view camera of `--scene-view` (`None` without it), held to the scene file's rule
+    /// in the words of the flags; the file name is checked too, all before any work is done.
+    fn camera(&self, scene: &Scene) -> Result<Option<Camera>> {
+        let Some(path) = &self.scene_view else {
+            return Ok(None);
+        };
+        let png = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        if !png {
+            bail!(
+                "cannot write {}: a scene view is a PNG, so the file name must end in .png",
+                path.display()
+            );
+        }
+        let view = Camera {
+            position: self.eye.unwrap_or_default(),
+            look_at: self.target.unwrap_or_default(),
+            up: self.up,
+            fov_y_deg: self.fov.unwrap_or(scene.camera.fov_y_deg),
+        };
+        if let Err(v) = rules::check_camera(&view) {
+            let flag = match v.field {
+                "position" => "--eye",
+                "look_at" => "--target",
+                "up" => "--up",
+                _ => "--fov",
+            };
+            let phrase = v
+                .phrase
+                .replace("`position`", "--eye")
+                .replace("`look_at`", "--target");
+            let got = v.value.map(|x| format!(", got {x}")).unwrap_or_default();
+            bail!("the scene view's {flag} {phrase}{got}");
+        }
+        Ok(Some(view))
+    }
+}
+
+/// Renders the scene view of `tree` from `view` at the scene's size and writes it as a PNG
+/// stamped like a render.
+fn write_scene_view(
+    label: &str,
+    tracer: &Tracer,
+    tree: &RayTree,
+    view: &Camera,
+    path: &Path,
+) -> Result<()> {
+    let scene = &tracer.scene;
+    let (w, h) = (scene.render.width, scene.render.height);
+    let filter = Filter::default();
+    let canvas = headless::scene_view_image(scene, tracer.settings, tree, view, w, h, &filter)?;
+    let text = export::stamp(
+        label,
+        1,
+        1,
+        &scene.render,
+        &tracer.settings,
+        tracer.accel.kind(),
+    );
+    export::write_png_rgba8(path, w, h, canvas.rgba(), &text)?;
     Ok(())
 }

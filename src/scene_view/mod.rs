@@ -4,8 +4,13 @@
 //! (generation, ray kind, end reason) that hide segments. The viewer's render overlay and scene
 //! view and the headless `raytree tree --scene-view` draw these, so their rules cannot drift.
 
+pub mod headless;
+pub mod occlusion;
+pub mod raster;
+
 use glam::Vec3;
 
+use crate::export::to_srgb8;
 use crate::ray_tree::{Node, RayTree};
 use crate::scene::{CameraFrame, Scene};
 use crate::trace::{EndReason, RayKind};
@@ -270,6 +275,39 @@ pub fn camera_segments(scene: &Scene, plane: f32, pixel: Option<[u32; 2]>) -> Ve
         out.push(seg(at(cx - r, cy + r), at(cx + r, cy - r), Style::Pixel));
     }
     out
+}
+
+/// A light as the scene views mark it: a small disc at its position, in its colour.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightMarker {
+    pub position: Vec3,
+    /// The light's hue at full brightness (sRGB): a dim light is as easy to see as a bright one.
+    pub rgb: [u8; 3],
+    /// The radius of its visible ball (0 for a point light): the marker's centre lies behind
+    /// that surface, which must not hide it.
+    pub radius: f32,
+}
+
+/// The scene's lights as markers.
+pub fn light_markers(scene: &Scene) -> Vec<LightMarker> {
+    scene
+        .lights
+        .iter()
+        .map(|l| {
+            let peak = l.color.max_element();
+            let rgb = if peak > 0.0 && peak.is_finite() {
+                to_srgb8(l.color / peak)
+            } else {
+                // A black light still has a place: grey.
+                [128, 128, 128]
+            };
+            LightMarker {
+                position: l.position,
+                rgb,
+                radius: l.radius,
+            }
+        })
+        .collect()
 }
 
 #[cfg(test)]

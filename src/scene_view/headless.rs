@@ -1,0 +1,74 @@
+//! The scene view without a window (`raytree tree --scene-view`): the scene rendered by raytree
+//! itself from a view camera, with the render camera, the lights and a pixel's ray tree drawn
+//! over it by the rules every scene view shares ([`super::occlusion`], [`super::raster`]).
+
+use std::sync::Arc;
+
+use super::occlusion::DepthImage;
+use super::raster::Canvas;
+use super::{Filter, Segment, camera_segments, extent, light_markers, tree_segments};
+use crate::export::srgb8_bytes;
+use crate::ray_tree::RayTree;
+use crate::render::{RenderError, render};
+use crate::scene::{Camera, CameraFrame, Scene};
+use crate::trace::{TraceSettings, Tracer};
+
+/// A scene view that could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneViewError {
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    #[error("a scene view needs at least one pixel, not {width}x{height}")]
+    Empty { width: u32, height: u32 },
+}
+
+/// How far from the eye the render camera's image plane is drawn: 15 % of the scene's size,
+/// so the frustum reads as a small camera rather than a pyramid over the whole scene, but never
+/// past half the way to what the clicked pixel's ray meets first, so the pixel's cross lies on
+/// the ray between the eye and its hit, as in the lecture's figure.
+pub fn image_plane_distance(scene: &Scene, tree: &RayTree) -> f32 {
+    let first = tree
+        .root
+        .hit
+        .as_ref()
+        .map(|h| h.t)
+        .or(tree.root.light.as_ref().map(|l| l.t));
+    let plane = 0.15 * extent(scene);
+    match first {
+        Some(t) if t > 0.0 => plane.min(0.5 * t),
+        _ => plane,
+    }
+}
+
+/// `scene` rendered from `view` at `width × height` with raytree's own 1-sample render (the
+/// scene's settings, `settings` for tracing), with the render camera of `scene` (frustum, image
+/// plane, the tree's pixel), its lights and the segments of `tree` that `filter` shows drawn
+/// over it; parts behind surfaces are dimmed. The result is 8-bit sRGB, converted from the
+/// render as PNG export does.
+pub fn scene_view_image(
+    scene: &Scene,
+    settings: TraceSettings,
+    tree: &RayTree,
+    view: &Camera,
+    width: u32,
+    height: u32,
+    filter: &Filter,
+) -> Result<Canvas, SceneViewError> {
+    let mut seen = scene.clone();
+    seen.camera = view.clone();
+    seen.render.width = width;
+    seen.render.height = height;
+    let tracer = Tracer::new(Arc::new(seen), settings);
+    let (image, _) = render(&tracer, 1, 0, &|_, _| {})?;
+    let frame = CameraFrame::new(view, width, height);
+    let depth = DepthImage::of(&tracer, &frame, width, height);
+    let mut canvas = Canvas::from_srgb8(width, height, &srgb8_bytes(&image))
+        .ok_or(SceneViewError::Empty { width, height })?;
+
+    let mut segments = camera_segments(scene, image_plane_distance(scene, tree), Some(tree.pixel));
+    segments.extend(tree_segments(tree, extent(scene)));
+    let shown: Vec<&Segment> = segments.iter().filter(|s| filter.shows(s)).collect();
+    canvas.draw_segments(&frame, &depth, &shown, None);
+    canvas.draw_light_markers(&frame, &depth, &light_markers(scene));
+    Ok(canvas)
+}

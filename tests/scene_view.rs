@@ -1,0 +1,308 @@
+//! The headless scene view (`raytree tree --scene-view`): lines land where the view camera
+//! projects them, hidden parts are dimmed, a golden picture of the default scene's glass sphere,
+//! and the command's refusals.
+//!
+//! Regenerate the golden picture (after a deliberate change, looking at it first) with:
+//! `RAYTREE_BLESS=1 cargo test --release --test scene_view golden`
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::Arc;
+
+use glam::Vec3;
+use raytree::scene::{Camera, CameraFrame, Object, ObjectId, ObjectSource, Scene, Sphere};
+use raytree::scene_view::occlusion::DepthImage;
+use raytree::scene_view::raster::{Canvas, line_width};
+use raytree::scene_view::{Segment, Style};
+use raytree::trace::{RayKind, TraceSettings, Tracer};
+
+fn raytree() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_raytree"))
+}
+
+fn segment(a: Vec3, b: Vec3) -> Segment {
+    Segment {
+        a,
+        b,
+        style: Style::Ray(RayKind::Primary),
+        path: Vec::new(),
+        generation: 0,
+        end: None,
+    }
+}
+
+/// A view of `scene` from an oblique camera: its frame and depth image at 200 × 150.
+fn view(scene: Scene) -> (CameraFrame, DepthImage) {
+    let camera = Camera {
+        position: Vec3::new(3.0, 2.0, 6.0),
+        look_at: Vec3::new(0.0, 0.5, 0.0),
+        up: Vec3::Y,
+        fov_y_deg: 50.0,
+    };
+    let frame = CameraFrame::new(&camera, 200, 150);
+    let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());
+    let depth = DepthImage::of(&tracer, &frame, 200, 150);
+    (frame, depth)
+}
+
+/// The pixels brighter than `level` (of the red channel), as image positions of their centres.
+fn lit(canvas: &Canvas, level: u8) -> Vec<(f32, f32, u8)> {
+    let w = canvas.width() as usize;
+    canvas
+        .rgba()
+        .chunks(4)
+        .enumerate()
+        .filter(|(_, p)| p[0] > level)
+        .map(|(i, p)| ((i % w) as f32 + 0.5, (i / w) as f32 + 0.5, p[0]))
+        .collect()
+}
+
+#[test]
+fn a_segment_is_drawn_where_the_view_camera_projects_it() {
+    let (frame, depth) = view(Scene::default());
+    let mut canvas = Canvas::from_srgb8(200, 150, &[0; 200 * 150 * 3]).expect("canvas");
+    let (a, b) = (Vec3::new(-1.5, 1.0, 0.5), Vec3::new(1.0, -0.5, -1.0));
+    canvas.draw_segments(&frame, &depth, &[&segment(a, b)], None);
+    let (pa, pb) = (
+        glam::Vec2::from(frame.project(a).expect("in front")),
+        glam::Vec2::from(frame.project(b).expect("in front")),
+    );
+    let pixels = lit(&canvas, 100);
+    assert!(pixels.len() > 50, "{} pixels drawn", pixels.len());
+    let width = line_width(150);
+    // Every drawn pixel lies on the projected segment, within the line's half width and a
+    // pixel of anti-aliasing.
+    let reach = 0.5 * width + 1.0;
+    for &(x, y, _) in &pixels {
+        let p = glam::Vec2::new(x, y);
+        let s = ((p - pa).dot(pb - pa) / (pb - pa).length_squared()).clamp(0.0, 1.0);
+        let off = (p - (pa + (pb - pa) * s)).length();
+        assert!(off <= reach, "pixel ({x}, {y}) is {off} px off the line");
+    }
+    // And both ends are reached: some drawn pixel is within the reach of each projected end.
+    for end in [pa, pb] {
+        let nearest = pixels
+            .iter()
+            .map(|&(x, y, _)| (glam::Vec2::new(x, y) - end).length())
+            .fold(f32::INFINITY, f32::min);
+        assert!(nearest <= reach, "nothing drawn within {reach} px of {end}");
+    }
+}
+
+#[test]
+fn a_highlighted_node_is_drawn_wider() {
+    let (frame, depth) = view(Scene::default());
+    let line = segment(Vec3::new(-1.5, 1.0, 0.5), Vec3::new(1.0, -0.5, -1.0));
+    let drawn = |highlight: Option<&[usize]>| {
+        let mut canvas = Canvas::from_srgb8(200, 150, &[0; 200 * 150 * 3]).expect("canvas");
+        canvas.draw_segments(&frame, &depth, &[&line], highlight);
+        lit(&canvas, 100).len()
+    };
+    let (plain, wide) = (drawn(None), drawn(Some(&[])));
+    assert!(
+        wide as f32 > 1.8 * plain as f32,
+        "{plain} pixels, {wide} highlighted"
+    );
+    assert_eq!(drawn(Some(&[0])), plain, "another node's highlight");
+}
+
+#[test]
+fn the_part_behind_a_sphere_is_drawn_dimmed_not_left_out() {
+    let mut scene = Scene::default();
+    let material = scene.default_material();
+    scene.objects.push(Object {
+        name: "ball".into(),
+        source: ObjectSource::Sphere,
+    });
+    scene.spheres.push(Sphere {
+        center: Vec3::new(0.0, 0.5, 0.0),
+        radius: 1.0,
+        material,
+        object: ObjectId(0),
+    });
+    let (frame, depth) = view(scene);
+    // Behind the ball as the view sees it: through its centre, across the view.
+    let right = Vec3::new(6.0, 0.0, -3.0).normalize();
+    let centre = Vec3::new(0.0, 0.5, 0.0) - Vec3::new(3.0, 1.5, 6.0).normalize() * 1.5;
+    let (a, b) = (centre - right * 3.0, centre + right * 3.0);
+    let mut canvas = Canvas::from_srgb8(200, 150, &[0; 200 * 150 * 3]).expect("canvas");
+    canvas.draw_segments(&frame, &depth, &[&segment(a, b)], None);
+    let (x, y) = frame.project(centre).expect("in front");
+    let w = canvas.width() as usize;
+    let at = |x: f32, y: f32| canvas.rgba()[(y as usize * w + x as usize) * 4];
+    // The primary ray's grey is 235; a third of its opacity over black gives about 78.
+    let behind = at(x, y);
+    assert!((60..=100).contains(&behind), "behind the ball: {behind}");
+    let (x, y) = frame.project(a).expect("in front");
+    let (x2, y2) = frame.project(centre).expect("in front");
+    // Past the ball's outline, a fifth of the way in from the end: full strength.
+    let clear = at(x + (x2 - x) * 0.2, y + (y2 - y) * 0.2);
+    assert!(clear > 200, "in the clear: {clear}");
+}
+
+fn golden_path(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/golden")
+        .join(format!("scene_view_{name}.png"))
+}
+
+fn read_rgba(path: &Path) -> (u32, u32, Vec<u8>) {
+    let file = std::fs::File::open(path).unwrap_or_else(|e| {
+        panic!(
+            "{}: {e}; regenerate with RAYTREE_BLESS=1 cargo test --release --test scene_view golden",
+            path.display()
+        )
+    });
+    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .expect("PNG header");
+    let mut buf = vec![0; reader.output_buffer_size().expect("size")];
+    let info = reader.next_frame(&mut buf).expect("PNG data");
+    assert_eq!(info.color_type, png::ColorType::Rgba);
+    buf.truncate(info.buffer_size());
+    (info.width, info.height, buf)
+}
+
+/// The default scene's glass sphere seen from the right of the render camera, at 320 × 240:
+/// pixel (125, 135) looks into the glass sphere, so its tree refracts through it; the picture
+/// shows the frustum, the image plane with the pixel's cross, both lights and the tree.
+/// Tolerance as the render goldens: a channel may differ by more than 2/255 on at most 0.5 %
+/// of pixels (a libm's rounding can move a shadow edge or a hidden piece's end by a pixel), and
+/// the mean difference stays below 0.25/255.
+#[test]
+fn golden_glass_sphere_from_the_side() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("view.png");
+    let status = raytree()
+        .args([
+            "tree",
+            "default",
+            "--pixel",
+            "125,135",
+            "--width",
+            "320",
+            "--height",
+            "240",
+            "--scene-view",
+        ])
+        .arg(&out)
+        .args([
+            "--eye",
+            "5,3.2,6.5",
+            "--target",
+            "-1.2,2,2.8",
+            "--fov",
+            "60",
+        ])
+        .stdout(std::process::Stdio::null())
+        .status()
+        .expect("runs");
+    assert!(status.success());
+    let path = golden_path("glass");
+    if std::env::var_os("RAYTREE_BLESS").is_some() {
+        std::fs::copy(&out, &path).expect("write golden");
+        return;
+    }
+    let (w, h, want) = read_rgba(&path);
+    let (gw, gh, got) = read_rgba(&out);
+    assert_eq!((gw, gh), (w, h), "size");
+    let mut off_pixels = 0;
+    let mut total = 0u64;
+    for (a, b) in got.chunks(4).zip(want.chunks(4)) {
+        let d: Vec<u8> = a.iter().zip(b).map(|(x, y)| x.abs_diff(*y)).collect();
+        total += d.iter().map(|&x| u64::from(x)).sum::<u64>();
+        if d.iter().any(|&x| x > 2) {
+            off_pixels += 1;
+        }
+    }
+    let n = f64::from(w * h);
+    let mean = total as f64 / (4.0 * n);
+    if off_pixels as f64 > 0.005 * n || mean > 0.25 {
+        let new = path.with_extension("new.png");
+        std::fs::copy(&out, &new).expect("write new");
+        panic!(
+            "{off_pixels} pixels off by more than 2/255, mean difference {mean:.3}/255; see {}; \
+             regenerate with RAYTREE_BLESS=1 cargo test --release --test scene_view golden",
+            new.display()
+        );
+    }
+}
+
+/// Runs `raytree tree default --pixel 10,10` with `args`; returns (exit code, stderr).
+fn refused(args: &[&str]) -> (Option<i32>, String) {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = raytree()
+        .args(["tree", "default", "--pixel", "10,10"])
+        .args(args)
+        .current_dir(dir.path())
+        .output()
+        .expect("runs");
+    assert!(
+        std::fs::read_dir(dir.path())
+            .expect("list")
+            .next()
+            .is_none(),
+        "nothing written"
+    );
+    assert!(out.stdout.is_empty(), "no tree printed when refused");
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn the_command_refuses_a_view_without_a_frame_in_one_sentence() {
+    let (code, err) = refused(&[
+        "--scene-view",
+        "v.png",
+        "--eye",
+        "1,2,3",
+        "--target",
+        "1,2,3",
+    ]);
+    assert_eq!(code, Some(1));
+    assert_eq!(
+        err.trim(),
+        "error: the scene view's --target must be a point apart from --eye (at a distance f32 \
+         can represent)"
+    );
+    let (code, err) = refused(&[
+        "--scene-view",
+        "v.png",
+        "--eye=-1,2,3",
+        "--target",
+        "0,0,0",
+        "--up",
+        "-1,2,3",
+    ]);
+    assert_eq!(code, Some(1));
+    assert!(err.contains("--up must not be parallel"), "{err}");
+    let (code, err) = refused(&[
+        "--scene-view",
+        "v.svg",
+        "--eye",
+        "1,2,3",
+        "--target",
+        "0,0,0",
+    ]);
+    assert_eq!(code, Some(1));
+    assert!(err.contains("must end in .png"), "{err}");
+}
+
+#[test]
+fn the_command_wants_eye_and_target_with_a_scene_view() {
+    let (code, err) = refused(&["--scene-view", "v.png", "--target", "0,0,0"]);
+    assert_eq!(code, Some(2));
+    assert!(err.contains("--eye"), "{err}");
+    let (code, err) = refused(&[
+        "--scene-view",
+        "v.png",
+        "--eye",
+        "1,2,x",
+        "--target",
+        "0,0,0",
+    ]);
+    assert_eq!(code, Some(2));
+    assert!(err.contains("`x` is not a number"), "{err}");
+}
