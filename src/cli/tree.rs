@@ -1,5 +1,7 @@
-//! `raytree tree`: the ray tracing tree of one pixel's centre sample, as text or JSON.
+//! `raytree tree`: the ray tracing tree of one pixel's centre sample, as text or JSON, and its
+//! figure as SVG.
 
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use anyhow::{Context, Result, bail};
@@ -19,6 +21,9 @@ pub struct TreeArgs {
     /// Print the tree as JSON (the schema in the README) instead of indented text.
     #[arg(long)]
     json: bool,
+    /// Also write the lecture's tree figure as SVG to this file.
+    #[arg(long)]
+    diagram: Option<PathBuf>,
     #[command(flatten)]
     overrides: SceneOverrides,
 }
@@ -37,6 +42,11 @@ pub fn run_tree(args: &TreeArgs) -> Result<()> {
     }
     let tracer = Tracer::new(Arc::new(scene), trace);
     let tree = ray_tree::pixel_tree(&tracer, x, y).context("the pixel has no tree")?;
+    if let Some(path) = &args.diagram {
+        let svg = raytree::diagram::svg(&tree, &Default::default());
+        raytree::export::write_text(path, &svg)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
     if args.json {
         out!(
             "{}",
