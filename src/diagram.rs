@@ -15,7 +15,7 @@ use crate::trace::{EndReason, RayKind};
 /// Height of a node box.
 pub const NODE_H: f32 = 38.0;
 /// Vertical distance between the tops of two rows: room for the edge and its R/T label.
-pub const ROW: f32 = 84.0;
+pub const ROW: f32 = 66.0;
 /// Least horizontal gap between two boxes on a row.
 pub const GAP: f32 = 14.0;
 /// Font size of node labels; [`CHAR_W`] is a generous estimate of one character's width in

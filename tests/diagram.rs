@@ -389,3 +389,75 @@ fn the_cli_writes_the_diagram() {
     let texts = texts(&svg);
     assert!(texts.iter().any(|t| t == "glass sphere"), "{texts:?}");
 }
+
+/// The viewer's diagram pane, through egui_kittest (see tests/viewer.rs).
+#[cfg(feature = "viewer")]
+mod viewer {
+    use std::time::{Duration, Instant};
+
+    use eframe::egui;
+    use egui_kittest::Harness;
+    use egui_kittest::kittest::Queryable;
+    use raytree::app::ViewerApp;
+    use raytree::scene::builtin::load_builtin;
+
+    #[test]
+    fn the_glass_spheres_tree_fits_its_pane() {
+        let mut scene = load_builtin("default").expect("built-in scene");
+        scene.render.width = 160;
+        scene.render.height = 120;
+        let mut h = Harness::builder()
+            .with_size([1600.0, 1000.0])
+            .renderer(egui_kittest::wgpu::WgpuTestRenderer::new())
+            .build_eframe(|cc| {
+                ViewerApp::new(cc, scene, "test".into()).expect("the viewer starts")
+            });
+        let deadline = Instant::now() + Duration::from_secs(120);
+        while !h.state().is_finished() {
+            assert!(Instant::now() < deadline, "the render did not finish");
+            h.step();
+            std::thread::sleep(Duration::from_millis(2));
+        }
+        h.step();
+        // Pixel (75, 62) of the 160×120 image is on the glass sphere: a 13-node tree.
+        let image = h.get_by_label("render viewport").rect();
+        let at = image.min
+            + egui::Vec2::new(75.5 / 160.0 * image.width(), 62.5 / 120.0 * image.height());
+        h.hover_at(at);
+        for pressed in [true, false] {
+            h.event(egui::Event::PointerButton {
+                pos: at,
+                button: egui::PointerButton::Primary,
+                pressed,
+                modifiers: egui::Modifiers::NONE,
+            });
+        }
+        for _ in 0..4 {
+            h.step();
+        }
+        let tree = h.state().tree.clone().expect("a tree after the click");
+        assert!(
+            tree.nodes >= 9,
+            "the glass sphere's tree: {} nodes",
+            tree.nodes
+        );
+        let [x, y] = tree.pixel;
+        let pane = h
+            .get_by_label(&format!("ray tree diagram of ({x}, {y})"))
+            .rect();
+        let nodes: Vec<_> = h
+            .query_all_by_label_contains("tree node ")
+            .map(|n| n.rect())
+            .collect();
+        assert_eq!(nodes.len(), tree.nodes, "every node is drawn");
+        for r in &nodes {
+            assert!(
+                pane.contains_rect(*r),
+                "node {r:?} is inside the pane {pane:?}"
+            );
+        }
+        if let Ok(path) = std::env::var("RAYTREE_DIAGRAM_PNG") {
+            h.render().expect("render").save(path).expect("saved");
+        }
+    }
+}
