@@ -6,6 +6,7 @@
 use eframe::egui::{self, Color32, Pos2, Rect, RichText, Sense, Stroke, Ui, Vec2};
 use glam::Vec3;
 
+pub use crate::diagram::end_text as end_label;
 use crate::diagram::{self, Glyph, Mark};
 use crate::ray_tree::{Node, RayTree};
 use crate::scene::Shading;
@@ -69,16 +70,6 @@ fn kind_letter(kind: RayKind) -> &'static str {
         RayKind::Reflected => "R",
         RayKind::Refracted => "T",
         RayKind::Shadow => "S",
-    }
-}
-
-pub fn end_label(end: EndReason) -> &'static str {
-    match end {
-        EndReason::NoHit => "no hit",
-        EndReason::HitLight => "hit light",
-        EndReason::MaxDepth => "max depth",
-        EndReason::Cutoff => "cutoff",
-        EndReason::Budget => "ray budget",
     }
 }
 
