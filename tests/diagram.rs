@@ -402,7 +402,7 @@ mod viewer {
     use raytree::scene::builtin::load_builtin;
 
     #[test]
-    fn the_glass_spheres_tree_fits_its_pane() {
+    fn the_glass_spheres_tree_fits_its_pane_zooms_and_pans() {
         let mut scene = load_builtin("default").expect("built-in scene");
         scene.render.width = 160;
         scene.render.height = 120;
@@ -456,6 +456,57 @@ mod viewer {
                 "node {r:?} is inside the pane {pane:?}"
             );
         }
+        // Ctrl+wheel zooms about the pointer: the root grows and stays under it.
+        let root_label = "tree node primary: glass sphere";
+        let before = h.get_by_label(root_label).rect();
+        h.hover_at(before.center());
+        h.event(egui::Event::MouseWheel {
+            unit: egui::MouseWheelUnit::Point,
+            delta: egui::Vec2::new(0.0, 60.0),
+            phase: egui::TouchPhase::Move,
+            source: egui::MouseWheelSource::Unknown,
+            modifiers: egui::Modifiers {
+                ctrl: true,
+                command: true,
+                ..egui::Modifiers::NONE
+            },
+        });
+        for _ in 0..4 {
+            h.step();
+        }
+        let zoomed = h.get_by_label(root_label).rect();
+        assert!(
+            zoomed.width() > before.width() * 1.05,
+            "{before:?} -> {zoomed:?}"
+        );
+        assert!(
+            (zoomed.center() - before.center()).length() < 2.0,
+            "{before:?} -> {zoomed:?}"
+        );
+        // Drag pans.
+        let from = pane.left_bottom() + egui::Vec2::new(20.0, -20.0);
+        let to = from + egui::Vec2::new(40.0, -30.0);
+        h.drag_at(from);
+        h.step();
+        for k in 1..=4 {
+            h.hover_at(from + (to - from) * k as f32 / 4.0);
+            h.step();
+        }
+        h.drop_at(to);
+        h.step();
+        let panned = h.get_by_label(root_label).rect();
+        assert!(
+            (panned.center() - zoomed.center() - egui::Vec2::new(40.0, -30.0)).length() < 2.0,
+            "{zoomed:?} -> {panned:?}"
+        );
+        // "Fit" shows the whole tree again.
+        h.get_by_label("Fit").click();
+        h.step();
+        h.step();
+        assert!(
+            h.query_all_by_label_contains("tree node ")
+                .all(|n| pane.contains_rect(n.rect()))
+        );
         if let Ok(path) = std::env::var("RAYTREE_DIAGRAM_PNG") {
             h.render().expect("render").save(path).expect("saved");
         }
