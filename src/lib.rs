@@ -24,6 +24,7 @@ pub mod accel;
 #[cfg(feature = "viewer")]
 pub mod app;
 pub mod choice;
+pub mod diagram;
 #[cfg(feature = "lab")]
 pub mod experiments;
 pub mod export;

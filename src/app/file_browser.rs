@@ -12,6 +12,7 @@ pub enum BrowseFor {
     SaveScene,
     Export,
     ExportTree,
+    ExportDiagram,
 }
 
 impl BrowseFor {
@@ -21,6 +22,7 @@ impl BrowseFor {
             BrowseFor::SaveScene => "Save scene as TOML",
             BrowseFor::Export => "Export render (.png or .exr)",
             BrowseFor::ExportTree => "Export ray tree (.json)",
+            BrowseFor::ExportDiagram => "Export ray tree diagram (.svg)",
         }
     }
 
@@ -30,6 +32,7 @@ impl BrowseFor {
             BrowseFor::SaveScene => &["toml"],
             BrowseFor::Export => &["png", "exr"],
             BrowseFor::ExportTree => &["json"],
+            BrowseFor::ExportDiagram => &["svg"],
         }
     }
 }

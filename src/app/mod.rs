@@ -67,6 +67,8 @@ pub enum Command {
     SaveScene(PathBuf),
     Export(PathBuf),
     ExportTree(PathBuf),
+    /// The tree's figure as SVG, to the generations shown.
+    ExportDiagram(PathBuf),
     /// Show the ray tree of this pixel and select its material.
     Pick(u32, u32),
     FrameAll,
@@ -404,18 +406,20 @@ impl ViewerApp {
                     }
                 }
                 Command::Export(path) => self.export(&path),
-                Command::ExportTree(path) => match &self.tree {
-                    Some(tree) => {
-                        let json = serde_json::to_string_pretty(tree).unwrap_or_default();
-                        match export::write_text(&path, &json) {
-                            Ok(()) => self
-                                .messages
-                                .push((false, format!("saved {}", path.display()))),
-                            Err(e) => self.error(e.to_string()),
-                        }
-                    }
-                    None => self.error("no ray tree to export: click a pixel first"),
-                },
+                Command::ExportTree(path) => {
+                    let json = self
+                        .tree
+                        .as_ref()
+                        .map(|t| serde_json::to_string_pretty(t).unwrap_or_default());
+                    self.save_tree_text(&path, json);
+                }
+                Command::ExportDiagram(path) => {
+                    let options = crate::diagram::Options {
+                        max_generation: self.tree_state.reveal.unwrap_or(u32::MAX),
+                    };
+                    let svg = self.tree.as_ref().map(|t| crate::diagram::svg(t, &options));
+                    self.save_tree_text(&path, svg);
+                }
                 Command::Pick(x, y) => {
                     self.tree = pixel_tree(&self.tracer, x, y);
                     self.tree_state.selected = Some(Vec::new());
@@ -456,6 +460,17 @@ impl ViewerApp {
     }
 
     /// Writes the film at full resolution (never a window grab), stamped with its progress.
+    /// Writes the ray tree in some form (`None`: there is no tree yet).
+    fn save_tree_text(&mut self, path: &Path, text: Option<String>) {
+        match text.map(|text| export::write_text(path, &text)) {
+            Some(Ok(())) => self
+                .messages
+                .push((false, format!("saved {}", path.display()))),
+            Some(Err(e)) => self.error(e.to_string()),
+            None => self.error("no ray tree to export: click a pixel first"),
+        }
+    }
+
     fn export(&mut self, path: &Path) {
         let target = self.scene.render.samples;
         let text = export::stamp(
@@ -508,10 +523,16 @@ impl eframe::App for ViewerApp {
         self.tree_state.hovered = None;
         let tree = self.tree.clone();
         if let Some(tree) = &tree {
-            egui::Panel::bottom("diagram")
+            let export_svg = egui::Panel::bottom("diagram")
                 .resizable(true)
-                .default_size(220.0)
-                .show(ui, |ui| tree_view::diagram(ui, tree, &mut self.tree_state));
+                .default_size(320.0)
+                .show(ui, |ui| tree_view::diagram(ui, tree, &mut self.tree_state))
+                .inner;
+            if export_svg {
+                let name = format!("tree-{}-{}.svg", tree.pixel[0], tree.pixel[1]);
+                let dir = self.start_dir();
+                self.browser = Some(FileBrowser::new(BrowseFor::ExportDiagram, dir, &name));
+            }
         }
         egui::Panel::left("settings")
             .resizable(true)
@@ -538,6 +559,7 @@ impl eframe::App for ViewerApp {
                         BrowseFor::SaveScene => Command::SaveScene(path),
                         BrowseFor::Export => Command::Export(path),
                         BrowseFor::ExportTree => Command::ExportTree(path),
+                        BrowseFor::ExportDiagram => Command::ExportDiagram(path),
                     });
                     self.browser = None;
                 }

@@ -6,8 +6,11 @@
 use eframe::egui::{self, Color32, Pos2, Rect, RichText, Sense, Stroke, Ui, Vec2};
 use glam::Vec3;
 
+pub use crate::diagram::end_text as end_label;
+use crate::diagram::{self, Glyph, Mark};
 use crate::ray_tree::{Node, RayTree};
 use crate::scene::Shading;
+use crate::scene_view::{Style, style_rgba};
 use crate::trace::{EndReason, RayKind};
 
 /// A node's place: the child indices from the root.
@@ -19,6 +22,8 @@ pub struct TreeState {
     pub selected: Option<NodePath>,
     pub hovered: Option<NodePath>,
     pub pinned: Option<RayTree>,
+    /// The step-through: show generations `0..=n` only (`None`: all).
+    pub reveal: Option<u32>,
 }
 
 /// The one palette of ray kinds, shared by every view of the tree and by the overlay (sRGB).
@@ -65,16 +70,6 @@ fn kind_letter(kind: RayKind) -> &'static str {
         RayKind::Reflected => "R",
         RayKind::Refracted => "T",
         RayKind::Shadow => "S",
-    }
-}
-
-pub fn end_label(end: EndReason) -> &'static str {
-    match end {
-        EndReason::NoHit => "no hit",
-        EndReason::HitLight => "hit light",
-        EndReason::MaxDepth => "max depth",
-        EndReason::Cutoff => "cutoff",
-        EndReason::Budget => "ray budget",
     }
 }
 
@@ -192,185 +187,422 @@ fn list_node(
 
 // ---- the diagram --------------------------------------------------------------------------
 
-const LEVEL: f32 = 74.0;
-const COLUMN: f32 = 92.0;
-const RADIUS: f32 = 11.0;
-
-/// Horizontal slot of every node: leaves get consecutive columns, parents sit over the middle
-/// of their children.
-fn layout(
-    node: &Node,
-    next_leaf: &mut f32,
-    out: &mut Vec<(NodePath, f32, u32)>,
-    path: &mut NodePath,
-) -> f32 {
-    let x = if node.children.is_empty() {
-        let x = *next_leaf;
-        *next_leaf += 1.0;
-        x
-    } else {
-        let mut xs = Vec::new();
-        for (i, child) in node.children.iter().enumerate() {
-            path.push(i);
-            xs.push(layout(child, next_leaf, out, path));
-            path.pop();
-        }
-        (xs[0] + xs[xs.len() - 1]) * 0.5
-    };
-    out.push((path.clone(), x, node.depth));
-    x
+fn rgba32([r, g, b, a]: [u8; 4]) -> Color32 {
+    Color32::from_rgba_unmultiplied(r, g, b, a)
 }
 
-/// The lecture's "Ray Tracing Tree": surface nodes, R and T edges, shadow rays to each light
-/// drawn lit or blocked, leaves labelled with why they ended.
-pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) {
-    let mut slots = Vec::new();
-    let mut leaves = 0.0;
-    layout(&tree.root, &mut leaves, &mut slots, &mut Vec::new());
-    let depth = slots.iter().map(|s| s.2).max().unwrap_or(0) as f32;
-    let size = Vec2::new(
-        (leaves.max(1.0)) * COLUMN + 60.0,
-        (depth + 1.0) * LEVEL + 40.0,
+/// The diagram's zoom and pan, kept in egui's memory: `screen = canvas.min + offset + zoom·p`
+/// for a point `p` of the layout.
+#[derive(Clone, Debug)]
+struct DiagramView {
+    zoom: f32,
+    offset: Vec2,
+    /// Fit the whole tree to the pane every frame (so also after a resize) until the user
+    /// zooms or pans; a new tree or the "Fit" button sets it again.
+    fit: bool,
+    /// The tree (pixel, nodes, max depth) and generations the view was made for.
+    key: Option<([u32; 2], usize, u32, Option<u32>)>,
+    legend: bool,
+}
+
+impl Default for DiagramView {
+    fn default() -> Self {
+        Self {
+            zoom: 1.0,
+            offset: Vec2::ZERO,
+            fit: true,
+            key: None,
+            legend: true,
+        }
+    }
+}
+
+/// Gap kept round the fitted tree, and the largest zoom a fit picks.
+const FIT_MARGIN: f32 = 12.0;
+const FIT_MAX_ZOOM: f32 = 1.5;
+const LEGEND_ROW: f32 = 15.0;
+const LEGEND_COLUMN: f32 = 300.0;
+const LEGEND_TOP: f32 = 24.0;
+
+/// One shadow glyph (or a legend's mark for it), `s` pixels across.
+fn paint_glyph(painter: &egui::Painter, glyph: Glyph, at: Pos2, s: f32) {
+    let c = rgba32(glyph.rgba());
+    match glyph {
+        Glyph::Lit | Glyph::FacingAway => {
+            painter.circle_filled(at, s * 0.5, c);
+        }
+        Glyph::Blocked => {
+            let d = s * 0.5;
+            let stroke = Stroke::new((s * 0.25).max(1.0), c);
+            painter.line_segment([at - Vec2::splat(d), at + Vec2::splat(d)], stroke);
+            painter.line_segment([at + Vec2::new(-d, d), at + Vec2::new(d, -d)], stroke);
+        }
+    }
+}
+
+/// The legend's size in `rows` rows per column.
+fn legend_size(rows: usize) -> Vec2 {
+    let n = diagram::legend().len();
+    let columns = n.div_ceil(rows.max(1));
+    Vec2::new(
+        columns as f32 * LEGEND_COLUMN,
+        LEGEND_TOP + 6.0 + n.min(rows) as f32 * LEGEND_ROW,
+    )
+}
+
+/// The legend, from [`diagram::legend`], in `rect`, `rows` entries per column.
+fn paint_legend(painter: &egui::Painter, rect: Rect, rows: usize) {
+    painter.rect_filled(rect, 6.0, Color32::from_rgba_unmultiplied(35, 35, 35, 235));
+    painter.rect_stroke(
+        rect,
+        6.0,
+        Stroke::new(1.0, Color32::from_gray(85)),
+        egui::StrokeKind::Inside,
     );
-    egui::ScrollArea::both().id_salt("diagram").show(ui, |ui| {
-        let (rect, response) = ui.allocate_exact_size(size, Sense::hover());
-        response.widget_info(|| {
+    let text = color(diagram::TEXT_RGB);
+    let font = egui::FontId::proportional(11.5);
+    painter.text(
+        rect.min + Vec2::new(10.0, 12.0),
+        egui::Align2::LEFT_CENTER,
+        "Legend",
+        egui::FontId::proportional(13.0),
+        text,
+    );
+    for (i, e) in diagram::legend().iter().enumerate() {
+        let column = rect.min.x + (i / rows.max(1)) as f32 * LEGEND_COLUMN;
+        let y = rect.min.y + LEGEND_TOP + 8.0 + (i % rows.max(1)) as f32 * LEGEND_ROW;
+        let at = Pos2::new(column + 22.0, y);
+        let c = rgba32(e.rgba);
+        match e.mark {
+            Mark::Ray(kind) => {
+                painter.line_segment(
+                    [at - Vec2::new(12.0, 0.0), at + Vec2::new(12.0, 0.0)],
+                    Stroke::new(2.0, c),
+                );
+                painter.text(
+                    at - Vec2::new(0.0, 6.0),
+                    egui::Align2::CENTER_CENTER,
+                    diagram::edge_label(kind),
+                    egui::FontId::proportional(10.0),
+                    c,
+                );
+            }
+            Mark::Glyph(g) => paint_glyph(painter, g, at, 8.0),
+            Mark::Swatch => {
+                painter.rect_filled(
+                    Rect::from_center_size(at, Vec2::splat(diagram::SWATCH)),
+                    0.0,
+                    Color32::from_rgb(192, 128, 64),
+                );
+            }
+            Mark::NotTraced => {
+                painter.add(egui::Shape::dashed_line(
+                    &rect_loop(Rect::from_center_size(at, Vec2::new(24.0, 12.0))),
+                    Stroke::new(1.5, c),
+                    4.0,
+                    3.0,
+                ));
+            }
+            Mark::Tir => {
+                painter.text(
+                    at,
+                    egui::Align2::CENTER_CENTER,
+                    "TIR",
+                    egui::FontId::proportional(10.0),
+                    c,
+                );
+            }
+            Mark::Highlight => {
+                painter.rect_stroke(
+                    Rect::from_center_size(at, Vec2::new(24.0, 12.0)),
+                    3.0,
+                    Stroke::new(3.0, c),
+                    egui::StrokeKind::Middle,
+                );
+            }
+        }
+        painter.text(
+            Pos2::new(column + 44.0, y),
+            egui::Align2::LEFT_CENTER,
+            e.text,
+            font.clone(),
+            text,
+        );
+    }
+}
+
+/// The corners of `r`, closed, for a dashed outline.
+fn rect_loop(r: Rect) -> [Pos2; 5] {
+    [
+        r.left_top(),
+        r.right_top(),
+        r.right_bottom(),
+        r.left_bottom(),
+        r.left_top(),
+    ]
+}
+
+/// The lecture's "Ray Tracing Tree" drawn from the core's layout ([`diagram::layout`]): boxes
+/// with the node's colour and what its ray met, R and T edges, shadow glyphs per light, the
+/// rays not traced dashed, and a collapsible legend. Fits the pane when a tree arrives (and on
+/// "Fit"); Ctrl+wheel zooms about the pointer, wheel and drag pan. Generations deeper than
+/// [`TreeState::reveal`] are hidden. Returns whether "Export SVG" was clicked.
+pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
+    let options = diagram::Options {
+        max_generation: state.reveal.unwrap_or(u32::MAX),
+    };
+    let lay = diagram::layout(tree, &options);
+    let id = ui.make_persistent_id("diagram view");
+    let mut view: DiagramView = ui.data(|d| d.get_temp(id)).unwrap_or_default();
+    let key = (
+        tree.pixel,
+        tree.nodes,
+        tree.settings.max_depth,
+        state.reveal,
+    );
+    if view.key != Some(key) {
+        view.key = Some(key);
+        view.fit = true;
+    }
+    let mut export = false;
+    ui.horizontal(|ui| {
+        if ui
+            .button("Fit")
+            .on_hover_text("show the whole tree in the pane")
+            .clicked()
+        {
+            view.fit = true;
+        }
+        ui.toggle_value(&mut view.legend, "Legend");
+        if ui
+            .button("Export SVG...")
+            .on_hover_text("the figure for slides, with its legend")
+            .clicked()
+        {
+            export = true;
+        }
+        ui.label(format!("{:.0}%", view.zoom * 100.0));
+        if lay.hidden > 0 {
+            ui.label(format!("{} deeper nodes hidden", lay.hidden));
+        }
+        ui.weak("Ctrl+wheel zooms, drag pans");
+    });
+    let size = ui.available_size().max(Vec2::new(120.0, 80.0));
+    let (rect, response) = ui.allocate_exact_size(size, Sense::click_and_drag());
+    response.widget_info(|| {
+        egui::WidgetInfo::labeled(
+            egui::Role::Image,
+            true,
+            format!("ray tree diagram of ({}, {})", tree.pixel[0], tree.pixel[1]),
+        )
+    });
+    // As many columns as the pane's height needs.
+    let legend_rows = ((rect.height() - 12.0 - LEGEND_TOP - 6.0) / LEGEND_ROW).floor() as usize;
+    let legend_box = legend_size(legend_rows);
+    let legend_rect = Rect::from_min_size(
+        Pos2::new(rect.max.x - legend_box.x - 6.0, rect.min.y + 6.0),
+        legend_box,
+    );
+    // The tree fits beside the open legend, unless that leaves it too little room.
+    let area = if view.legend && legend_rect.min.x - rect.min.x > 240.0 {
+        Rect::from_min_max(rect.min, Pos2::new(legend_rect.min.x - 6.0, rect.max.y))
+    } else {
+        rect
+    };
+    let [w, h] = lay.size;
+    if view.fit {
+        let room = area.size() - Vec2::splat(2.0 * FIT_MARGIN);
+        view.zoom = (room.x / w.max(1.0))
+            .min(room.y / h.max(1.0))
+            .clamp(0.01, FIT_MAX_ZOOM);
+        view.offset = area.center() - rect.min - Vec2::new(w, h) * view.zoom * 0.5;
+    }
+    if response.dragged() {
+        view.offset += response.drag_delta();
+        view.fit = false;
+    }
+    let pointer = ui
+        .input(|i| i.pointer.hover_pos())
+        .filter(|p| rect.contains(*p));
+    if let Some(p) = pointer {
+        let (zoom, scroll) = ui.input(|i| (i.zoom_delta(), i.smooth_scroll_delta));
+        if zoom != 1.0 {
+            // The layout point under the pointer stays under it.
+            let under = (p - rect.min - view.offset) / view.zoom;
+            view.zoom = (view.zoom * zoom).clamp(0.01, 8.0);
+            view.offset = p - rect.min - under * view.zoom;
+            view.fit = false;
+        } else if scroll != Vec2::ZERO {
+            view.offset += scroll;
+            view.fit = false;
+        }
+    }
+    let (zoom, origin) = (view.zoom, rect.min + view.offset);
+    let at = |[x, y]: [f32; 2]| origin + Vec2::new(x, y) * zoom;
+    let painter = ui.painter_at(rect);
+    painter.rect_filled(rect, 0.0, color(diagram::BACKGROUND_RGB));
+    // Text too small to read is left out; boxes and glyphs stay.
+    let font = diagram::FONT * zoom;
+    let readable = font >= 5.0;
+    let line = (2.0 * zoom).clamp(1.0, 3.0);
+    for e in &lay.edges {
+        let style = if e.not_traced {
+            Style::NotTraced(e.kind)
+        } else {
+            Style::Ray(e.kind)
+        };
+        let c = rgba32(style_rgba(style));
+        let (a, b) = (at(e.from), at(e.to));
+        if e.not_traced {
+            painter.add(egui::Shape::dashed_line(
+                &[a, b],
+                Stroke::new(line, c),
+                4.0 * zoom,
+                3.0 * zoom,
+            ));
+        } else {
+            painter.line_segment([a, b], Stroke::new(line, c));
+        }
+        if readable {
+            // The label sits on its own edge over a patch of background: it crosses no line.
+            let mid = at(e.label_at);
+            painter.rect_filled(
+                Rect::from_center_size(mid, Vec2::new(14.0, 16.0) * zoom),
+                3.0 * zoom,
+                color(diagram::BACKGROUND_RGB),
+            );
+            painter.text(
+                mid,
+                egui::Align2::CENTER_CENTER,
+                e.label,
+                egui::FontId::proportional(font),
+                c,
+            );
+        }
+    }
+    for n in &lay.nodes {
+        let [x0, y0, x1, y1] = n.rect();
+        let node_rect = Rect::from_min_max(at([x0, y0]), at([x1, y1]));
+        let Some(node) = node_at(&tree.root, &n.path) else {
+            continue;
+        };
+        let r = ui.interact(node_rect, id.with(("node", &n.path)), Sense::click());
+        r.widget_info(|| {
             egui::WidgetInfo::labeled(
-                egui::Role::Image,
+                egui::Role::Button,
                 true,
-                format!("ray tree diagram of ({}, {})", tree.pixel[0], tree.pixel[1]),
+                format!("tree node {}: {}", kind_letter(node.kind), n.label),
             )
         });
-        let painter = ui.painter_at(rect);
-        let pos = |x: f32, d: u32| {
-            Pos2::new(
-                rect.min.x + 40.0 + x * COLUMN,
-                rect.min.y + 28.0 + d as f32 * LEVEL,
-            )
-        };
-        let place = |p: &[usize]| slots.iter().find(|s| s.0 == p).map(|s| pos(s.1, s.2));
-        // Edges first, so the nodes sit on top.
-        for (path, x, d) in &slots {
-            let Some(node) = node_at(&tree.root, path) else {
-                continue;
-            };
-            let here = pos(*x, *d);
-            for (i, child) in node.children.iter().enumerate() {
-                let mut cp = path.clone();
-                cp.push(i);
-                if let Some(there) = place(&cp) {
-                    let c = kind_color(child.kind);
-                    painter.line_segment([here, there], Stroke::new(2.0, c));
-                    let mid = here + (there - here) * 0.5;
-                    painter.text(
-                        mid + Vec2::new(if there.x < here.x { -8.0 } else { 8.0 }, -4.0),
-                        egui::Align2::CENTER_CENTER,
-                        kind_letter(child.kind),
-                        egui::FontId::proportional(13.0),
-                        c,
-                    );
-                }
-            }
+        if r.hovered() {
+            state.hovered = Some(n.path.clone());
         }
-        for (path, x, d) in &slots {
-            let Some(node) = node_at(&tree.root, path) else {
-                continue;
-            };
-            let p = pos(*x, *d);
-            // Shadow rays fan out to the upper right, one per light.
-            for (k, s) in node.shadow_rays.iter().enumerate() {
-                let angle = -0.9 + 0.45 * k as f32;
-                let tip = p + Vec2::new(angle.cos(), angle.sin()) * 30.0;
-                let (c, stroke) = if s.facing_away {
-                    (Color32::GRAY, 1.0)
-                } else if s.blocked_by.is_some() {
-                    (color(SHADOW_BLOCKED_RGB), 1.5)
-                } else {
-                    (color(kind_rgb(RayKind::Shadow)), 1.5)
-                };
-                painter.line_segment([p, tip], Stroke::new(stroke, c));
-                if s.blocked_by.is_some() && !s.facing_away {
-                    let d = 4.0;
-                    painter.line_segment(
-                        [tip - Vec2::splat(d), tip + Vec2::splat(d)],
-                        Stroke::new(2.0, c),
-                    );
-                    painter.line_segment(
-                        [tip + Vec2::new(-d, d), tip + Vec2::new(d, -d)],
-                        Stroke::new(2.0, c),
-                    );
-                } else {
-                    painter.circle_filled(tip, 3.0, c);
-                }
+        if r.clicked() {
+            state.selected = Some(n.path.clone());
+        }
+        let r = r.on_hover_ui(|ui| {
+            ui.label(node_summary(node));
+            for g in &n.glyphs {
+                ui.label(&g.note);
             }
-            let id = ui.make_persistent_id(("diagram node", path.clone()));
-            let node_rect = Rect::from_center_size(p, Vec2::splat(RADIUS * 2.0 + 4.0));
-            let r = ui.interact(node_rect, id, Sense::click());
-            let label = match (&node.end, &node.hit) {
-                (Some(end), _) => end_label(*end).to_string(),
-                (None, Some(hit)) => hit.object.clone(),
-                _ => String::new(),
-            };
-            r.widget_info(|| {
-                egui::WidgetInfo::labeled(
-                    egui::Role::Button,
-                    true,
-                    format!("tree node {}: {label}", kind_letter(node.kind)),
-                )
-            });
-            if r.hovered() {
-                state.hovered = Some(path.clone());
-            }
-            if r.clicked() {
-                state.selected = Some(path.clone());
-            }
-            let active = state.selected.as_deref() == Some(path.as_slice())
-                || state.hovered.as_deref() == Some(path.as_slice());
-            let fill = Color32::from_rgb(
-                (node.color.x.clamp(0.0, 1.0) * 255.0) as u8,
-                (node.color.y.clamp(0.0, 1.0) * 255.0) as u8,
-                (node.color.z.clamp(0.0, 1.0) * 255.0) as u8,
-            );
-            if node.end.is_some() {
-                // A leaf that was not shaded: a square with its end reason.
-                painter.rect_filled(
-                    Rect::from_center_size(p, Vec2::splat(RADIUS * 1.6)),
-                    2.0,
-                    fill,
-                );
-            } else {
-                painter.circle_filled(p, RADIUS, fill);
-            }
-            painter.circle_stroke(
-                p,
-                RADIUS + 1.0,
+        });
+        let _ = r;
+        let selected = state.selected.as_deref() == Some(n.path.as_slice());
+        let hovered = state.hovered.as_deref() == Some(n.path.as_slice());
+        let outline = if n.not_traced {
+            Style::NotTraced(n.kind)
+        } else {
+            Style::Ray(n.kind)
+        };
+        painter.rect_filled(node_rect, 5.0 * zoom, Color32::from_gray(42));
+        if selected || hovered {
+            // Thicker than any outline and in the highlight colour, so the selected primary
+            // ray is not white on white.
+            painter.rect_stroke(
+                node_rect.expand(2.0),
+                5.0 * zoom,
                 Stroke::new(
-                    if active { 3.0 } else { 1.5 },
-                    if active {
-                        color(HIGHLIGHT_RGB)
-                    } else {
-                        kind_color(node.kind)
-                    },
+                    if selected { 4.0 } else { 2.5 },
+                    color(crate::scene_view::HIGHLIGHT_RGB),
                 ),
+                egui::StrokeKind::Outside,
             );
-            if node.total_internal_reflection {
+        } else if n.not_traced {
+            painter.add(egui::Shape::dashed_line(
+                &rect_loop(node_rect),
+                Stroke::new(1.5, rgba32(style_rgba(outline))),
+                4.0 * zoom,
+                3.0 * zoom,
+            ));
+        } else {
+            painter.rect_stroke(
+                node_rect,
+                5.0 * zoom,
+                Stroke::new(
+                    if n.depth == 0 { 2.5 } else { 1.5 },
+                    rgba32(style_rgba(outline)),
+                ),
+                egui::StrokeKind::Inside,
+            );
+        }
+        let pad = diagram::PAD * zoom;
+        let swatch = diagram::SWATCH * zoom;
+        let line1 = node_rect.min.y + pad + swatch / 2.0;
+        painter.rect_filled(
+            Rect::from_min_size(
+                Pos2::new(node_rect.min.x + pad, line1 - swatch / 2.0),
+                Vec2::splat(swatch),
+            ),
+            0.0,
+            color(n.swatch),
+        );
+        for g in &n.glyphs {
+            paint_glyph(&painter, g.glyph, at(g.at), 8.0 * zoom);
+        }
+        if readable {
+            // Clipped to the box, so a label never reaches an edge or a neighbour.
+            painter.with_clip_rect(node_rect.intersect(rect)).text(
+                Pos2::new(node_rect.min.x + 2.0 * pad + swatch, line1),
+                egui::Align2::LEFT_CENTER,
+                &n.label,
+                egui::FontId::proportional(font),
+                if n.not_traced {
+                    rgba32(style_rgba(outline))
+                } else {
+                    color(diagram::TEXT_RGB)
+                },
+            );
+            let line2 = node_rect.min.y + node_rect.height() * 0.75;
+            if n.total_internal_reflection {
                 painter.text(
-                    p + Vec2::new(RADIUS + 4.0, 0.0),
+                    Pos2::new(
+                        node_rect.min.x
+                            + pad
+                            + (n.glyphs.len() as f32 * diagram::GLYPH_PITCH + diagram::PAD) * zoom,
+                        line2,
+                    ),
                     egui::Align2::LEFT_CENTER,
                     "TIR",
-                    egui::FontId::proportional(11.0),
-                    Color32::from_rgb(255, 150, 50),
+                    egui::FontId::proportional(10.0 * zoom),
+                    color(diagram::TIR_RGB),
                 );
             }
-            painter.text(
-                p + Vec2::new(0.0, RADIUS + 9.0),
-                egui::Align2::CENTER_CENTER,
-                label,
-                egui::FontId::proportional(11.0),
-                ui.visuals().text_color(),
-            );
+            if n.hidden_children > 0 {
+                painter.text(
+                    Pos2::new(node_rect.center().x, node_rect.max.y + 10.0 * zoom),
+                    egui::Align2::CENTER_CENTER,
+                    format!("+{} deeper", n.hidden_children),
+                    egui::FontId::proportional(10.0 * zoom),
+                    color(diagram::TEXT_RGB),
+                );
+            }
         }
-    });
+    }
+    if view.legend {
+        paint_legend(&painter, legend_rect, legend_rows);
+    }
+    ui.data_mut(|d| d.insert_temp(id, view));
+    export
 }
 
 // ---- the numbers --------------------------------------------------------------------------

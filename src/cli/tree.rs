@@ -1,5 +1,6 @@
-//! `raytree tree`: the ray tracing tree of one pixel's centre sample, as text or JSON, and
-//! (`--scene-view`) drawn in 3D over the scene seen from another camera, as a PNG.
+//! `raytree tree`: the ray tracing tree of one pixel's centre sample, as text or JSON; its
+//! figure as SVG (`--diagram`); and (`--scene-view`) drawn in 3D over the scene seen from
+//! another camera, as a PNG.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -24,6 +25,9 @@ pub struct TreeArgs {
     /// Print the tree as JSON (the schema in the README) instead of indented text.
     #[arg(long)]
     json: bool,
+    /// Also write the lecture's tree figure as SVG to this file.
+    #[arg(long)]
+    diagram: Option<PathBuf>,
     #[command(flatten)]
     overrides: SceneOverrides,
     #[command(flatten)]
@@ -45,6 +49,11 @@ pub fn run_tree(args: &TreeArgs) -> Result<()> {
     let view = args.view.camera(&scene)?;
     let tracer = Tracer::new(Arc::new(scene), trace);
     let tree = ray_tree::pixel_tree(&tracer, x, y).context("the pixel has no tree")?;
+    if let Some(path) = &args.diagram {
+        let svg = raytree::diagram::svg(&tree, &Default::default());
+        raytree::export::write_text(path, &svg)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
     if args.json {
         out!(
             "{}",
