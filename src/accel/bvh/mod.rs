@@ -13,7 +13,7 @@
 mod build;
 mod traverse;
 
-use glam::Vec4;
+use glam::{Vec3, Vec4};
 
 use super::Prim;
 use crate::geometry::Triangles4;
@@ -79,4 +79,137 @@ impl Bvh {
     pub(in crate::accel) fn depth(&self) -> usize {
         self.depth
     }
+}
+
+/// One box of the tree as [`Bvh::for_each_box`] reports it.
+pub(in crate::accel) struct TreeBox {
+    pub lo: Vec3,
+    pub hi: Vec3,
+    /// Root = 0; a child is one below its parent.
+    pub level: u32,
+    /// Index (in report order) of the parent box; `None` for the root.
+    pub parent: Option<usize>,
+    /// The child word, for leaves (see [`LEAF`]); `None` for the root and inner nodes.
+    pub leaf: Option<u32>,
+}
+
+impl Bvh {
+    /// The box of a node: the union of its children's (padded) boxes, the root's included.
+    fn node_box(&self, node: u32) -> (Vec3, Vec3) {
+        let n = &self.nodes[node as usize];
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for slot in 0..4 {
+            if n.valid & (1 << slot) != 0 {
+                let (l, h) = slot_box(n, slot);
+                lo = lo.min(l);
+                hi = hi.max(h);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// Calls `f` for every box of the tree, parents before children: the root (the union of
+    /// its children), then each child slot's box (inner node or leaf), a node's children
+    /// together.
+    pub(in crate::accel) fn for_each_box(&self, mut f: impl FnMut(TreeBox)) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let (lo, hi) = self.node_box(0);
+        f(TreeBox {
+            lo,
+            hi,
+            level: 0,
+            parent: None,
+            leaf: None,
+        });
+        let mut count = 1;
+        // (node, its index in report order, its level)
+        let mut todo = vec![(0u32, 0usize, 0u32)];
+        while let Some((node, index, level)) = todo.pop() {
+            let n = &self.nodes[node as usize];
+            for slot in 0..4 {
+                if n.valid & (1 << slot) == 0 {
+                    continue;
+                }
+                let (lo, hi) = slot_box(n, slot);
+                let word = n.child[slot];
+                f(TreeBox {
+                    lo,
+                    hi,
+                    level: level + 1,
+                    parent: Some(index),
+                    leaf: (word & LEAF != 0).then_some(word),
+                });
+                if word & LEAF == 0 {
+                    todo.push((word, count, level + 1));
+                }
+                count += 1;
+            }
+        }
+    }
+
+    /// The primitive ids of a leaf word, in lane order.
+    pub(in crate::accel) fn leaf_prims(&self, word: u32) -> Vec<u32> {
+        if word & SPHERE != 0 {
+            vec![self.spheres[(word & !(LEAF | SPHERE)) as usize].id]
+        } else {
+            let packet = &self.packets[((word & !LEAF) >> 2) as usize];
+            packet.ids[..(word & 3) as usize + 1].to_vec()
+        }
+    }
+
+    /// The boxes and levels of the child words a traversal entered, in the order given (the
+    /// order of a traversal, so every word's parent comes before it). The root (word 0, which
+    /// every traversal starts at) is kept when the ray's `(t_min, t_max)` meets its box or
+    /// anything below it was entered, so a ray that misses the tree entered nothing.
+    pub(in crate::accel) fn entered_boxes(
+        &self,
+        words: &[u32],
+        ray: &crate::geometry::Ray,
+        t_min: f32,
+        t_max: f32,
+    ) -> Vec<(Vec3, Vec3, u32)> {
+        if self.nodes.is_empty() {
+            return Vec::new();
+        }
+        let root = self.node_box(0);
+        let mut known = std::collections::HashMap::from([(0u32, (root.0, root.1, 0u32))]);
+        let mut out = Vec::with_capacity(words.len());
+        for &word in words {
+            // A word not yet known would have been entered without its parent, which the
+            // traversal cannot do; skipping it keeps this total.
+            let Some(&(lo, hi, level)) = known.get(&word) else {
+                continue;
+            };
+            out.push((lo, hi, level));
+            if word & LEAF == 0 {
+                let n = &self.nodes[word as usize];
+                for slot in 0..4 {
+                    if n.valid & (1 << slot) != 0 {
+                        let (l, h) = slot_box(n, slot);
+                        known.insert(n.child[slot], (l, h, level + 1));
+                    }
+                }
+            }
+        }
+        if out.len() == 1 && words.first() == Some(&0) {
+            let (t0, t1) = super::slab(ray.origin, super::safe_inv(ray.dir), root.0, root.1);
+            let meets = t0.max(t_min) <= t1.min(t_max);
+            if !meets {
+                out.clear();
+            }
+        }
+        out
+    }
+}
+
+/// The padded box of a node's child slot.
+fn slot_box(n: &Node, slot: usize) -> (Vec3, Vec3) {
+    let p = &n.planes;
+    (
+        Vec3::new(p[0][slot], p[2][slot], p[4][slot]),
+        Vec3::new(p[1][slot], p[3][slot], p[5][slot]),
+    )
 }
