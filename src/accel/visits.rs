@@ -17,7 +17,7 @@ use crate::geometry::{Methods, Ray, Triangles4};
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Visits {
     /// Boxes entered, in the order the traversal entered them: BVH nodes and leaves (with their
-    /// level, root = 0) or grid cells (level 0, empty cells included). None for `AccelKind::None`.
+    /// level, root = 0) or grid cells (level 0, empty cells included); empty for `AccelKind::None`.
     pub boxes: Vec<VisitedBox>,
     /// Primitive ids tested, in order (ids as in [`super::PrimSet`]: spheres first, then
     /// triangles). The grid tests a primitive once per cell it lies in, so ids can repeat.
@@ -164,20 +164,19 @@ impl Accel {
 
     /// The boxes of the keys a traversal passed to [`Visitor::enter`].
     fn entered(&self, keys: &[u32], ray: &Ray, t_min: f32, t_max: f32) -> Vec<VisitedBox> {
-        let visited = |(lo, hi, level)| VisitedBox { lo, hi, level };
         match &self.imp {
             Imp::None(_) => Vec::new(),
             Imp::Grid(g) => keys
                 .iter()
                 .map(|&c| {
                     let (lo, hi) = g.cell_box(c as usize);
-                    visited((lo, hi, 0))
+                    VisitedBox { lo, hi, level: 0 }
                 })
                 .collect(),
             Imp::Bvh(b) => b
                 .entered_boxes(keys, ray, t_min, t_max)
                 .into_iter()
-                .map(visited)
+                .map(|(lo, hi, level)| VisitedBox { lo, hi, level })
                 .collect(),
         }
     }
