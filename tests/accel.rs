@@ -645,6 +645,20 @@ fn prim_bounds(p: &PrimSet, id: usize) -> (Vec3, Vec3) {
     }
 }
 
+/// The visits of the closest-hit query (`false`) and of the occlusion query (`true`).
+fn both_visits(
+    a: &Accel,
+    m: &Methods,
+    ray: &Ray,
+    t_min: f32,
+    t_max: f32,
+) -> [(bool, raytree::accel::Visits); 2] {
+    [
+        (false, a.closest_hit_visits(m, ray, t_min, t_max)),
+        (true, a.occluded_visits(m, ray, t_min, t_max)),
+    ]
+}
+
 /// A box as a hashable key: its corners' bits.
 fn box_key(lo: Vec3, hi: Vec3) -> [u32; 6] {
     let (l, h) = (lo.to_array(), hi.to_array());
@@ -713,12 +727,7 @@ fn bvh_visits_match_a_brute_force_walk_of_its_boxes() {
         let key = |lo: Vec3, hi: Vec3, level: u32| (box_key(lo, hi), level);
         let rays = rays_for(&scene, &mut rng, 1500);
         for (i, (ray, t_min, t_max)) in rays.iter().enumerate() {
-            for occlusion in [false, true] {
-                let v = if occlusion {
-                    a.occluded_visits(&m, ray, *t_min, *t_max)
-                } else {
-                    a.closest_hit_visits(&m, ray, *t_min, *t_max)
-                };
+            for (occlusion, v) in both_visits(&a, &m, ray, *t_min, *t_max) {
                 let entered: std::collections::HashSet<_> =
                     v.boxes.iter().map(|b| key(b.lo, b.hi, b.level)).collect();
                 for b in &v.boxes {
@@ -865,12 +874,7 @@ fn grid_visits_step_cell_by_cell() {
         }
         let rays = rays_for(&scene, &mut rng, 1500);
         for (i, (ray, t_min, t_max)) in rays.iter().enumerate() {
-            for occlusion in [false, true] {
-                let v = if occlusion {
-                    a.occluded_visits(&m, ray, *t_min, *t_max)
-                } else {
-                    a.closest_hit_visits(&m, ray, *t_min, *t_max)
-                };
+            for (occlusion, v) in both_visits(&a, &m, ray, *t_min, *t_max) {
                 for b in &v.boxes {
                     assert_eq!(b.level, 0);
                     assert!(

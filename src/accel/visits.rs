@@ -173,11 +173,7 @@ impl Accel {
                     VisitedBox { lo, hi, level: 0 }
                 })
                 .collect(),
-            Imp::Bvh(b) => b
-                .entered_boxes(keys, ray, t_min, t_max)
-                .into_iter()
-                .map(|(lo, hi, level)| VisitedBox { lo, hi, level })
-                .collect(),
+            Imp::Bvh(b) => b.entered_boxes(keys, ray, t_min, t_max),
         }
     }
 
@@ -206,8 +202,8 @@ impl Accel {
             Imp::Bvh(b) => {
                 let mut out = Vec::new();
                 if level < self.levels() {
-                    b.for_each_box(|t| {
-                        if t.level == level || (t.leaf.is_some() && t.level < level) {
+                    b.for_each_box(|t, _, leaf| {
+                        if t.level == level || (leaf.is_some() && t.level < level) {
                             out.push((t.lo, t.hi));
                         }
                     });
@@ -237,13 +233,13 @@ impl Accel {
                 .collect(),
             Imp::Bvh(b) => {
                 let mut out = Vec::new();
-                b.for_each_box(|t| {
+                b.for_each_box(|t, parent, leaf| {
                     out.push(AccelBox {
                         lo: t.lo,
                         hi: t.hi,
                         level: t.level,
-                        parent: t.parent,
-                        prims: t.leaf.map(|w| b.leaf_prims(w)).unwrap_or_default(),
+                        parent,
+                        prims: leaf.map(|w| b.leaf_prims(w)).unwrap_or_default(),
                     });
                 });
                 out

@@ -15,7 +15,7 @@ mod traverse;
 
 use glam::{Vec3, Vec4};
 
-use super::Prim;
+use super::{Prim, VisitedBox};
 use crate::geometry::Triangles4;
 
 /// Padding of child boxes in every axis, relative to the largest coordinate magnitude of the
@@ -81,18 +81,6 @@ impl Bvh {
     }
 }
 
-/// One box of the tree as [`Bvh::for_each_box`] reports it.
-pub(in crate::accel) struct TreeBox {
-    pub lo: Vec3,
-    pub hi: Vec3,
-    /// Root = 0; a child is one below its parent.
-    pub level: u32,
-    /// Index (in report order) of the parent box; `None` for the root.
-    pub parent: Option<usize>,
-    /// The child word, for leaves (see [`LEAF`]); `None` for the root and inner nodes.
-    pub leaf: Option<u32>,
-}
-
 impl Bvh {
     /// The box of a node: the union of its children's (padded) boxes, the root's included.
     fn node_box(&self, node: u32) -> (Vec3, Vec3) {
@@ -101,29 +89,28 @@ impl Bvh {
         let mut hi = Vec3::splat(f32::NEG_INFINITY);
         for slot in 0..4 {
             if n.valid & (1 << slot) != 0 {
-                let (l, h) = slot_box(n, slot);
-                lo = lo.min(l);
-                hi = hi.max(h);
+                let b = slot_box(n, slot, 0);
+                lo = lo.min(b.lo);
+                hi = hi.max(b.hi);
             }
         }
         (lo, hi)
     }
 
-    /// Calls `f` for every box of the tree, parents before children: the root (the union of
-    /// its children), then each child slot's box (inner node or leaf), a node's children
-    /// together.
-    pub(in crate::accel) fn for_each_box(&self, mut f: impl FnMut(TreeBox)) {
+    /// Calls `f(box, parent, leaf)` for every box of the tree, parents before children: the
+    /// root (the union of its children), then each child slot's box (inner node or leaf), a
+    /// node's children together. `parent` is the index (in call order) of the enclosing box,
+    /// `None` for the root; `leaf` is the child word of a leaf (see [`LEAF`]), `None` for the
+    /// root and inner nodes.
+    pub(in crate::accel) fn for_each_box(
+        &self,
+        mut f: impl FnMut(VisitedBox, Option<usize>, Option<u32>),
+    ) {
         if self.nodes.is_empty() {
             return;
         }
         let (lo, hi) = self.node_box(0);
-        f(TreeBox {
-            lo,
-            hi,
-            level: 0,
-            parent: None,
-            leaf: None,
-        });
+        f(VisitedBox { lo, hi, level: 0 }, None, None);
         let mut count = 1;
         // (node, its index in report order, its level)
         let mut todo = vec![(0u32, 0usize, 0u32)];
@@ -133,15 +120,9 @@ impl Bvh {
                 if n.valid & (1 << slot) == 0 {
                     continue;
                 }
-                let (lo, hi) = slot_box(n, slot);
                 let word = n.child[slot];
-                f(TreeBox {
-                    lo,
-                    hi,
-                    level: level + 1,
-                    parent: Some(index),
-                    leaf: (word & LEAF != 0).then_some(word),
-                });
+                let leaf = (word & LEAF != 0).then_some(word);
+                f(slot_box(n, slot, level + 1), Some(index), leaf);
                 if word & LEAF == 0 {
                     todo.push((word, count, level + 1));
                 }
@@ -170,26 +151,27 @@ impl Bvh {
         ray: &crate::geometry::Ray,
         t_min: f32,
         t_max: f32,
-    ) -> Vec<(Vec3, Vec3, u32)> {
+    ) -> Vec<VisitedBox> {
         if self.nodes.is_empty() {
             return Vec::new();
         }
         let root = self.node_box(0);
-        let mut known = std::collections::HashMap::from([(0u32, (root.0, root.1, 0u32))]);
+        let (lo, hi) = root;
+        let mut known = std::collections::HashMap::from([(0u32, VisitedBox { lo, hi, level: 0 })]);
         let mut out = Vec::with_capacity(words.len());
         for &word in words {
             // A word not yet known would have been entered without its parent, which the
             // traversal cannot do; skipping it keeps this total.
-            let Some(&(lo, hi, level)) = known.get(&word) else {
+            let Some(&entered) = known.get(&word) else {
                 continue;
             };
-            out.push((lo, hi, level));
+            out.push(entered);
             if word & LEAF == 0 {
                 let n = &self.nodes[word as usize];
                 for slot in 0..4 {
                     if n.valid & (1 << slot) != 0 {
-                        let (l, h) = slot_box(n, slot);
-                        known.insert(n.child[slot], (l, h, level + 1));
+                        let child = slot_box(n, slot, entered.level + 1);
+                        known.insert(n.child[slot], child);
                     }
                 }
             }
@@ -205,11 +187,12 @@ impl Bvh {
     }
 }
 
-/// The padded box of a node's child slot.
-fn slot_box(n: &Node, slot: usize) -> (Vec3, Vec3) {
+/// The padded box of a node's child slot, at `level`.
+fn slot_box(n: &Node, slot: usize, level: u32) -> VisitedBox {
     let p = &n.planes;
-    (
-        Vec3::new(p[0][slot], p[2][slot], p[4][slot]),
-        Vec3::new(p[1][slot], p[3][slot], p[5][slot]),
-    )
+    VisitedBox {
+        lo: Vec3::new(p[0][slot], p[2][slot], p[4][slot]),
+        hi: Vec3::new(p[1][slot], p[3][slot], p[5][slot]),
+        level,
+    }
 }
