@@ -18,9 +18,10 @@ use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::accel::{Accel, AccelKind, PrimHit, PrimSet};
+use crate::accel::{Accel, AccelKind, PrimHit, PrimSet, Visits};
 use crate::geometry::{
-    Methods, Ray, intersect_sphere, offset_ray_origin, sphere_hit_point, triangle_hit_point,
+    Methods, OffsetMethod, Ray, intersect_sphere, offset_ray_origin, sphere_hit_point,
+    triangle_hit_point,
 };
 use crate::scene::{MaterialId, ObjectId, Scene};
 use crate::shade::{LightTerms, ambient_term, light_terms, reflect, refract};
@@ -199,6 +200,15 @@ pub struct Tracer {
     visible_lights: Vec<usize>,
     /// Seconds spent building the accelerator.
     pub build_secs: f64,
+}
+
+/// Which of a ray's accelerator queries [`Tracer::visits_of`] replays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VisitQuery {
+    /// The ray's closest hit.
+    Closest,
+    /// The shadow ray towards light `light` (its index in the scene) from the ray's hit.
+    Shadow { light: usize },
 }
 
 enum Found {
@@ -399,12 +409,8 @@ impl Tracer {
             let mut blocked_by = None;
             let mut blocked_at = None;
             if n_dot_l > 0.0 {
-                // The shadow ray runs from the offset origin to the light's centre; only
-                // objects count as blockers, never lights.
-                let origin = offset_ray_origin(offset, p, error, n, l);
-                let segment = light.position - origin;
-                let length = segment.length();
-                let shadow_ray = Ray::new(origin, div3(segment, length));
+                // Only objects count as blockers, never lights.
+                let (shadow_ray, length) = shadow_ray(offset, p, error, n, l, light.position);
                 counts.count(RayKind::Shadow);
                 info.rays += 1;
                 let blocked = if R::ENABLED {
@@ -495,6 +501,37 @@ impl Tracer {
         color
     }
 
+    /// Replays one ray's accelerator query with the boxes it entered and the primitives it
+    /// tested, for a ray-tree [`Node`](crate::ray_tree::Node) (its offset `origin` and unit
+    /// `direction`): [`VisitQuery::Closest`] is the node's own query, `(0, ∞)` as
+    /// [`Tracer::trace`] casts it, so its hit is the node's unless a visible light ended the ray
+    /// first (lights are not in the accelerator); [`VisitQuery::Shadow`] is the shadow ray the
+    /// render casts from that hit towards a light (same offset origin and length), answered by
+    /// the occlusion query the image uses. A shadow query whose ray hits no surface, or whose
+    /// light is behind the surface (no shadow ray is cast), or out of range, visits nothing.
+    pub fn visits_of(&self, origin: Vec3, direction: Vec3, query: VisitQuery) -> Visits {
+        let ray = Ray::new(origin, direction);
+        let m = self.methods();
+        let closest = self.accel.closest_hit_visits(m, &ray, 0.0, f32::INFINITY);
+        let VisitQuery::Shadow { light } = query else {
+            return closest;
+        };
+        let (Some(hit), Some(light)) = (closest.hit, self.scene.lights.get(light)) else {
+            return Visits::default();
+        };
+        let (surface, error) = self.surface(&ray, &hit);
+        let to_light = light.position - surface.point;
+        let l = div3(to_light, to_light.length());
+        // As in `shade`: no shadow ray unless N·L > 0.
+        if surface.normal.dot(l) > 0.0 {
+            let (p, n) = (surface.point, surface.normal);
+            let (shadow, length) = shadow_ray(m.offset, p, error, n, l, light.position);
+            self.accel.occluded_visits(m, &shadow, 0.0, length)
+        } else {
+            Visits::default()
+        }
+    }
+
     /// The object a primitive id belongs to.
     pub fn object_of(&self, prim: u32) -> ObjectId {
         let prim = prim as usize;
@@ -505,6 +542,23 @@ impl Tracer {
             self.scene.triangles[prim - n_spheres].object
         }
     }
+}
+
+/// The shadow ray from hit point `p` (error bound `error`, normal `n`) towards the light at
+/// `light` in direction `l`: from the offset origin to the light's centre, and its length.
+#[inline(always)]
+fn shadow_ray(
+    offset: OffsetMethod,
+    p: Vec3,
+    error: Vec3,
+    n: Vec3,
+    l: Vec3,
+    light: Vec3,
+) -> (Ray, f32) {
+    let origin = offset_ray_origin(offset, p, error, n, l);
+    let segment = light - origin;
+    let length = segment.length();
+    (Ray::new(origin, div3(segment, length)), length)
 }
 
 /// `v / s`, the three quotients in one SSE division: each lane rounds exactly as the scalar

@@ -584,3 +584,341 @@ fn large_scene_built_with_the_fast_preset_agrees_with_the_grid() {
     }
     assert!(hits > 1000, "too few hits to be a test: {hits}");
 }
+
+// ---- The accelerator made visible (issue 12): what one ray's traversal entered and tested. ----
+
+/// Scenes for the visit tests: mixed random primitives, a closed mesh, a flat plane (the grid
+/// has one cell layer) and a large random soup (a deep tree).
+fn visit_scenes(rng: &mut Pcg) -> Vec<(&'static str, PrimSet)> {
+    let (verts, idx) = octasphere(3, 1.5, Vec3::new(0.2, -0.1, 0.3));
+    vec![
+        ("mixed", random_scene(rng, 30, 150, 2.0, 0.4)),
+        (
+            "octasphere",
+            PrimSet {
+                spheres: vec![(Vec3::new(0.2, -0.1, 0.3), 0.5)],
+                triangles: idx.iter().map(|t| t.map(|i| verts[i])).collect(),
+            },
+        ),
+        (
+            "plane",
+            PrimSet {
+                spheres: vec![],
+                triangles: plane(12, 4.0, -0.5),
+            },
+        ),
+        ("soup", random_scene(rng, 200, 2500, 3.0, 0.15)),
+    ]
+}
+
+/// Whether the ray's `(t_min, t_max)` meets the box, in `f64`, with the box grown by a small
+/// tolerance of its magnitude (the traversal pads boxes and widens its slab test).
+fn meets(ray: &Ray, t_min: f32, t_max: f32, lo: Vec3, hi: Vec3) -> bool {
+    let (mut t0, mut t1) = (f64::from(t_min), f64::from(t_max));
+    let magnitude = f64::from(lo.abs().max(hi.abs()).max_element());
+    for axis in 0..3 {
+        let o = f64::from(ray.origin[axis]);
+        let d = f64::from(ray.dir[axis]);
+        let tol = 1e-5 * (1.0 + magnitude + o.abs());
+        let (l, h) = (f64::from(lo[axis]) - tol, f64::from(hi[axis]) + tol);
+        if d == 0.0 {
+            if o < l || o > h {
+                return false;
+            }
+            continue;
+        }
+        let (a, b) = ((l - o) / d, (h - o) / d);
+        t0 = t0.max(a.min(b));
+        t1 = t1.min(a.max(b));
+    }
+    t0 <= t1 + 1e-6 * (1.0 + t1.abs().min(1e30))
+}
+
+/// The primitive's bounds, for the containment checks (invalid primitives have none).
+fn prim_bounds(p: &PrimSet, id: usize) -> (Vec3, Vec3) {
+    if id < p.spheres.len() {
+        let (c, r) = p.spheres[id];
+        (c - r, c + r)
+    } else {
+        let [a, b, c] = p.triangles[id - p.spheres.len()];
+        (a.min(b).min(c), a.max(b).max(c))
+    }
+}
+
+/// The visits of the closest-hit query (`false`) and of the occlusion query (`true`).
+fn both_visits(
+    a: &Accel,
+    m: &Methods,
+    ray: &Ray,
+    t_min: f32,
+    t_max: f32,
+) -> [(bool, raytree::accel::Visits); 2] {
+    [
+        (false, a.closest_hit_visits(m, ray, t_min, t_max)),
+        (true, a.occluded_visits(m, ray, t_min, t_max)),
+    ]
+}
+
+/// A box as a hashable key: its corners' bits.
+fn box_key(lo: Vec3, hi: Vec3) -> [u32; 6] {
+    let (l, h) = (lo.to_array(), hi.to_array());
+    [l[0], l[1], l[2], h[0], h[1], h[2]].map(f32::to_bits)
+}
+
+fn inside(lo: Vec3, hi: Vec3, outer: (Vec3, Vec3), tol: f32) -> bool {
+    lo.cmpge(outer.0 - tol).all() && hi.cmple(outer.1 + tol).all()
+}
+
+/// (a) A recording query gives the answer of the plain one, for every kind, on many rays; the
+/// hit primitive is among those tested.
+#[test]
+fn visits_answer_as_the_plain_queries() {
+    let mut rng = Pcg::new(12);
+    let m = default_methods();
+    let mut hits = 0;
+    for (name, scene) in visit_scenes(&mut rng) {
+        let rays = rays_for(&scene, &mut rng, 1500);
+        for k in KINDS {
+            let a = Accel::build(k, &scene);
+            for (i, (ray, t_min, t_max)) in rays.iter().enumerate() {
+                let closest = a.closest_hit_visits(&m, ray, *t_min, *t_max);
+                assert_eq!(
+                    closest.hit,
+                    a.closest_hit(&m, ray, *t_min, *t_max),
+                    "{name} {k:?} ray {i}"
+                );
+                let any = a.occluded_visits(&m, ray, *t_min, *t_max);
+                assert_eq!(
+                    any.hit.is_some(),
+                    a.occluded(&m, ray, *t_min, *t_max),
+                    "{name} {k:?} ray {i}"
+                );
+                for (v, what) in [(&closest, "closest"), (&any, "occluded")] {
+                    if let Some(h) = v.hit {
+                        assert!(v.prims.contains(&h.prim), "{name} {k:?} {what} ray {i}");
+                        assert!(h.t > *t_min && h.t <= *t_max, "{name} {k:?} {what} {i}");
+                    }
+                    if k == AccelKind::None {
+                        assert!(v.boxes.is_empty());
+                    }
+                }
+                // Occlusion stops at the first hit: never more tests than the closest hit.
+                if k == AccelKind::None {
+                    assert!(any.prims.len() <= closest.prims.len());
+                }
+                hits += usize::from(closest.hit.is_some());
+            }
+        }
+    }
+    assert!(hits > 5000, "too few hits to be a test: {hits}");
+}
+
+/// (b) The BVH's visited boxes against a brute-force look at the same boxes: every box entered
+/// meets the ray's interval; every box from the root to the hit's leaf is entered; every tested
+/// primitive lies in an entered leaf; a ray that misses the root box enters nothing.
+#[test]
+fn bvh_visits_match_a_brute_force_walk_of_its_boxes() {
+    let mut rng = Pcg::new(13);
+    let m = default_methods();
+    let mut checked_paths = 0;
+    for (name, scene) in visit_scenes(&mut rng) {
+        let a = Accel::build(AccelKind::Bvh, &scene);
+        let boxes = a.boxes();
+        let key = |lo: Vec3, hi: Vec3, level: u32| (box_key(lo, hi), level);
+        let rays = rays_for(&scene, &mut rng, 1500);
+        for (i, (ray, t_min, t_max)) in rays.iter().enumerate() {
+            for (occlusion, v) in both_visits(&a, &m, ray, *t_min, *t_max) {
+                let entered: std::collections::HashSet<_> =
+                    v.boxes.iter().map(|b| key(b.lo, b.hi, b.level)).collect();
+                for b in &v.boxes {
+                    assert!(
+                        meets(ray, *t_min, *t_max, b.lo, b.hi),
+                        "{name} ray {i}: entered {b:?}, which the ray misses: {ray:?} {t_min} {t_max} {v:?}"
+                    );
+                }
+                if !v.boxes.is_empty() {
+                    assert_eq!(v.boxes[0].level, 0, "{name} ray {i}: starts at the root");
+                }
+                // The leaves entered and what they hold.
+                let mut in_leaves = std::collections::HashSet::new();
+                for b in boxes.iter().filter(|b| !b.prims.is_empty()) {
+                    if entered.contains(&key(b.lo, b.hi, b.level)) {
+                        in_leaves.extend(b.prims.iter().copied());
+                    }
+                }
+                for p in &v.prims {
+                    assert!(in_leaves.contains(p), "{name} ray {i}: {p} not in a leaf");
+                }
+                if let (false, Some(hit)) = (occlusion, v.hit) {
+                    let leaf = boxes
+                        .iter()
+                        .position(|b| b.prims.contains(&hit.prim))
+                        .expect("the hit's leaf");
+                    let mut at = Some(leaf);
+                    while let Some(b) = at {
+                        let b = &boxes[b];
+                        assert!(
+                            entered.contains(&key(b.lo, b.hi, b.level)),
+                            "{name} ray {i}: the path to the hit skips {b:?}"
+                        );
+                        at = b.parent;
+                    }
+                    checked_paths += 1;
+                }
+            }
+        }
+        // Rays that leave the root box behind them, or pass beside it, enter nothing.
+        let root = &boxes[0];
+        let (c, size) = ((root.lo + root.hi) * 0.5, (root.hi - root.lo).length());
+        for _ in 0..300 {
+            let u = rng.unit();
+            let away = Ray::new(c + u * size, u);
+            let side = rng.perpendicular(u).normalize();
+            let beside = Ray::new(c + side * size - u * (2.0 * size), u);
+            for ray in [away, beside] {
+                assert!(!meets(&ray, 0.0, f32::INFINITY, root.lo, root.hi));
+                for v in [
+                    a.closest_hit_visits(&m, &ray, 0.0, f32::INFINITY),
+                    a.occluded_visits(&m, &ray, 0.0, f32::INFINITY),
+                ] {
+                    assert!(v.boxes.is_empty() && v.prims.is_empty(), "{name}: {v:?}");
+                }
+            }
+        }
+    }
+    assert!(checked_paths > 2000, "{checked_paths}");
+}
+
+/// (c) The levels of the BVH: level 0 is the root box, holding every primitive; each box of
+/// level k + 1 lies inside one of level k; every level holds every primitive.
+#[test]
+fn bvh_levels_nest_and_hold_every_primitive() {
+    let mut rng = Pcg::new(14);
+    for (name, scene) in visit_scenes(&mut rng) {
+        let a = Accel::build(AccelKind::Bvh, &scene);
+        let levels = a.levels();
+        let boxes = a.boxes();
+        assert_eq!(
+            levels,
+            boxes.iter().map(|b| b.level).max().expect("boxes") + 1,
+            "{name}"
+        );
+        assert!(levels >= 2, "{name}: {levels}");
+        assert!(a.level_boxes(levels).is_empty());
+        let root = a.level_boxes(0);
+        assert_eq!(root.len(), 1, "{name}");
+        assert_eq!((boxes[0].lo, boxes[0].hi), root[0]);
+        let ids = 0..scene.spheres.len() + scene.triangles.len();
+        for k in 0..levels {
+            let level = a.level_boxes(k);
+            assert!(!level.is_empty(), "{name} level {k}");
+            for id in ids.clone() {
+                let (lo, hi) = prim_bounds(&scene, id);
+                let tol = 1e-5 * (1.0 + lo.abs().max(hi.abs()).max_element());
+                assert!(
+                    level.iter().any(|b| inside(lo, hi, *b, tol)),
+                    "{name}: level {k} loses primitive {id}"
+                );
+            }
+            if k + 1 < levels {
+                for (lo, hi) in a.level_boxes(k + 1) {
+                    assert!(
+                        level.iter().any(|b| inside(lo, hi, *b, 0.0)),
+                        "{name}: a box of level {} sticks out of level {k}",
+                        k + 1
+                    );
+                }
+            }
+        }
+        // Every primitive is in exactly one leaf, and a leaf's box holds its primitives.
+        let mut seen = vec![0; ids.len()];
+        for b in &boxes {
+            for &p in &b.prims {
+                seen[p as usize] += 1;
+                let (lo, hi) = prim_bounds(&scene, p as usize);
+                let tol = 1e-5 * (1.0 + lo.abs().max(hi.abs()).max_element());
+                assert!(inside(lo, hi, (b.lo, b.hi), tol), "{name}: {p}");
+            }
+            if let Some(parent) = b.parent {
+                assert_eq!(boxes[parent].level + 1, b.level);
+                assert!(
+                    boxes[parent].prims.is_empty(),
+                    "{name}: a leaf with children"
+                );
+            }
+        }
+        assert!(seen.iter().all(|&n| n == 1), "{name}: {seen:?}");
+    }
+}
+
+/// (d) Grid cells: the cells entered are consecutive along the ray (each shares a face with
+/// the one before, as the 3D-DDA steps), and the primitives tested are those of the entered
+/// cells, in order (all of them for the closest hit, a prefix for occlusion).
+#[test]
+fn grid_visits_step_cell_by_cell() {
+    let mut rng = Pcg::new(15);
+    let m = default_methods();
+    let mut long_walks = 0;
+    for (name, scene) in visit_scenes(&mut rng) {
+        let a = Accel::build(AccelKind::Grid, &scene);
+        assert_eq!(a.levels(), 0);
+        let cells: std::collections::HashMap<_, Vec<u32>> = a
+            .boxes()
+            .into_iter()
+            .map(|b| (box_key(b.lo, b.hi), b.prims))
+            .collect();
+        assert_eq!(a.level_boxes(0).len(), cells.len(), "{name}");
+        assert!(a.level_boxes(1).is_empty());
+        for id in 0..scene.spheres.len() + scene.triangles.len() {
+            assert!(cells.values().any(|p| p.contains(&(id as u32))), "{name}");
+        }
+        let rays = rays_for(&scene, &mut rng, 1500);
+        for (i, (ray, t_min, t_max)) in rays.iter().enumerate() {
+            for (occlusion, v) in both_visits(&a, &m, ray, *t_min, *t_max) {
+                for b in &v.boxes {
+                    assert_eq!(b.level, 0);
+                    assert!(
+                        meets(ray, *t_min, *t_max, b.lo, b.hi),
+                        "{name} ray {i} {ray:?} {t_min} {t_max} {b:?} {v:?}"
+                    );
+                }
+                for w in v.boxes.windows(2) {
+                    let (p, q) = (&w[0], &w[1]);
+                    let stepped: Vec<usize> = (0..3)
+                        .filter(|&axis| (p.lo[axis], p.hi[axis]) != (q.lo[axis], q.hi[axis]))
+                        .collect();
+                    assert_eq!(stepped.len(), 1, "{name} ray {i}: {p:?} then {q:?}");
+                    let axis = stepped[0];
+                    assert!(
+                        p.hi[axis] == q.lo[axis] || p.lo[axis] == q.hi[axis],
+                        "{name} ray {i}: {p:?} then {q:?} do not touch"
+                    );
+                }
+                let listed: Vec<u32> = v
+                    .boxes
+                    .iter()
+                    .flat_map(|b| cells.get(&box_key(b.lo, b.hi)).cloned().unwrap_or_default())
+                    .collect();
+                if occlusion {
+                    assert!(listed.starts_with(&v.prims), "{name} ray {i}");
+                } else {
+                    assert_eq!(listed, v.prims, "{name} ray {i}");
+                }
+                long_walks += usize::from(v.boxes.len() > 3);
+            }
+        }
+    }
+    assert!(long_walks > 1000, "{long_walks}");
+    // Axis-parallel rays beside the grid (and one leaving it) enter no cell.
+    let scene = random_scene(&mut rng, 20, 100, 1.0, 0.3);
+    let a = Accel::build(AccelKind::Grid, &scene);
+    for ray in [
+        Ray::new(Vec3::new(-3.0, 5.0, 0.0), Vec3::X),
+        Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::Y),
+        Ray::new(Vec3::new(5.0, 0.0, 0.0), Vec3::X),
+        Ray::new(Vec3::new(5.0, 5.0, 5.0), Vec3::ONE.normalize()),
+    ] {
+        let v = a.closest_hit_visits(&m, &ray, 0.0, f32::INFINITY);
+        assert!(v.boxes.is_empty() && v.prims.is_empty(), "{ray:?}: {v:?}");
+    }
+}

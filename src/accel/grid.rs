@@ -17,7 +17,7 @@
 //! camera in practice.
 use glam::{IVec3, Vec3};
 
-use super::{Prim, Visitor, box_t_slack, safe_inv};
+use super::{Prim, Visitor, safe_inv, slab};
 
 /// Target cells per primitive (the `λ` in `res = cbrt(λ·N/V)·extent`). 4 is the usual middle
 /// of the 2…8 range; issue 5 measures it.
@@ -150,6 +150,44 @@ impl Grid {
             .sum()
     }
 
+    /// Cell boundary `res` on each axis: the grid box is `[lo, far_corner()]`.
+    fn far_corner(&self) -> Vec3 {
+        Vec3::new(
+            self.plane(0, self.res.x),
+            self.plane(1, self.res.y),
+            self.plane(2, self.res.z),
+        )
+    }
+
+    /// The box of cell `c` (a [`Grid::cell_index`]), bounded by the same planes the traversal
+    /// crosses.
+    pub(super) fn cell_box(&self, c: usize) -> (Vec3, Vec3) {
+        let (nx, ny) = (self.res.x as usize, self.res.y as usize);
+        let i = [c % nx, (c / nx) % ny, c / (nx * ny)].map(|i| i as i32);
+        let lo = Vec3::new(
+            self.plane(0, i[0]),
+            self.plane(1, i[1]),
+            self.plane(2, i[2]),
+        );
+        let hi = Vec3::new(
+            self.plane(0, i[0] + 1),
+            self.plane(1, i[1] + 1),
+            self.plane(2, i[2] + 1),
+        );
+        (lo, hi)
+    }
+
+    /// The ids of the primitives listed in cell `c`.
+    pub(super) fn cell_prims(&self, c: usize) -> impl Iterator<Item = u32> + '_ {
+        let (s, e) = (self.cell_start[c] as usize, self.cell_start[c + 1] as usize);
+        self.items[s..e].iter().map(|&p| self.prims[p as usize].id)
+    }
+
+    /// Number of cells.
+    pub(super) fn cells(&self) -> usize {
+        self.cell_start.len() - 1
+    }
+
     #[inline(always)]
     fn cell_index(&self, x: i32, y: i32, z: i32) -> usize {
         (x + self.res.x * (y + self.res.y * z)) as usize
@@ -216,17 +254,9 @@ impl Grid {
         let t_plane = |axis: usize, i: i32| (self.plane(axis, i) - o[axis]) * inv[axis];
 
         // Clip to the grid box [plane(0), plane(res)], widened by the slab test's rounding.
-        let mut t_enter = f32::NEG_INFINITY;
-        let mut t_exit = f32::INFINITY;
-        for axis in 0..3 {
-            let ta = t_plane(axis, 0);
-            let tb = t_plane(axis, self.res[axis]);
-            t_enter = t_enter.max(ta.min(tb));
-            t_exit = t_exit.min(ta.max(tb));
-        }
-        let slack = box_t_slack();
-        let t0 = (t_enter - t_enter.abs() * slack).max(t_min);
-        let t1 = (t_exit + t_exit.abs() * slack).min(t_max);
+        let (t_enter, t_exit) = slab(o, inv, self.lo, self.far_corner());
+        let t0 = t_enter.max(t_min);
+        let t1 = t_exit.min(t_max);
         if t0.is_nan() || t1.is_nan() || t0 > t1 {
             return;
         }
@@ -270,6 +300,7 @@ impl Grid {
 
         loop {
             let c = self.cell_index(idx[0], idx[1], idx[2]);
+            v.enter(c as u32);
             let (s, e) = (self.cell_start[c] as usize, self.cell_start[c + 1] as usize);
             for &p in &self.items[s..e] {
                 if v.visit(&self.prims[p as usize]) {

@@ -22,6 +22,9 @@
 
 mod bvh;
 mod grid;
+mod visits;
+
+pub use visits::{AccelBox, VisitedBox, Visits};
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -162,6 +165,11 @@ trait Visitor {
     /// Test the triangles in lanes `0..count` of `tris` (ids `ids`), in lane order, with one
     /// four-lane test; the same answer as visiting them one by one. `true` stops.
     fn visit_triangles(&mut self, tris: &Triangles4, ids: &[u32; 4], count: usize) -> bool;
+    /// The traversal enters a box: a BVH child word (node or leaf) or a grid cell index. Only
+    /// the recording visitor of [`visits`] looks; for the others this compiles away, so the
+    /// queries of a render are not slowed by it.
+    #[inline(always)]
+    fn enter(&mut self, _key: u32) {}
 }
 
 /// What every visitor tests primitives with: the methods, the ray, its shear (for the
@@ -483,6 +491,29 @@ fn safe_inv(d: Vec3) -> Vec3 {
         }
     };
     Vec3::new(f(d.x), f(d.y), f(d.z))
+}
+
+/// The `t` interval in which the ray `o + t·d` (with `inv` = `1/d` per axis) meets the box
+/// `[lo, hi]`, both ends widened by [`box_t_slack`]; empty (or NaN) when it misses.
+#[inline(always)]
+fn slab(o: Vec3, inv: Vec3, lo: Vec3, hi: Vec3) -> (f32, f32) {
+    let mut t_enter = f32::NEG_INFINITY;
+    let mut t_exit = f32::INFINITY;
+    for axis in 0..3 {
+        let ta = (lo[axis] - o[axis]) * inv[axis];
+        let tb = (hi[axis] - o[axis]) * inv[axis];
+        t_enter = t_enter.max(ta.min(tb));
+        t_exit = t_exit.min(ta.max(tb));
+    }
+    // An infinite end (an axis-parallel ray beside the box: `±∞` from the clamped `1/d`) is
+    // kept as it is: widening it would give `∞ − ∞ = NaN`, which `max`/`min` with the query's
+    // interval then silently drop, turning a miss into a walk over the whole box.
+    let slack = box_t_slack();
+    let widen = |t: f32, by: f32| if t.is_finite() { t + by } else { t };
+    (
+        widen(t_enter, -t_enter.abs() * slack),
+        widen(t_exit, t_exit.abs() * slack),
+    )
 }
 
 /// Relative widening of both ends of a slab test's `t` interval (pbrt-v4 widens the far end:

@@ -13,9 +13,9 @@
 mod build;
 mod traverse;
 
-use glam::Vec4;
+use glam::{Vec3, Vec4};
 
-use super::Prim;
+use super::{Prim, VisitedBox};
 use crate::geometry::Triangles4;
 
 /// Padding of child boxes in every axis, relative to the largest coordinate magnitude of the
@@ -78,5 +78,121 @@ impl Bvh {
 
     pub(in crate::accel) fn depth(&self) -> usize {
         self.depth
+    }
+}
+
+impl Bvh {
+    /// The box of a node: the union of its children's (padded) boxes, the root's included.
+    fn node_box(&self, node: u32) -> (Vec3, Vec3) {
+        let n = &self.nodes[node as usize];
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for slot in 0..4 {
+            if n.valid & (1 << slot) != 0 {
+                let b = slot_box(n, slot, 0);
+                lo = lo.min(b.lo);
+                hi = hi.max(b.hi);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// Calls `f(box, parent, leaf)` for every box of the tree, parents before children: the
+    /// root (the union of its children), then each child slot's box (inner node or leaf), a
+    /// node's children together. `parent` is the index (in call order) of the enclosing box,
+    /// `None` for the root; `leaf` is the child word of a leaf (see [`LEAF`]), `None` for the
+    /// root and inner nodes.
+    pub(in crate::accel) fn for_each_box(
+        &self,
+        mut f: impl FnMut(VisitedBox, Option<usize>, Option<u32>),
+    ) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let (lo, hi) = self.node_box(0);
+        f(VisitedBox { lo, hi, level: 0 }, None, None);
+        let mut count = 1;
+        // (node, its index in report order, its level)
+        let mut todo = vec![(0u32, 0usize, 0u32)];
+        while let Some((node, index, level)) = todo.pop() {
+            let n = &self.nodes[node as usize];
+            for slot in 0..4 {
+                if n.valid & (1 << slot) == 0 {
+                    continue;
+                }
+                let word = n.child[slot];
+                let leaf = (word & LEAF != 0).then_some(word);
+                f(slot_box(n, slot, level + 1), Some(index), leaf);
+                if word & LEAF == 0 {
+                    todo.push((word, count, level + 1));
+                }
+                count += 1;
+            }
+        }
+    }
+
+    /// The primitive ids of a leaf word, in lane order.
+    pub(in crate::accel) fn leaf_prims(&self, word: u32) -> Vec<u32> {
+        if word & SPHERE != 0 {
+            vec![self.spheres[(word & !(LEAF | SPHERE)) as usize].id]
+        } else {
+            let packet = &self.packets[((word & !LEAF) >> 2) as usize];
+            packet.ids[..(word & 3) as usize + 1].to_vec()
+        }
+    }
+
+    /// The boxes and levels of the child words a traversal entered, in the order given (the
+    /// order of a traversal, so every word's parent comes before it). The root (word 0, which
+    /// every traversal starts at) is kept when the ray's `(t_min, t_max)` meets its box or
+    /// anything below it was entered, so a ray that misses the tree entered nothing.
+    pub(in crate::accel) fn entered_boxes(
+        &self,
+        words: &[u32],
+        ray: &crate::geometry::Ray,
+        t_min: f32,
+        t_max: f32,
+    ) -> Vec<VisitedBox> {
+        if self.nodes.is_empty() {
+            return Vec::new();
+        }
+        let root = self.node_box(0);
+        let (lo, hi) = root;
+        let mut known = std::collections::HashMap::from([(0u32, VisitedBox { lo, hi, level: 0 })]);
+        let mut out = Vec::with_capacity(words.len());
+        for &word in words {
+            // A word not yet known would have been entered without its parent, which the
+            // traversal cannot do; skipping it keeps this total.
+            let Some(&entered) = known.get(&word) else {
+                continue;
+            };
+            out.push(entered);
+            if word & LEAF == 0 {
+                let n = &self.nodes[word as usize];
+                for slot in 0..4 {
+                    if n.valid & (1 << slot) != 0 {
+                        let child = slot_box(n, slot, entered.level + 1);
+                        known.insert(n.child[slot], child);
+                    }
+                }
+            }
+        }
+        if out.len() == 1 && words.first() == Some(&0) {
+            let (t0, t1) = super::slab(ray.origin, super::safe_inv(ray.dir), root.0, root.1);
+            let meets = t0.max(t_min) <= t1.min(t_max);
+            if !meets {
+                out.clear();
+            }
+        }
+        out
+    }
+}
+
+/// The padded box of a node's child slot, at `level`.
+fn slot_box(n: &Node, slot: usize, level: u32) -> VisitedBox {
+    let p = &n.planes;
+    VisitedBox {
+        lo: Vec3::new(p[0][slot], p[2][slot], p[4][slot]),
+        hi: Vec3::new(p[1][slot], p[3][slot], p[5][slot]),
+        level,
     }
 }

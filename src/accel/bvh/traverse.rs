@@ -60,6 +60,7 @@ impl Bvh {
         let (nx, ny, nz) = (r.near[0], r.near[1], r.near[2]);
         let (fx, fy, fz) = (nx ^ 1, ny ^ 1, nz ^ 1);
         loop {
+            v.enter(word);
             if word & LEAF != 0 {
                 let stop = if word & SPHERE != 0 {
                     v.visit(&self.spheres[(word & !(LEAF | SPHERE)) as usize])
