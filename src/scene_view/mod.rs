@@ -10,10 +10,11 @@ pub mod raster;
 
 use glam::Vec3;
 
+use crate::accel::Visits;
 use crate::export::to_srgb8;
 use crate::ray_tree::{Node, RayTree};
 use crate::scene::{CameraFrame, Scene};
-use crate::trace::{EndReason, RayKind};
+use crate::trace::{EndReason, RayKind, Tracer, VisitQuery};
 
 /// A node's place in its tree: the child indices from the root.
 pub type NodePath = Vec<usize>;
@@ -40,6 +41,10 @@ pub enum Style {
     ImagePlane,
     /// The clicked pixel on the image plane.
     Pixel,
+    /// A box (BVH node or grid cell) the selected ray's traversal entered.
+    VisitedBox,
+    /// A box of the BVH level shown.
+    LevelBox,
 }
 
 /// sRGB colour and opacity of each style: the one palette of ray kinds, used by the tree's
@@ -64,6 +69,8 @@ pub fn style_rgba(style: Style) -> [u8; 4] {
         Style::Frustum => [150, 150, 150, 200],
         Style::ImagePlane => [200, 200, 200, 230],
         Style::Pixel => [255, 255, 255, 255],
+        Style::VisitedBox => [0, 230, 230, 220],
+        Style::LevelBox => [160, 160, 255, 110],
     }
 }
 
@@ -141,7 +148,11 @@ impl Filter {
             },
             Style::ShadowLit | Style::ShadowBlocked | Style::ShadowPastBlocker => self.shadow,
             Style::Normal => self.normals,
-            Style::Frustum | Style::ImagePlane | Style::Pixel => true,
+            Style::Frustum
+            | Style::ImagePlane
+            | Style::Pixel
+            | Style::VisitedBox
+            | Style::LevelBox => true,
         }
     }
 }
@@ -268,8 +279,8 @@ pub fn camera_segments(scene: &Scene, plane: f32, pixel: Option<[u32; 2]>) -> Ve
     }
     if let Some([x, y]) = pixel {
         let (x, y) = (x as f32, y as f32);
-        // The pixel's square, at least a hundredth of the plane wide so it can be seen.
-        let r = (0.5f32).max(wf.max(hf) * 0.005);
+        // A cross over the pixel, 4 % of the plane wide so it can be seen at any size.
+        let r = (0.5f32).max(wf.max(hf) * 0.02);
         let (cx, cy) = (x + 0.5, y + 0.5);
         out.push(seg(at(cx - r, cy - r), at(cx + r, cy + r), Style::Pixel));
         out.push(seg(at(cx - r, cy + r), at(cx + r, cy - r), Style::Pixel));
@@ -307,6 +318,58 @@ pub fn light_markers(scene: &Scene) -> Vec<LightMarker> {
                 radius: l.radius,
             }
         })
+        .collect()
+}
+
+/// The twelve edges of the box `lo..hi` in `style`.
+pub fn box_segments(lo: Vec3, hi: Vec3, style: Style) -> Vec<Segment> {
+    let corner = |i: usize| {
+        Vec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    };
+    // Corner pairs that differ in one bit are the edges.
+    (0..8)
+        .flat_map(|i| [1, 2, 4].map(move |bit| (i, i | bit)))
+        .filter(|&(i, j)| i != j)
+        .map(|(i, j)| Segment {
+            a: corner(i),
+            b: corner(j),
+            style,
+            path: Vec::new(),
+            generation: 0,
+            end: None,
+        })
+        .collect()
+}
+
+/// What the accelerator did for the ray of node `path` of `tree`: the boxes it entered as
+/// segments, and the counts (boxes entered, primitives tested). `None` when the path is not
+/// in the tree.
+pub fn visit_segments(
+    tracer: &Tracer,
+    tree: &RayTree,
+    path: &[usize],
+) -> Option<(Vec<Segment>, Visits)> {
+    let node = node_at(&tree.root, path)?;
+    let visits = tracer.visits_of(node.origin, node.direction, VisitQuery::Closest);
+    let segments = visits
+        .boxes
+        .iter()
+        .flat_map(|b| box_segments(b.lo, b.hi, Style::VisitedBox))
+        .collect();
+    Some((segments, visits))
+}
+
+/// Every box of level `level` of the tracer's BVH (or the grid's non-empty cells) as segments.
+pub fn level_segments(tracer: &Tracer, level: u32) -> Vec<Segment> {
+    tracer
+        .accel
+        .level_boxes(level)
+        .into_iter()
+        .flat_map(|(lo, hi)| box_segments(lo, hi, Style::LevelBox))
         .collect()
 }
 
@@ -413,5 +476,38 @@ mod tests {
         );
         let dir = (centre - scene.camera.position).normalize();
         assert!(dir.abs_diff_eq(tree.root.direction, 1e-4));
+    }
+
+    #[test]
+    fn a_box_has_twelve_edges_of_its_sides() {
+        let edges = box_segments(Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0), Style::LevelBox);
+        assert_eq!(edges.len(), 12);
+        let mut lengths: Vec<f32> = edges.iter().map(|e| (e.b - e.a).length()).collect();
+        lengths.sort_by(f32::total_cmp);
+        assert_eq!(
+            lengths,
+            [1.0, 1.0, 1.0, 1.0, 2.0, 2.0, 2.0, 2.0, 3.0, 3.0, 3.0, 3.0]
+        );
+    }
+
+    #[test]
+    fn the_selected_rays_visits_are_boxes_around_its_path() {
+        let scene = load_builtin("default").expect("built-in");
+        let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());
+        let tree = pixel_tree(&tracer, 320, 300).expect("inside");
+        let (segments, visits) = visit_segments(&tracer, &tree, &[]).expect("the root");
+        assert_eq!(segments.len(), 12 * visits.boxes.len());
+        assert!(!visits.boxes.is_empty() && !visits.prims.is_empty());
+        // The hit lies inside an entered box.
+        let p = tree.root.hit.as_ref().expect("a hit").point;
+        assert!(
+            visits
+                .boxes
+                .iter()
+                .any(|b| (b.lo - Vec3::splat(1e-3)).cmple(p).all()
+                    && p.cmple(b.hi + Vec3::splat(1e-3)).all())
+        );
+        assert!(visit_segments(&tracer, &tree, &[7, 7]).is_none());
+        assert!(!level_segments(&tracer, 0).is_empty());
     }
 }
