@@ -9,10 +9,13 @@ mod file_browser;
 mod film;
 mod input;
 pub mod modes;
+mod paint3d;
 mod panels;
+pub mod scene_pane;
 pub mod sweep;
 pub mod tree_view;
 pub mod viewport;
+pub mod workspace;
 
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -42,6 +45,8 @@ pub struct Prefs {
     pub tonemap: u32,
     pub mode: ImageMode,
     pub last_dir: Option<PathBuf>,
+    /// The panes' arrangement (replaced by the default when unusable).
+    pub layout: workspace::Layout,
 }
 
 impl Default for Prefs {
@@ -51,6 +56,7 @@ impl Default for Prefs {
             tonemap: 0,
             mode: ImageMode::Render,
             last_dir: None,
+            layout: workspace::default_layout(),
         }
     }
 }
@@ -60,6 +66,9 @@ impl Default for Prefs {
 pub enum Command {
     /// The working copy of the scene or settings changed: render it.
     Restart,
+    /// Only the render camera moved: render again, but the scene view's picture (which does
+    /// not depend on the render camera) stays.
+    MoveCamera,
     /// The scene's geometry or the accelerator changed: rebuild it, then render.
     Rebuild,
     OpenFile(PathBuf),
@@ -69,6 +78,11 @@ pub enum Command {
     ExportTree(PathBuf),
     /// Show the ray tree of this pixel and select its material.
     Pick(u32, u32),
+    /// Add this pixel's tree to the trees shown (shift-click).
+    PickMore(u32, u32),
+    /// Add the trees of a sparse grid of the pixels in `x0..=x1 × y0..=y1` (a dragged
+    /// rectangle).
+    PickRect([u32; 2], [u32; 2]),
     FrameAll,
     Stop,
 }
@@ -105,6 +119,11 @@ pub struct ViewerApp {
     pub selected_material: Option<usize>,
     pub selected_light: Option<usize>,
     pub tree: Option<RayTree>,
+    /// More pixels' trees, drawn beside the current one (shift-click, a dragged rectangle);
+    /// at most [`MAX_TREES`] with the current one.
+    pub extra_trees: Vec<RayTree>,
+    /// The scene view: its camera, its own render and its filters.
+    pub scene_view: scene_pane::SceneView,
     /// Selection, hover and the pinned tree, shared by the tree's views.
     pub tree_state: tree_view::TreeState,
     hover: Option<(u32, u32)>,
@@ -117,6 +136,9 @@ pub struct ViewerApp {
     last_mode: ImageMode,
     pending: Vec<Command>,
 }
+
+/// The most trees shown at once (the current one and the extra ones).
+pub const MAX_TREES: usize = 64;
 
 /// Opens the window and runs the viewer until it is closed.
 pub fn run(scene_arg: Option<&str>) -> anyhow::Result<()> {
@@ -178,6 +200,7 @@ impl ViewerApp {
     fn with_limit(scene: Scene, label: String, max_side: u32) -> Result<Self, String> {
         let settings = RenderSettings::default();
         let session = Session::new(settings.threads)?;
+        let scene_view = scene_pane::SceneView::new(settings.threads)?;
         let scene = Arc::new(scene);
         let tracer = Arc::new(Tracer::new(scene.clone(), settings.trace));
         let (w, h) = (scene.render.width, scene.render.height);
@@ -197,6 +220,8 @@ impl ViewerApp {
             selected_material: None,
             selected_light: None,
             tree: None,
+            extra_trees: Vec::new(),
+            scene_view,
             tree_state: tree_view::TreeState::default(),
             hover: None,
             browser: None,
@@ -246,6 +271,11 @@ impl ViewerApp {
 
     /// Starts a new generation from the working copy; `rebuild` also rebuilds the accelerator.
     fn restart(&mut self, rebuild: bool) {
+        self.restart_views(rebuild, true);
+    }
+
+    /// [`Self::restart`], restarting the scene view's render too when `scene_view`.
+    fn restart_views(&mut self, rebuild: bool, scene_view: bool) {
         if let Err(e) = self.session.set_threads(self.settings.threads) {
             self.error(e);
         }
@@ -311,10 +341,67 @@ impl ViewerApp {
             let [x, y] = tree.pixel;
             self.tree = pixel_tree(&self.tracer, x, y);
         }
+        let tracer = self.tracer.clone();
+        self.extra_trees = self
+            .extra_trees
+            .iter()
+            .filter_map(|t| pixel_tree(&tracer, t.pixel[0], t.pixel[1]))
+            .collect();
+        if scene_view {
+            if let Err(e) = self.scene_view.set_threads(self.settings.threads) {
+                self.error(e);
+            }
+            self.scene_view.restart(&tracer);
+        }
+    }
+
+    /// The trees shown: the current one first, then the extra ones.
+    pub fn trees(&self) -> impl Iterator<Item = &RayTree> {
+        self.tree.iter().chain(self.extra_trees.iter())
+    }
+
+    /// Makes extra tree `i` the current one (the list and detail show it); the current one
+    /// joins the extra trees in its place.
+    pub fn make_current(&mut self, i: usize) {
+        if i < self.extra_trees.len() {
+            match self.tree.take() {
+                Some(current) => {
+                    self.tree = Some(std::mem::replace(&mut self.extra_trees[i], current))
+                }
+                None => self.tree = Some(self.extra_trees.remove(i)),
+            }
+        }
+    }
+
+    /// Adds the tree of pixel (`x`, `y`) to the trees shown, unless it is there or the trees
+    /// are full (then says so). Returns false when full.
+    fn add_tree(&mut self, x: u32, y: u32) -> bool {
+        if self.trees().any(|t| t.pixel == [x, y]) {
+            return true;
+        }
+        if self.trees().count() >= MAX_TREES {
+            self.messages.push((
+                false,
+                format!("at most {MAX_TREES} trees are shown: click a pixel (without shift) to start over"),
+            ));
+            return false;
+        }
+        let Some(tree) = pixel_tree(&self.tracer, x, y) else {
+            return true;
+        };
+        match self.tree {
+            None => {
+                self.tree = Some(tree);
+                self.tree_state.selected = Some(Vec::new());
+            }
+            Some(_) => self.extra_trees.push(tree),
+        }
+        true
     }
 
     /// Takes the tiles that arrived, within a time budget so the UI stays responsive.
     pub fn poll_session(&mut self) {
+        self.scene_view.poll();
         let budget = Instant::now();
         let mut display = self.display.lock().unwrap_or_else(|p| p.into_inner());
         let mode = self.prefs.mode;
@@ -370,9 +457,14 @@ impl ViewerApp {
         let commands = std::mem::take(&mut self.pending);
         let mut restart = false;
         let mut rebuild = false;
+        let mut camera_only = true;
         for c in commands {
+            if !matches!(c, Command::MoveCamera) {
+                camera_only = false;
+            }
             match c {
                 Command::Restart => restart = true,
+                Command::MoveCamera => restart = true,
                 Command::Rebuild => {
                     restart = true;
                     rebuild = true;
@@ -416,7 +508,31 @@ impl ViewerApp {
                     }
                     None => self.error("no ray tree to export: click a pixel first"),
                 },
+                Command::PickMore(x, y) => {
+                    self.add_tree(x, y);
+                }
+                Command::PickRect([x0, y0], [x1, y1]) => {
+                    // A sparse grid: at most 8 × 8 pixels spread over the rectangle.
+                    let axis = |a: u32, b: u32| -> Vec<u32> {
+                        let n = (b - a + 1).min(8);
+                        let mut v: Vec<u32> = (0..n)
+                            .map(|i| {
+                                a + ((b - a) as u64 * (2 * i as u64 + 1) / (2 * n as u64)) as u32
+                            })
+                            .collect();
+                        v.dedup();
+                        v
+                    };
+                    'grid: for y in axis(y0.min(y1), y0.max(y1)) {
+                        for x in axis(x0.min(x1), x0.max(x1)) {
+                            if !self.add_tree(x, y) {
+                                break 'grid;
+                            }
+                        }
+                    }
+                }
                 Command::Pick(x, y) => {
+                    self.extra_trees.clear();
                     self.tree = pixel_tree(&self.tracer, x, y);
                     self.tree_state.selected = Some(Vec::new());
                     if let Some(hit) = self.tree.as_ref().and_then(|t| t.root.hit.as_ref()) {
@@ -440,7 +556,7 @@ impl ViewerApp {
             }
         }
         if restart {
-            self.restart(rebuild);
+            self.restart_views(rebuild, !camera_only);
         }
     }
 
@@ -453,6 +569,10 @@ impl ViewerApp {
         self.selected_material = None;
         self.selected_light = None;
         self.tree = None;
+        // Pins and extra trees belong to the old scene; the scene view frames the new one.
+        self.extra_trees.clear();
+        self.tree_state = tree_view::TreeState::default();
+        self.scene_view.unframe();
     }
 
     /// Writes the film at full resolution (never a window grab), stamped with its progress.
@@ -506,27 +626,18 @@ impl eframe::App for ViewerApp {
         panels::status_bar(self, ui);
         // Hover is transient: the views set it again while the pointer stays on a node.
         self.tree_state.hovered = None;
-        let tree = self.tree.clone();
-        if let Some(tree) = &tree {
-            egui::Panel::bottom("diagram")
-                .resizable(true)
-                .default_size(220.0)
-                .show(ui, |ui| tree_view::diagram(ui, tree, &mut self.tree_state));
-        }
+        scene_pane::advance_playback(self, &ctx);
         egui::Panel::left("settings")
             .resizable(true)
-            .default_size(330.0)
+            .default_size(300.0)
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| panels::side_panel(self, ui));
             });
-        if tree.is_some() {
-            egui::Panel::right("tree")
-                .resizable(true)
-                .default_size(420.0)
-                .max_size(560.0)
-                .show(ui, |ui| panels::tree_panel(self, ui));
-        }
-        egui::CentralPanel::default().show(ui, |ui| self.viewport(ui));
+        // The panes fill the central panel edge to edge.
+        let frame = egui::Frame::central_panel(ui.style()).inner_margin(0);
+        egui::CentralPanel::default()
+            .frame(frame)
+            .show(ui, |ui| workspace::show(self, ui));
         if let Some(browser) = &mut self.browser {
             match browser.show(&ctx) {
                 file_browser::Outcome::Open => {}

@@ -19,6 +19,8 @@ pub struct TreeState {
     pub selected: Option<NodePath>,
     pub hovered: Option<NodePath>,
     pub pinned: Option<RayTree>,
+    /// The step-through: show generations `0..=reveal` only (`None`: all).
+    pub reveal: Option<u32>,
 }
 
 /// The one palette of ray kinds, shared by every view of the tree and by the overlay (sRGB).
@@ -520,97 +522,4 @@ pub fn detail(ui: &mut Ui, tree: &RayTree, path: &[usize]) {
                 );
             });
     }
-}
-
-// ---- the overlay --------------------------------------------------------------------------
-
-fn rgba(rgb: [u8; 3], alpha: f32) -> [f32; 4] {
-    [
-        rgb[0] as f32 / 255.0,
-        rgb[1] as f32 / 255.0,
-        rgb[2] as f32 / 255.0,
-        alpha,
-    ]
-}
-
-/// Segments for `shaders/overlay.wgsl`: every ray of the tree to its hit (or out of the scene),
-/// each shadow ray to its light (red up to a blocker, dark past it), and the normal at each hit
-/// as a short tick. `extent` is the scene's size, for rays that hit nothing and for ticks.
-pub fn overlay_vertices(
-    tree: &RayTree,
-    state: &TreeState,
-    extent: f32,
-) -> Vec<super::viewport::OverlayVertex> {
-    use super::viewport::OverlayVertex;
-    let mut out = Vec::new();
-    let mut segment = |a: Vec3, b: Vec3, c: [f32; 4]| {
-        out.push(OverlayVertex {
-            position: a.to_array(),
-            color: c,
-        });
-        out.push(OverlayVertex {
-            position: b.to_array(),
-            color: c,
-        });
-    };
-    let mut stack: Vec<(NodePath, &Node)> = vec![(Vec::new(), &tree.root)];
-    while let Some((path, node)) = stack.pop() {
-        let active = state.selected.as_deref() == Some(path.as_slice())
-            || state.hovered.as_deref() == Some(path.as_slice());
-        let kind = if active {
-            rgba(HIGHLIGHT_RGB, 1.0)
-        } else {
-            rgba(kind_rgb(node.kind), 1.0)
-        };
-        match (&node.hit, node.end) {
-            (Some(hit), _) => {
-                segment(node.origin, hit.point, kind);
-                segment(
-                    hit.point,
-                    hit.point + hit.normal * extent * 0.04,
-                    rgba(NORMAL_RGB, 1.0),
-                );
-                for s in node.shadow_rays.iter().filter(|s| !s.facing_away) {
-                    let light = hit.point + s.to_light * s.distance;
-                    match s.blocked_at {
-                        Some(d) if s.blocked_by.is_some() => {
-                            let blocker = hit.point + s.to_light * d;
-                            segment(hit.point, blocker, rgba(SHADOW_BLOCKED_RGB, 1.0));
-                            segment(blocker, light, rgba(SHADOW_PAST_BLOCKER_RGB, 0.8));
-                        }
-                        _ => segment(hit.point, light, rgba(kind_rgb(RayKind::Shadow), 0.9)),
-                    }
-                }
-            }
-            (None, Some(EndReason::NoHit)) => {
-                segment(
-                    node.origin,
-                    node.origin + node.direction * extent * 2.0,
-                    kind,
-                );
-            }
-            // Not traced (past max depth, below the cutoff or past the ray budget): a short,
-            // faint stub.
-            (None, Some(EndReason::MaxDepth | EndReason::Cutoff | EndReason::Budget)) => {
-                let mut faint = kind;
-                faint[3] = 0.45;
-                segment(
-                    node.origin,
-                    node.origin + node.direction * extent * 0.08,
-                    faint,
-                );
-            }
-            // A visible light ends the ray at its surface.
-            (None, _) => {
-                let t = node.light.as_ref().map_or(extent * 0.2, |l| l.t);
-                segment(node.origin, node.origin + node.direction * t, kind);
-            }
-        }
-        for (i, child) in node.children.iter().enumerate() {
-            let mut p = path.clone();
-            p.push(i);
-            stack.push((p, child));
-        }
-    }
-    out
 }

@@ -4,6 +4,8 @@
 //! (generation, ray kind, end reason) that hide segments. The viewer's render overlay and scene
 //! view and the headless `raytree tree --scene-view` draw these, so their rules cannot drift.
 
+pub mod occlusion;
+
 use glam::Vec3;
 
 use crate::ray_tree::{Node, RayTree};
