@@ -395,3 +395,55 @@ fn speed_vs_accuracy_window_runs_the_sweep_and_a_point_applies() {
             .is_none()
     );
 }
+
+#[test]
+fn ctrl_drag_traces_a_sparse_grid_of_the_rectangle() {
+    let mut h = harness(small("default"));
+    settle(&mut h);
+    let (from, to) = (pixel_pos(&h, 10, 10), pixel_pos(&h, 150, 110));
+    h.event(egui::Event::ModifiersChanged(egui::Modifiers::COMMAND));
+    h.hover_at(from);
+    h.event(egui::Event::PointerButton {
+        pos: from,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: egui::Modifiers::COMMAND,
+    });
+    h.step();
+    for i in 1..=4 {
+        h.hover_at(from + (to - from) * (i as f32 / 4.0));
+        h.step();
+    }
+    h.event(egui::Event::PointerButton {
+        pos: to,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: egui::Modifiers::COMMAND,
+    });
+    h.step();
+    h.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
+    h.step();
+    let n = h.state().trees().count();
+    assert_eq!(n, 64, "an 8×8 grid");
+    assert!(
+        h.state()
+            .trees()
+            .all(|t| (10..=150).contains(&t.pixel[0]) && (10..=110).contains(&t.pixel[1])),
+        "every pixel inside the rectangle"
+    );
+    assert_eq!(
+        h.state().scene().camera,
+        small("default").camera,
+        "the drag orbited"
+    );
+    // Full: one more pixel is refused with a message.
+    let at = pixel_pos(&h, 1, 1);
+    click(&mut h, at, egui::Modifiers::SHIFT);
+    assert_eq!(h.state().trees().count(), 64);
+    assert!(
+        h.state()
+            .messages
+            .last()
+            .is_some_and(|m| m.1.contains("at most 64"))
+    );
+}

@@ -122,9 +122,9 @@ impl ViewerApp {
                 ui.input(|i| i.pointer.press_origin()),
                 response.interact_pointer_pos(),
             ) {
-                let r = egui::Rect::from_two_pos(origin, now);
+                self.rect_select = Some((origin, now));
                 ui.painter_at(rect).rect_stroke(
-                    r,
+                    egui::Rect::from_two_pos(origin, now),
                     0.0,
                     egui::Stroke::new(2.0, egui::Color32::from_rgb(255, 120, 255)),
                     egui::StrokeKind::Middle,
@@ -132,18 +132,14 @@ impl ViewerApp {
             }
             return;
         }
-        if selecting
-            && response.drag_stopped()
-            && let (Some(origin), Some(end)) = (
-                ui.input(|i| i.pointer.press_origin()),
-                response.interact_pointer_pos(),
-            )
-        {
-            let clamp = |p: egui::Pos2| to_pixel(rect.clamp(p - egui::vec2(0.01, 0.01)));
-            if let (Some(a), Some(b)) = (clamp(origin), clamp(end)) {
-                self.pending.push(Command::PickRect([a.0, a.1], [b.0, b.1]));
+        if let Some((origin, end)) = self.rect_select.take() {
+            if selecting && response.drag_stopped() {
+                let inside = |p: egui::Pos2| to_pixel(rect.shrink(0.01).clamp(p));
+                if let (Some(a), Some(b)) = (inside(origin), inside(end)) {
+                    self.pending.push(Command::PickRect([a.0, a.1], [b.0, b.1]));
+                }
+                return;
             }
-            return;
         }
         let delta = response.drag_delta();
         if delta != egui::Vec2::ZERO {

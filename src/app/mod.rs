@@ -124,6 +124,10 @@ pub struct ViewerApp {
     pub extra_trees: Vec<RayTree>,
     /// The scene view: its camera, its own render and its filters.
     pub scene_view: scene_pane::SceneView,
+    /// Whether the tree's panes were last opened (true) or closed for want of a tree.
+    tree_panes_shown: Option<bool>,
+    /// The rectangle being dragged over the render with Ctrl or Alt (screen points).
+    rect_select: Option<(egui::Pos2, egui::Pos2)>,
     /// Selection, hover and the pinned tree, shared by the tree's views.
     pub tree_state: tree_view::TreeState,
     hover: Option<(u32, u32)>,
@@ -222,6 +226,8 @@ impl ViewerApp {
             tree: None,
             extra_trees: Vec::new(),
             scene_view,
+            tree_panes_shown: None,
+            rect_select: None,
             tree_state: tree_view::TreeState::default(),
             hover: None,
             browser: None,

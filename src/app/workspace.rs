@@ -1,6 +1,6 @@
 //! The workspace of panes (egui_tiles): the render view, the scene view, the tree diagram and
 //! the tree list with its detail, resizable, hideable (View menu) and re-dockable by dragging
-//! their tabs. The layout is part of [`super::Prefs`], so it is remembered between runs; a saved
+//! their tabs. The tree's panes open when a pixel is clicked. The layout is part of [`super::Prefs`], so it is remembered between runs; a saved
 //! layout that lacks a pane or holds one twice is replaced by the default.
 
 use eframe::egui::{self, Ui};
@@ -78,11 +78,29 @@ pub fn tile_of(layout: &Layout, pane: Pane) -> Option<TileId> {
     layout.tiles.find_pane(&pane)
 }
 
+/// Opens the tree's panes (diagram, list) when a tree appears and closes them when it goes,
+/// so that before any click the render and scene views share the whole workspace. Only the
+/// change is acted on: a pane hidden or shown from the View menu stays so meanwhile.
+fn follow_tree(app: &mut ViewerApp) {
+    let want = app.tree.is_some();
+    if app.tree_panes_shown == Some(want) {
+        return;
+    }
+    app.tree_panes_shown = Some(want);
+    for pane in [Pane::Diagram, Pane::TreeList] {
+        if let Some(id) = tile_of(&app.prefs.layout, pane) {
+            app.prefs.layout.tiles.set_visible(id, want);
+        }
+    }
+}
+
 /// Draws the panes of `app`'s layout into `ui`.
 pub fn show(app: &mut ViewerApp, ui: &mut Ui) {
     if !usable(&app.prefs.layout) {
         app.prefs.layout = default_layout();
+        app.tree_panes_shown = None;
     }
+    follow_tree(app);
     let mut layout = std::mem::replace(
         &mut app.prefs.layout,
         egui_tiles::Tree::empty(egui::Id::unique("none")),
@@ -103,6 +121,7 @@ pub fn pane_toggles(app: &mut ViewerApp, ui: &mut Ui) {
     }
     if ui.button("Default layout").clicked() {
         app.prefs.layout = default_layout();
+        app.tree_panes_shown = None;
     }
 }
 
