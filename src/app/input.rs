@@ -132,14 +132,15 @@ impl ViewerApp {
             }
             return;
         }
-        if let Some((origin, end)) = self.rect_select.take() {
-            if selecting && response.drag_stopped() {
-                let inside = |p: egui::Pos2| to_pixel(rect.shrink(0.01).clamp(p));
-                if let (Some(a), Some(b)) = (inside(origin), inside(end)) {
-                    self.pending.push(Command::PickRect([a.0, a.1], [b.0, b.1]));
-                }
-                return;
+        if let Some((origin, end)) = self.rect_select.take()
+            && selecting
+            && response.drag_stopped()
+        {
+            let inside = |p: egui::Pos2| to_pixel(rect.shrink(0.01).clamp(p));
+            if let (Some(a), Some(b)) = (inside(origin), inside(end)) {
+                self.pending.push(Command::PickRect([a.0, a.1], [b.0, b.1]));
             }
+            return;
         }
         let delta = response.drag_delta();
         if delta != egui::Vec2::ZERO {
