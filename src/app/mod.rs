@@ -672,7 +672,7 @@ impl eframe::App for ViewerApp {
         }
         self.apply();
         self.refresh_if_mode_changed();
-        if !self.is_finished() {
+        if !self.is_finished() || !self.scene_view.is_finished() {
             ctx.request_repaint();
         }
     }

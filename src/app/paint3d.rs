@@ -10,7 +10,7 @@ use glam::Vec3;
 
 use crate::scene::CameraFrame;
 use crate::scene_view::occlusion::{DepthImage, visible_pieces};
-use crate::scene_view::{HIGHLIGHT_RGB, NodePath, Segment, style_rgba};
+use crate::scene_view::{HIGHLIGHT_RGB, NodePath, Segment, Style, style_rgba};
 
 /// Width of a ray on screen, in logical pixels.
 pub const WIDTH: f32 = 2.5;
@@ -102,7 +102,10 @@ pub fn draw_segments<'a>(
 ) {
     let mut shapes = Vec::new();
     for s in segments {
-        let highlighted = active.contains(&s.path.as_slice());
+        // The node's own ray lights up; its shadow rays and normal keep their colours, which
+        // say lit or blocked.
+        let highlighted = matches!(s.style, Style::Ray(_) | Style::NotTraced(_))
+            && active.contains(&s.path.as_slice());
         let rgba = if highlighted {
             let [r, g, b] = HIGHLIGHT_RGB;
             [r, g, b, 255]

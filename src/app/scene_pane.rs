@@ -210,7 +210,7 @@ pub fn advance_playback(app: &mut ViewerApp, ctx: &egui::Context) {
 /// The toolbar: the step-through (depth slider, play, speed) and the filters.
 fn toolbar(app: &mut ViewerApp, ui: &mut Ui) {
     let deepest = deepest(app.trees());
-    ui.horizontal_wrapped(|ui| {
+    ui.horizontal(|ui| {
         let mut depth = app.tree_state.reveal.unwrap_or(deepest).min(deepest);
         let l = ui.label("depth");
         let r = ui
@@ -234,12 +234,21 @@ fn toolbar(app: &mut ViewerApp, ui: &mut Ui) {
                 app.scene_view.playing = Some(Instant::now());
             }
         }
+        let l = ui.label("speed");
         ui.add(
-            egui::Slider::new(&mut app.scene_view.speed, 0.25..=8.0)
-                .logarithmic(true)
-                .text("gen/s"),
-        );
-        ui.separator();
+            egui::DragValue::new(&mut app.scene_view.speed)
+                .range(0.25..=8.0)
+                .speed(0.05)
+                .suffix(" gen/s"),
+        )
+        .labelled_by(l.id);
+        if ui.button("Frame").clicked() {
+            let scene = app.scene.clone();
+            app.scene_view.frame(&scene);
+            app.scene_view.restart(&app.tracer);
+        }
+    });
+    ui.horizontal_wrapped(|ui| {
         let f = &mut app.scene_view.filter;
         ui.checkbox(&mut f.primary, "primary");
         ui.checkbox(&mut f.reflected, "reflected");
@@ -263,12 +272,6 @@ fn toolbar(app: &mut ViewerApp, ui: &mut Ui) {
                 }
             }
         });
-        ui.separator();
-        if ui.button("Frame").clicked() {
-            let scene = app.scene.clone();
-            app.scene_view.frame(&scene);
-            app.scene_view.restart(&app.tracer);
-        }
     });
 }
 
