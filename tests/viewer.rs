@@ -177,19 +177,7 @@ fn pixel_pos(h: &Harness<'static, ViewerApp>, x: u32, y: u32) -> egui::Pos2 {
 }
 
 fn click(h: &mut Harness<'static, ViewerApp>, pos: egui::Pos2, modifiers: egui::Modifiers) {
-    h.event(egui::Event::ModifiersChanged(modifiers));
-    h.hover_at(pos);
-    for pressed in [true, false] {
-        h.event(egui::Event::PointerButton {
-            pos,
-            button: egui::PointerButton::Primary,
-            pressed,
-            modifiers,
-        });
-    }
-    h.step();
-    h.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
-    h.step();
+    drag(h, pos, egui::Vec2::ZERO, modifiers);
 }
 
 /// A pixel of the glass sphere in the 160×120 default scene.
@@ -264,26 +252,31 @@ fn clicking_a_pixel_shows_its_ray_tree_in_every_view() {
     h.snapshot("viewer_tree");
 }
 
-/// Drags from `from` by `by` with the primary button.
-fn drag(h: &mut Harness<'static, ViewerApp>, from: egui::Pos2, by: egui::Vec2) {
+/// Drags from `from` by `by` with the primary button, `modifiers` held (by zero: a click).
+fn drag(
+    h: &mut Harness<'static, ViewerApp>,
+    from: egui::Pos2,
+    by: egui::Vec2,
+    modifiers: egui::Modifiers,
+) {
+    h.event(egui::Event::ModifiersChanged(modifiers));
     h.hover_at(from);
-    h.event(egui::Event::PointerButton {
-        pos: from,
-        button: egui::PointerButton::Primary,
-        pressed: true,
-        modifiers: egui::Modifiers::NONE,
-    });
-    h.step();
-    for i in 1..=5 {
-        h.hover_at(from + by * (i as f32 / 5.0));
+    for (pressed, pos) in [(true, from), (false, from + by)] {
+        if !pressed && by != egui::Vec2::ZERO {
+            for i in 1..=5 {
+                h.hover_at(from + by * (i as f32 / 5.0));
+                h.step();
+            }
+        }
+        h.event(egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers,
+        });
         h.step();
     }
-    h.event(egui::Event::PointerButton {
-        pos: from + by,
-        button: egui::PointerButton::Primary,
-        pressed: false,
-        modifiers: egui::Modifiers::NONE,
-    });
+    h.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
     h.step();
 }
 
@@ -298,7 +291,12 @@ fn orbiting_the_scene_view_leaves_the_tree_and_the_render_unchanged() {
     let generation = h.state().generation();
     let camera = h.state().scene_view.camera.clone();
     let view = h.get_by_label("scene view").rect();
-    drag(&mut h, view.center(), egui::vec2(120.0, 30.0));
+    drag(
+        &mut h,
+        view.center(),
+        egui::vec2(120.0, 30.0),
+        egui::Modifiers::NONE,
+    );
     assert_ne!(
         h.state().scene_view.camera,
         camera,
@@ -401,28 +399,7 @@ fn ctrl_drag_traces_a_sparse_grid_of_the_rectangle() {
     let mut h = harness(small("default"));
     settle(&mut h);
     let (from, to) = (pixel_pos(&h, 10, 10), pixel_pos(&h, 150, 110));
-    h.event(egui::Event::ModifiersChanged(egui::Modifiers::COMMAND));
-    h.hover_at(from);
-    h.event(egui::Event::PointerButton {
-        pos: from,
-        button: egui::PointerButton::Primary,
-        pressed: true,
-        modifiers: egui::Modifiers::COMMAND,
-    });
-    h.step();
-    for i in 1..=4 {
-        h.hover_at(from + (to - from) * (i as f32 / 4.0));
-        h.step();
-    }
-    h.event(egui::Event::PointerButton {
-        pos: to,
-        button: egui::PointerButton::Primary,
-        pressed: false,
-        modifiers: egui::Modifiers::COMMAND,
-    });
-    h.step();
-    h.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
-    h.step();
+    drag(&mut h, from, to - from, egui::Modifiers::COMMAND);
     let n = h.state().trees().count();
     assert_eq!(n, 64, "an 8×8 grid");
     assert!(

@@ -19,7 +19,7 @@ pub mod workspace;
 
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use eframe::egui;
 use serde::{Deserialize, Serialize};
@@ -412,13 +412,10 @@ impl ViewerApp {
         let mut display = self.display.lock().unwrap_or_else(|p| p.into_inner());
         let mode = self.prefs.mode;
         let max_depth = self.scene.render.max_depth;
-        while budget.elapsed().as_millis() < 8 {
-            let Some(event) = self.session.try_next() else {
-                break;
-            };
-            if event.generation() != self.generation {
-                continue;
-            }
+        while let Some(event) =
+            self.session
+                .next_within(self.generation, budget, Duration::from_millis(8))
+        {
             match event {
                 SessionEvent::Tile(tile) => {
                     self.film.write_tile(&tile, mode, max_depth, &mut display);

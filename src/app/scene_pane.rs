@@ -14,7 +14,7 @@
 //! Orbiting, panning or zooming restarts only this session; the trees are never re-traced.
 
 use std::sync::{Arc, Mutex};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use eframe::egui::{self, Color32, Sense, Ui};
 use glam::Vec3;
@@ -138,13 +138,10 @@ impl SceneView {
     pub fn poll(&mut self) {
         let budget = Instant::now();
         let mut display = self.display.lock().unwrap_or_else(|p| p.into_inner());
-        while budget.elapsed().as_millis() < 4 {
-            let Some(event) = self.session.try_next() else {
-                break;
-            };
-            if event.generation() != self.generation {
-                continue;
-            }
+        while let Some(event) =
+            self.session
+                .next_within(self.generation, budget, Duration::from_millis(4))
+        {
             match event {
                 SessionEvent::Tile(tile) => {
                     self.film
@@ -302,51 +299,45 @@ pub(super) fn draw_trees(
         .into_iter()
         .flatten()
         .collect();
+    // Back to front: the pinned tree (dashed, fainter, not pickable), the extra trees
+    // (numbered 1..), the current tree (0) with its hovered and selected nodes.
+    let pinned = Look {
+        alpha: 0.55,
+        dashed: true,
+    };
+    let extra = Look {
+        alpha: 0.7,
+        dashed: false,
+    };
+    let layers = state
+        .pinned
+        .iter()
+        .map(|t| (t, None, pinned))
+        .chain(
+            app.extra_trees
+                .iter()
+                .enumerate()
+                .map(|(i, t)| (t, Some(i + 1), extra)),
+        )
+        .chain(app.tree.iter().map(|t| (t, Some(0), Look::default())));
     let mut drawn = Vec::new();
-    if let Some(pinned) = &state.pinned {
-        let segments = shown_segments(pinned, extent, filter);
-        let look = Look {
-            alpha: 0.55,
-            dashed: true,
+    let mut unpickable = Vec::new();
+    for (tree, number, look) in layers {
+        let segments = shown_segments(tree, extent, filter);
+        let (out, lit) = match number {
+            Some(0) => (&mut drawn, active.as_slice()),
+            Some(_) => (&mut drawn, &[][..]),
+            None => (&mut unpickable, &[][..]),
         };
         paint3d::draw_segments(
             painter,
             view,
             depth,
             &segments,
-            usize::MAX,
-            &[],
+            number.unwrap_or(usize::MAX),
+            lit,
             look,
-            &mut Vec::new(),
-        );
-    }
-    for (i, tree) in app.extra_trees.iter().enumerate() {
-        let segments = shown_segments(tree, extent, filter);
-        paint3d::draw_segments(
-            painter,
-            view,
-            depth,
-            &segments,
-            i + 1,
-            &[],
-            Look {
-                alpha: 0.7,
-                dashed: false,
-            },
-            &mut drawn,
-        );
-    }
-    if let Some(tree) = &app.tree {
-        let segments = shown_segments(tree, extent, filter);
-        paint3d::draw_segments(
-            painter,
-            view,
-            depth,
-            &segments,
-            0,
-            &active,
-            Look::default(),
-            &mut drawn,
+            out,
         );
     }
     drawn
