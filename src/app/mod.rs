@@ -640,7 +640,7 @@ impl eframe::App for ViewerApp {
         let frame = egui::Frame::central_panel(ui.style()).inner_margin(0);
         egui::CentralPanel::default()
             .frame(frame)
-            .show(ui, |ui| workspace::show(self, ui));
+            .show(ui, |ui| workspace::show(self, ui, pane_ui));
         if let Some(browser) = &mut self.browser {
             match browser.show(&ctx) {
                 file_browser::Outcome::Open => {}
@@ -676,6 +676,30 @@ impl eframe::App for ViewerApp {
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
         eframe::set_value(storage, eframe::APP_KEY, &self.prefs);
+    }
+}
+
+/// What each pane of the workspace shows.
+fn pane_ui(app: &mut ViewerApp, ui: &mut egui::Ui, pane: workspace::Pane) {
+    use workspace::Pane;
+    match pane {
+        Pane::Render => app.viewport(ui),
+        Pane::SceneView => scene_pane::scene_view_ui(app, ui),
+        Pane::Diagram => match app.tree.clone() {
+            Some(tree) => tree_view::diagram(ui, &tree, &mut app.tree_state),
+            None => {
+                ui.weak("click a pixel in the render view for its ray tree");
+            }
+        },
+        Pane::TreeList => {
+            if app.tree.is_some() {
+                panels::tree_panel(app, ui);
+            } else {
+                ui.weak(
+                    "click a pixel in the render view for its ray tree; shift-click adds more pixels",
+                );
+            }
+        }
     }
 }
 

@@ -7,7 +7,7 @@ use eframe::egui::{self, Ui};
 use egui_tiles::{Behavior, Linear, LinearDir, SimplificationOptions, Tile, TileId};
 use serde::{Deserialize, Serialize};
 
-use super::{ViewerApp, panels, scene_pane, tree_view};
+use super::ViewerApp;
 
 /// One pane of the workspace.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -94,8 +94,11 @@ fn follow_tree(app: &mut ViewerApp) {
     }
 }
 
-/// Draws the panes of `app`'s layout into `ui`.
-pub fn show(app: &mut ViewerApp, ui: &mut Ui) {
+/// Draws what a pane shows.
+pub type PaneUi = fn(&mut ViewerApp, &mut Ui, Pane);
+
+/// Draws the panes of `app`'s layout into `ui`, each by `pane_ui`.
+pub fn show(app: &mut ViewerApp, ui: &mut Ui, pane_ui: PaneUi) {
     if !usable(&app.prefs.layout) {
         app.prefs.layout = default_layout();
         app.tree_panes_shown = None;
@@ -105,7 +108,7 @@ pub fn show(app: &mut ViewerApp, ui: &mut Ui) {
         &mut app.prefs.layout,
         egui_tiles::Tree::empty(egui::Id::unique("none")),
     );
-    layout.ui(&mut Panes { app }, ui);
+    layout.ui(&mut Panes { app, pane_ui }, ui);
     app.prefs.layout = layout;
 }
 
@@ -127,28 +130,12 @@ pub fn pane_toggles(app: &mut ViewerApp, ui: &mut Ui) {
 
 struct Panes<'a> {
     app: &'a mut ViewerApp,
+    pane_ui: PaneUi,
 }
 
 impl Behavior<Pane> for Panes<'_> {
     fn pane_ui(&mut self, ui: &mut Ui, _id: TileId, pane: &mut Pane) -> egui_tiles::UiResponse {
-        let app = &mut *self.app;
-        match pane {
-            Pane::Render => app.viewport(ui),
-            Pane::SceneView => scene_pane::scene_view_ui(app, ui),
-            Pane::Diagram => match app.tree.clone() {
-                Some(tree) => tree_view::diagram(ui, &tree, &mut app.tree_state),
-                None => {
-                    ui.weak("click a pixel in the render view for its ray tree");
-                }
-            },
-            Pane::TreeList => {
-                if app.tree.is_some() {
-                    panels::tree_panel(app, ui);
-                } else {
-                    ui.weak("click a pixel in the render view for its ray tree; shift-click adds more pixels");
-                }
-            }
-        }
+        (self.pane_ui)(self.app, ui, *pane);
         egui_tiles::UiResponse::None
     }
 
