@@ -424,3 +424,51 @@ fn ctrl_drag_traces_a_sparse_grid_of_the_rectangle() {
             .is_some_and(|m| m.1.contains("at most 64"))
     );
 }
+
+#[test]
+fn play_reveals_the_tree_generation_by_generation() {
+    let mut h = harness(small("default"));
+    settle(&mut h);
+    let at = pixel_pos(&h, GLASS.0, GLASS.1);
+    click(&mut h, at, egui::Modifiers::NONE);
+    h.state_mut().scene_view.speed = 8.0;
+    h.get_by_role_and_label(Role::Button, "Play").click();
+    h.step();
+    let mut seen = vec![h.state().tree_state.reveal];
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while h.state().scene_view.playing.is_some() {
+        assert!(Instant::now() < deadline, "the playback did not end");
+        h.step();
+        std::thread::sleep(Duration::from_millis(20));
+        if seen.last() != Some(&h.state().tree_state.reveal) {
+            seen.push(h.state().tree_state.reveal);
+        }
+    }
+    let deepest = raytree::app::scene_pane::deepest(h.state().trees());
+    let mut expected: Vec<Option<u32>> = (0..=deepest).map(Some).collect();
+    expected.push(None);
+    assert_eq!(
+        seen, expected,
+        "one generation at a time, then the whole tree"
+    );
+}
+
+#[test]
+fn opening_another_scene_clears_the_pinned_and_extra_trees() {
+    let mut h = harness(small("default"));
+    settle(&mut h);
+    let (a, b) = (pixel_pos(&h, GLASS.0, GLASS.1), pixel_pos(&h, 99, 53));
+    click(&mut h, a, egui::Modifiers::NONE);
+    click(&mut h, b, egui::Modifiers::SHIFT);
+    h.get_by_role_and_label(Role::Button, "Pin for comparison")
+        .click();
+    h.step();
+    assert!(h.state().tree_state.pinned.is_some());
+    assert_eq!(h.state().trees().count(), 2);
+    h.state_mut()
+        .command(raytree::app::Command::OpenBuiltin("quiz".into()));
+    h.step();
+    h.step();
+    assert!(h.state().tree_state.pinned.is_none());
+    assert_eq!(h.state().trees().count(), 0);
+}
