@@ -95,8 +95,9 @@ impl RayCounts {
 }
 
 /// Per-sample facts for the image modes: the deepest ray traced, the rays traced (shadow rays
-/// included), every way its branches ended, and the normal at the primary hit.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// included), every way its branches ended, the normal at the primary hit and how far away it
+/// is.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SampleInfo {
     pub depth_reached: u32,
     pub rays: u32,
@@ -104,6 +105,21 @@ pub struct SampleInfo {
     pub ends: u8,
     /// Unit normal (turned towards the camera) at the primary hit; zero when it met no surface.
     pub normal: Vec3,
+    /// Distance along the primary ray to the surface (or visible light) it met; INFINITY when
+    /// it met nothing. The scene view's depth, to dim the rays behind surfaces.
+    pub hit_t: f32,
+}
+
+impl Default for SampleInfo {
+    fn default() -> Self {
+        Self {
+            depth_reached: 0,
+            rays: 0,
+            ends: 0,
+            normal: Vec3::ZERO,
+            hit_t: f32::INFINITY,
+        }
+    }
 }
 
 /// The surface a ray met, as the tree shows it.
@@ -313,6 +329,9 @@ impl Tracer {
                     background
                 }
                 Found::Light(i, t) => {
+                    if depth == 0 {
+                        info.hit_t = t;
+                    }
                     ended(rec, info, EndReason::HitLight);
                     rec.light(i, t);
                     self.scene.lights[i].color
@@ -390,6 +409,7 @@ impl Tracer {
         rec.hit(&surface, v);
         if depth == 0 {
             info.normal = n;
+            info.hit_t = surface.t;
         }
         let material = scene.material(surface.material);
 

@@ -1,6 +1,8 @@
 //! The real viewer driven through egui_kittest on the wgpu software adapter (Mesa lavapipe in
 //! CI): edits restart the render, bad scenes keep the old one, exports write stamped PNGs, a
-//! click shows the ray tree, and a snapshot of the whole window.
+//! click shows the ray tree in the list, the diagram and the scene view, orbiting the scene view
+//! re-traces nothing, shift-click adds trees, the depth slider hides deeper rays, and snapshots
+//! of the whole window.
 //!
 //! Update the snapshot after a deliberate change (look at it first):
 //! `UPDATE_SNAPSHOTS=1 cargo test --release --test viewer`
@@ -42,10 +44,10 @@ fn harness(scene: Scene) -> Harness<'static, ViewerApp> {
         .build_eframe(|cc| ViewerApp::new(cc, scene, "test".into()).expect("the viewer starts"))
 }
 
-/// Steps frames until the progressive render reaches its target.
+/// Steps frames until the progressive renders (render view and scene view) reach their target.
 fn settle(h: &mut Harness<'static, ViewerApp>) {
     let deadline = Instant::now() + Duration::from_secs(120);
-    while !h.state().is_finished() {
+    while !h.state().is_finished() || !h.state().scene_view.is_finished() {
         assert!(Instant::now() < deadline, "the render did not finish");
         h.step();
         std::thread::sleep(Duration::from_millis(2));
@@ -161,67 +163,187 @@ fn ctrl_s_exports_a_stamped_png() {
     );
 }
 
+/// Where pixel (`x`, `y`) of the render is on screen.
+fn pixel_pos(h: &Harness<'static, ViewerApp>, x: u32, y: u32) -> egui::Pos2 {
+    let image = h.get_by_label("render viewport").rect();
+    let (w, hh) = (
+        h.state().scene().render.width as f32,
+        h.state().scene().render.height as f32,
+    );
+    egui::pos2(
+        image.min.x + (x as f32 + 0.5) / w * image.width(),
+        image.min.y + (y as f32 + 0.5) / hh * image.height(),
+    )
+}
+
+fn click(h: &mut Harness<'static, ViewerApp>, pos: egui::Pos2, modifiers: egui::Modifiers) {
+    drag(h, pos, egui::Vec2::ZERO, modifiers);
+}
+
+/// A pixel of the glass sphere in the 160×120 default scene.
+const GLASS: (u32, u32) = (60, 69);
+
 #[test]
-fn clicking_a_pixel_shows_its_ray_tree() {
+fn the_glass_pixel_is_on_the_glass_sphere() {
+    let scene = small("default");
+    let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());
+    let tree = raytree::ray_tree::pixel_tree(&tracer, GLASS.0, GLASS.1).expect("inside");
+    let hit = tree.root.hit.as_ref().expect("a hit");
+    assert!(hit.material.contains("glass"), "{}", hit.material);
+}
+
+/// Line shapes painted inside `rect` in the last frame.
+fn lines_in(h: &Harness<'static, ViewerApp>, rect: egui::Rect) -> usize {
+    h.output()
+        .shapes
+        .iter()
+        .filter(|c| match &c.shape {
+            egui::Shape::LineSegment { points, .. } => points.iter().all(|p| rect.contains(*p)),
+            _ => false,
+        })
+        .count()
+}
+
+#[test]
+fn clicking_a_pixel_shows_its_ray_tree_in_every_view() {
     let mut h = harness(small("default"));
     settle(&mut h);
-    // The centre of the viewport is the glass sphere's neighbourhood in the default scene.
-    let image = h.get_by_label("render viewport").rect();
-    let centre = image.center();
-    h.hover_at(centre);
-    h.event(egui::Event::PointerButton {
-        pos: centre,
-        button: egui::PointerButton::Primary,
-        pressed: true,
-        modifiers: egui::Modifiers::NONE,
-    });
-    h.event(egui::Event::PointerButton {
-        pos: centre,
-        button: egui::PointerButton::Primary,
-        pressed: false,
-        modifiers: egui::Modifiers::NONE,
-    });
-    h.step();
-    h.step();
+    let scene_view = h.get_by_label("scene view").rect();
+    let lines_before = lines_in(&h, scene_view);
+    let at = pixel_pos(&h, GLASS.0, GLASS.1);
+    click(&mut h, at, egui::Modifiers::NONE);
     let tree = h.state().tree.clone().expect("a tree after the click");
+    assert_eq!(tree.pixel, [GLASS.0, GLASS.1]);
+    assert!(tree.nodes > 3, "the glass sphere's tree has children");
     let [x, y] = tree.pixel;
-    assert!(
-        x.abs_diff(80) <= 1 && y.abs_diff(60) <= 1,
-        "clicked {x}, {y}"
-    );
     h.get_by_label_contains(&format!("Ray tree of ({x}, {y})"));
     assert!(h.query_all_by_label_contains("primary d0").count() >= 1);
     // The diagram shows the same tree, its root labelled with what the primary ray met.
     h.get_by_label(&format!("ray tree diagram of ({x}, {y})"));
-    let root = match (&tree.root.end, &tree.root.hit) {
-        (_, Some(hit)) => hit.object.clone(),
-        (Some(_), None) => "no hit".to_string(),
-        _ => unreachable!("a root either ends or hits"),
-    };
+    let root = tree.root.hit.as_ref().expect("the sphere").object.clone();
     h.get_by_label(&format!("tree node primary: {root}"));
+    // The scene view draws the tree's rays: more lines in its rectangle than the camera alone.
+    assert!(h.state().scene_view.drawn_count() >= tree.nodes);
+    let lines_after = lines_in(&h, scene_view);
+    assert!(
+        lines_after > lines_before,
+        "scene view lines: {lines_before} before the click, {lines_after} after"
+    );
     // Selecting a child in the diagram shows its numbers in the detail pane.
-    if let Some(child) = tree.root.children.first() {
-        let letter = if child.kind == raytree::trace::RayKind::Reflected {
-            "R"
-        } else {
-            "T"
-        };
-        let label = format!("tree node {letter}:");
-        h.query_all_by_label_contains(&label)
-            .next()
-            .expect("a child node")
-            .click();
-        h.step();
-        h.step();
-        assert_eq!(
-            h.state().tree_state.selected.as_deref(),
-            Some(&[0usize][..])
-        );
-    }
-    // The rays drawn over the image, with the tree panels open.
+    let child = tree.root.children.first().expect("a child");
+    let letter = if child.kind == raytree::trace::RayKind::Reflected {
+        "R"
+    } else {
+        "T"
+    };
+    h.query_all_by_label_contains(&format!("tree node {letter}:"))
+        .next()
+        .expect("a child node")
+        .click();
+    h.step();
+    h.step();
+    assert_eq!(
+        h.state().tree_state.selected.as_deref(),
+        Some(&[0usize][..])
+    );
+    settle(&mut h);
     let status = h.get_by_label_contains("Mrays/s").rect();
     h.mask(status);
     h.snapshot("viewer_tree");
+}
+
+/// Drags from `from` by `by` with the primary button, `modifiers` held (by zero: a click).
+fn drag(
+    h: &mut Harness<'static, ViewerApp>,
+    from: egui::Pos2,
+    by: egui::Vec2,
+    modifiers: egui::Modifiers,
+) {
+    h.event(egui::Event::ModifiersChanged(modifiers));
+    h.hover_at(from);
+    for (pressed, pos) in [(true, from), (false, from + by)] {
+        if !pressed && by != egui::Vec2::ZERO {
+            for i in 1..=5 {
+                h.hover_at(from + by * (i as f32 / 5.0));
+                h.step();
+            }
+        }
+        h.event(egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers,
+        });
+        h.step();
+    }
+    h.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
+    h.step();
+}
+
+#[test]
+fn orbiting_the_scene_view_leaves_the_tree_and_the_render_unchanged() {
+    let mut h = harness(small("default"));
+    settle(&mut h);
+    let at = pixel_pos(&h, GLASS.0, GLASS.1);
+    click(&mut h, at, egui::Modifiers::NONE);
+    let tree = h.state().tree.clone().expect("a tree");
+    let render_camera = h.state().scene().camera.clone();
+    let generation = h.state().generation();
+    let camera = h.state().scene_view.camera.clone();
+    let view = h.get_by_label("scene view").rect();
+    drag(
+        &mut h,
+        view.center(),
+        egui::vec2(120.0, 30.0),
+        egui::Modifiers::NONE,
+    );
+    assert_ne!(
+        h.state().scene_view.camera,
+        camera,
+        "the drag did not orbit"
+    );
+    assert_eq!(
+        h.state().tree.as_ref(),
+        Some(&tree),
+        "the tree was re-traced"
+    );
+    assert_eq!(h.state().scene().camera, render_camera);
+    assert_eq!(h.state().generation(), generation, "the render restarted");
+}
+
+#[test]
+fn shift_click_adds_a_tree_and_a_plain_click_starts_over() {
+    let mut h = harness(small("default"));
+    settle(&mut h);
+    let a = pixel_pos(&h, GLASS.0, GLASS.1);
+    click(&mut h, a, egui::Modifiers::NONE);
+    let b = pixel_pos(&h, 99, 53);
+    click(&mut h, b, egui::Modifiers::SHIFT);
+    let c = pixel_pos(&h, 20, 100);
+    click(&mut h, c, egui::Modifiers::SHIFT);
+    let pixels: Vec<[u32; 2]> = h.state().trees().map(|t| t.pixel).collect();
+    assert_eq!(pixels, vec![[60, 69], [99, 53], [20, 100]]);
+    click(&mut h, b, egui::Modifiers::NONE);
+    assert_eq!(h.state().trees().count(), 1);
+}
+
+#[test]
+fn the_depth_slider_hides_deeper_segments() {
+    let mut h = harness(small("default"));
+    settle(&mut h);
+    let at = pixel_pos(&h, GLASS.0, GLASS.1);
+    click(&mut h, at, egui::Modifiers::NONE);
+    let all = h.state().scene_view.drawn_count();
+    h.get_by_role_and_label(Role::Slider, "depth")
+        .set_value_accesskit(0.0);
+    h.step();
+    h.step();
+    assert_eq!(h.state().tree_state.reveal, Some(0));
+    let first = h.state().scene_view.drawn_count();
+    assert!(
+        first > 0 && first < all,
+        "generation 0 shows {first} pieces, the whole tree {all}"
+    );
 }
 
 #[test]
@@ -270,4 +392,83 @@ fn speed_vs_accuracy_window_runs_the_sweep_and_a_point_applies() {
         raytree::app::sweep::nearest_point(&report, [at[0] + 0.5, at[1] + 0.5], [1.0, 1.0])
             .is_none()
     );
+}
+
+#[test]
+fn ctrl_drag_traces_a_sparse_grid_of_the_rectangle() {
+    let mut h = harness(small("default"));
+    settle(&mut h);
+    let (from, to) = (pixel_pos(&h, 10, 10), pixel_pos(&h, 150, 110));
+    drag(&mut h, from, to - from, egui::Modifiers::COMMAND);
+    let n = h.state().trees().count();
+    assert_eq!(n, 64, "an 8×8 grid");
+    assert!(
+        h.state()
+            .trees()
+            .all(|t| (10..=150).contains(&t.pixel[0]) && (10..=110).contains(&t.pixel[1])),
+        "every pixel inside the rectangle"
+    );
+    assert_eq!(
+        h.state().scene().camera,
+        small("default").camera,
+        "the drag orbited"
+    );
+    // Full: one more pixel is refused with a message.
+    let at = pixel_pos(&h, 1, 1);
+    click(&mut h, at, egui::Modifiers::SHIFT);
+    assert_eq!(h.state().trees().count(), 64);
+    assert!(
+        h.state()
+            .messages
+            .last()
+            .is_some_and(|m| m.1.contains("at most 64"))
+    );
+}
+
+#[test]
+fn play_reveals_the_tree_generation_by_generation() {
+    let mut h = harness(small("default"));
+    settle(&mut h);
+    let at = pixel_pos(&h, GLASS.0, GLASS.1);
+    click(&mut h, at, egui::Modifiers::NONE);
+    h.state_mut().scene_view.speed = 8.0;
+    h.get_by_role_and_label(Role::Button, "Play").click();
+    h.step();
+    let mut seen = vec![h.state().tree_state.reveal];
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while h.state().scene_view.playing.is_some() {
+        assert!(Instant::now() < deadline, "the playback did not end");
+        h.step();
+        std::thread::sleep(Duration::from_millis(20));
+        if seen.last() != Some(&h.state().tree_state.reveal) {
+            seen.push(h.state().tree_state.reveal);
+        }
+    }
+    let deepest = raytree::app::scene_pane::deepest(h.state().trees());
+    let mut expected: Vec<Option<u32>> = (0..=deepest).map(Some).collect();
+    expected.push(None);
+    assert_eq!(
+        seen, expected,
+        "one generation at a time, then the whole tree"
+    );
+}
+
+#[test]
+fn opening_another_scene_clears_the_pinned_and_extra_trees() {
+    let mut h = harness(small("default"));
+    settle(&mut h);
+    let (a, b) = (pixel_pos(&h, GLASS.0, GLASS.1), pixel_pos(&h, 99, 53));
+    click(&mut h, a, egui::Modifiers::NONE);
+    click(&mut h, b, egui::Modifiers::SHIFT);
+    h.get_by_role_and_label(Role::Button, "Pin for comparison")
+        .click();
+    h.step();
+    assert!(h.state().tree_state.pinned.is_some());
+    assert_eq!(h.state().trees().count(), 2);
+    h.state_mut()
+        .command(raytree::app::Command::OpenBuiltin("quiz".into()));
+    h.step();
+    h.step();
+    assert!(h.state().tree_state.pinned.is_none());
+    assert_eq!(h.state().trees().count(), 0);
 }

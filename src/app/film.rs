@@ -8,6 +8,7 @@ use super::modes::{ImageMode, mode_color};
 use super::viewport::DisplayState;
 use crate::render::Image;
 use crate::render::session::TileUpdate;
+use crate::scene_view::occlusion::DepthImage;
 use crate::trace::SampleInfo;
 
 /// The film of one image size; [`Film::resize`] starts it over at another.
@@ -45,6 +46,16 @@ impl Film {
     pub fn pixel(&self, x: u32, y: u32) -> (Vec3, SampleInfo) {
         let i = (y * self.width + x) as usize;
         (self.beauty[i], self.aux[i])
+    }
+
+    /// Each pixel's distance to the surface its centre ray met (INFINITY where none): the depth
+    /// the overlays dim occluded rays with.
+    pub fn depth(&self) -> DepthImage {
+        DepthImage {
+            width: self.width,
+            height: self.height,
+            t: self.aux.iter().map(|a| a.hit_t).collect(),
+        }
     }
 
     /// The film as an image: the mean of the samples done so far.

@@ -1,15 +1,18 @@
 //! The viewer's input: keyboard shortcuts and dropped files, and the viewport's pointer
-//! (drag to orbit or pan, scroll to zoom, click for a pixel's ray tree, hover for its values),
+//! (drag to orbit or pan, scroll to zoom, click for a pixel's ray tree, shift-click for one
+//! more, Ctrl or Alt drag for a grid of a rectangle's pixels, hover for its values),
 //! each turned into an edit of the working copy or a [`Command`].
 
 use std::path::PathBuf;
-use std::sync::Arc;
 
 use eframe::egui;
 
 use super::file_browser::{BrowseFor, FileBrowser};
-use super::viewport::DisplayCallback;
-use super::{Command, ViewerApp, tree_view, viewport};
+use super::paint3d::ScreenView;
+use super::viewport::{DisplayCallback, DisplayId};
+use super::{Command, ViewerApp, scene_pane};
+use crate::scene::CameraFrame;
+use crate::scene_view::Filter;
 
 impl ViewerApp {
     /// Export (Ctrl+S), open (Ctrl+O), help (F1), stop (Escape) and a file dropped on the
@@ -67,61 +70,95 @@ impl ViewerApp {
         let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
         response
             .widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, "render viewport"));
-        // The tree's rays over the image: drawn by shaders/overlay.wgsl with the render
-        // camera's projection, one colour per ray kind, the hovered or selected node in white.
-        let overlay = self.tree.as_ref().map(|tree| {
-            let extent = self
-                .scene
-                .bounds()
-                .map(|(lo, hi)| (hi - lo).length())
-                .unwrap_or(10.0)
-                .max(1e-3);
-            let frame = crate::scene::CameraFrame::new(
-                &self.scene.camera,
-                self.scene.render.width,
-                self.scene.render.height,
-            );
-            Arc::new(viewport::Overlay {
-                clip_from_world: frame.clip_from_world(extent * 1e-5, extent * 1e5),
-                vertices: tree_view::overlay_vertices(tree, &self.tree_state, extent),
-            })
-        });
         ui.painter()
             .add(eframe::egui_wgpu::Callback::new_paint_callback(
                 rect,
                 DisplayCallback {
+                    id: DisplayId::Render,
                     shared: self.display.clone(),
-                    overlay,
                 },
             ));
+        // The trees' rays over the image, by the scene view's rules and widths, seen from the
+        // render camera; parts behind surfaces (the render's own depth) dimmed.
+        if self.tree.is_some() || !self.extra_trees.is_empty() {
+            let view = ScreenView {
+                rect,
+                frame: CameraFrame::new(
+                    &self.scene.camera,
+                    self.scene.render.width,
+                    self.scene.render.height,
+                ),
+                width: self.scene.render.width,
+                height: self.scene.render.height,
+            };
+            let filter = Filter {
+                max_generation: self.tree_state.reveal.unwrap_or(u32::MAX),
+                ..self.scene_view.filter.clone()
+            };
+            let depth = self.film.depth();
+            let drawn = scene_pane::draw_trees(self, &ui.painter_at(rect), &view, &depth, &filter);
+            scene_pane::pick_and_hover_only(self, &response, &drawn);
+        }
         let to_pixel = |p: egui::Pos2| {
             let x = ((p.x - rect.min.x) / scale).floor();
             let y = ((p.y - rect.min.y) / scale).floor();
             (x >= 0.0 && y >= 0.0 && x < w && y < h).then_some((x as u32, y as u32))
         };
         self.hover = response.hover_pos().and_then(to_pixel);
+        let modifiers = ui.input(|i| i.modifiers);
         if response.clicked()
             && let Some((x, y)) = response.interact_pointer_pos().and_then(to_pixel)
         {
-            self.pending.push(Command::Pick(x, y));
+            self.pending.push(if modifiers.shift {
+                Command::PickMore(x, y)
+            } else {
+                Command::Pick(x, y)
+            });
+        }
+        // Ctrl (or Alt) and drag: a rectangle of pixels whose trees are traced on release.
+        let selecting = modifiers.command || modifiers.alt;
+        if selecting && response.dragged_by(egui::PointerButton::Primary) {
+            if let (Some(origin), Some(now)) = (
+                ui.input(|i| i.pointer.press_origin()),
+                response.interact_pointer_pos(),
+            ) {
+                self.rect_select = Some((origin, now));
+                ui.painter_at(rect).rect_stroke(
+                    egui::Rect::from_two_pos(origin, now),
+                    0.0,
+                    egui::Stroke::new(2.0, egui::Color32::from_rgb(255, 120, 255)),
+                    egui::StrokeKind::Middle,
+                );
+            }
+            return;
+        }
+        if let Some((origin, end)) = self.rect_select.take()
+            && selecting
+            && response.drag_stopped()
+        {
+            let inside = |p: egui::Pos2| to_pixel(rect.shrink(0.01).clamp(p));
+            if let (Some(a), Some(b)) = (inside(origin), inside(end)) {
+                self.pending.push(Command::PickRect([a.0, a.1], [b.0, b.1]));
+            }
+            return;
         }
         let delta = response.drag_delta();
         if delta != egui::Vec2::ZERO {
             if response.dragged_by(egui::PointerButton::Primary) {
                 self.edit.camera.orbit(delta.x * 0.01, delta.y * 0.01);
-                self.pending.push(Command::Restart);
+                self.pending.push(Command::MoveCamera);
             } else if response.dragged_by(egui::PointerButton::Secondary)
                 || response.dragged_by(egui::PointerButton::Middle)
             {
                 self.edit.camera.pan(delta.x / size.y, delta.y / size.y);
-                self.pending.push(Command::Restart);
+                self.pending.push(Command::MoveCamera);
             }
         }
         if response.hovered() {
             let scroll = ui.input(|i| i.smooth_scroll_delta.y);
             if scroll != 0.0 {
                 self.edit.camera.zoom((-scroll * 0.002).exp());
-                self.pending.push(Command::Restart);
+                self.pending.push(Command::MoveCamera);
             }
         }
     }

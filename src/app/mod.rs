@@ -9,14 +9,17 @@ mod file_browser;
 mod film;
 mod input;
 pub mod modes;
+mod paint3d;
 mod panels;
+pub mod scene_pane;
 pub mod sweep;
 pub mod tree_view;
 pub mod viewport;
+pub mod workspace;
 
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use eframe::egui;
 use serde::{Deserialize, Serialize};
@@ -42,6 +45,8 @@ pub struct Prefs {
     pub tonemap: u32,
     pub mode: ImageMode,
     pub last_dir: Option<PathBuf>,
+    /// The panes' arrangement (replaced by the default when unusable).
+    pub layout: workspace::Layout,
 }
 
 impl Default for Prefs {
@@ -51,6 +56,7 @@ impl Default for Prefs {
             tonemap: 0,
             mode: ImageMode::Render,
             last_dir: None,
+            layout: workspace::default_layout(),
         }
     }
 }
@@ -60,6 +66,9 @@ impl Default for Prefs {
 pub enum Command {
     /// The working copy of the scene or settings changed: render it.
     Restart,
+    /// Only the render camera moved: render again, but the scene view's picture (which does
+    /// not depend on the render camera) stays.
+    MoveCamera,
     /// The scene's geometry or the accelerator changed: rebuild it, then render.
     Rebuild,
     OpenFile(PathBuf),
@@ -71,6 +80,11 @@ pub enum Command {
     ExportDiagram(PathBuf),
     /// Show the ray tree of this pixel and select its material.
     Pick(u32, u32),
+    /// Add this pixel's tree to the trees shown (shift-click).
+    PickMore(u32, u32),
+    /// Add the trees of a sparse grid of the pixels in `x0..=x1 × y0..=y1` (a dragged
+    /// rectangle).
+    PickRect([u32; 2], [u32; 2]),
     FrameAll,
     Stop,
 }
@@ -107,6 +121,15 @@ pub struct ViewerApp {
     pub selected_material: Option<usize>,
     pub selected_light: Option<usize>,
     pub tree: Option<RayTree>,
+    /// More pixels' trees, drawn beside the current one (shift-click, a dragged rectangle);
+    /// at most [`MAX_TREES`] with the current one.
+    pub extra_trees: Vec<RayTree>,
+    /// The scene view: its camera, its own render and its filters.
+    pub scene_view: scene_pane::SceneView,
+    /// Whether the tree's panes were last opened (true) or closed for want of a tree.
+    tree_panes_shown: Option<bool>,
+    /// The rectangle being dragged over the render with Ctrl or Alt (screen points).
+    rect_select: Option<(egui::Pos2, egui::Pos2)>,
     /// Selection, hover and the pinned tree, shared by the tree's views.
     pub tree_state: tree_view::TreeState,
     hover: Option<(u32, u32)>,
@@ -119,6 +142,9 @@ pub struct ViewerApp {
     last_mode: ImageMode,
     pending: Vec<Command>,
 }
+
+/// The most trees shown at once (the current one and the extra ones).
+pub const MAX_TREES: usize = 64;
 
 /// Opens the window and runs the viewer until it is closed.
 pub fn run(scene_arg: Option<&str>) -> anyhow::Result<()> {
@@ -180,6 +206,7 @@ impl ViewerApp {
     fn with_limit(scene: Scene, label: String, max_side: u32) -> Result<Self, String> {
         let settings = RenderSettings::default();
         let session = Session::new(settings.threads)?;
+        let scene_view = scene_pane::SceneView::new(settings.threads)?;
         let scene = Arc::new(scene);
         let tracer = Arc::new(Tracer::new(scene.clone(), settings.trace));
         let (w, h) = (scene.render.width, scene.render.height);
@@ -199,6 +226,10 @@ impl ViewerApp {
             selected_material: None,
             selected_light: None,
             tree: None,
+            extra_trees: Vec::new(),
+            scene_view,
+            tree_panes_shown: None,
+            rect_select: None,
             tree_state: tree_view::TreeState::default(),
             hover: None,
             browser: None,
@@ -248,6 +279,11 @@ impl ViewerApp {
 
     /// Starts a new generation from the working copy; `rebuild` also rebuilds the accelerator.
     fn restart(&mut self, rebuild: bool) {
+        self.restart_views(rebuild, true);
+    }
+
+    /// [`Self::restart`], restarting the scene view's render too when `scene_view`.
+    fn restart_views(&mut self, rebuild: bool, scene_view: bool) {
         if let Err(e) = self.session.set_threads(self.settings.threads) {
             self.error(e);
         }
@@ -313,21 +349,75 @@ impl ViewerApp {
             let [x, y] = tree.pixel;
             self.tree = pixel_tree(&self.tracer, x, y);
         }
+        let tracer = self.tracer.clone();
+        self.extra_trees = self
+            .extra_trees
+            .iter()
+            .filter_map(|t| pixel_tree(&tracer, t.pixel[0], t.pixel[1]))
+            .collect();
+        if scene_view {
+            if let Err(e) = self.scene_view.set_threads(self.settings.threads) {
+                self.error(e);
+            }
+            self.scene_view.restart(&tracer);
+        }
+    }
+
+    /// The trees shown: the current one first, then the extra ones.
+    pub fn trees(&self) -> impl Iterator<Item = &RayTree> {
+        self.tree.iter().chain(self.extra_trees.iter())
+    }
+
+    /// Makes extra tree `i` the current one (the list and detail show it); the current one
+    /// joins the extra trees in its place.
+    pub fn make_current(&mut self, i: usize) {
+        if i < self.extra_trees.len() {
+            match self.tree.take() {
+                Some(current) => {
+                    self.tree = Some(std::mem::replace(&mut self.extra_trees[i], current))
+                }
+                None => self.tree = Some(self.extra_trees.remove(i)),
+            }
+        }
+    }
+
+    /// Adds the tree of pixel (`x`, `y`) to the trees shown, unless it is there or the trees
+    /// are full (then says so). Returns false when full.
+    fn add_tree(&mut self, x: u32, y: u32) -> bool {
+        if self.trees().any(|t| t.pixel == [x, y]) {
+            return true;
+        }
+        if self.trees().count() >= MAX_TREES {
+            self.messages.push((
+                false,
+                format!("at most {MAX_TREES} trees are shown: click a pixel (without shift) to start over"),
+            ));
+            return false;
+        }
+        let Some(tree) = pixel_tree(&self.tracer, x, y) else {
+            return true;
+        };
+        match self.tree {
+            None => {
+                self.tree = Some(tree);
+                self.tree_state.selected = Some(Vec::new());
+            }
+            Some(_) => self.extra_trees.push(tree),
+        }
+        true
     }
 
     /// Takes the tiles that arrived, within a time budget so the UI stays responsive.
     pub fn poll_session(&mut self) {
+        self.scene_view.poll();
         let budget = Instant::now();
         let mut display = self.display.lock().unwrap_or_else(|p| p.into_inner());
         let mode = self.prefs.mode;
         let max_depth = self.scene.render.max_depth;
-        while budget.elapsed().as_millis() < 8 {
-            let Some(event) = self.session.try_next() else {
-                break;
-            };
-            if event.generation() != self.generation {
-                continue;
-            }
+        while let Some(event) =
+            self.session
+                .next_within(self.generation, budget, Duration::from_millis(8))
+        {
             match event {
                 SessionEvent::Tile(tile) => {
                     self.film.write_tile(&tile, mode, max_depth, &mut display);
@@ -372,9 +462,14 @@ impl ViewerApp {
         let commands = std::mem::take(&mut self.pending);
         let mut restart = false;
         let mut rebuild = false;
+        let mut camera_only = true;
         for c in commands {
+            if !matches!(c, Command::MoveCamera) {
+                camera_only = false;
+            }
             match c {
                 Command::Restart => restart = true,
+                Command::MoveCamera => restart = true,
                 Command::Rebuild => {
                     restart = true;
                     rebuild = true;
@@ -420,7 +515,31 @@ impl ViewerApp {
                     let svg = self.tree.as_ref().map(|t| crate::diagram::svg(t, &options));
                     self.save_tree_text(&path, svg);
                 }
+                Command::PickMore(x, y) => {
+                    self.add_tree(x, y);
+                }
+                Command::PickRect([x0, y0], [x1, y1]) => {
+                    // A sparse grid: at most 8 × 8 pixels spread over the rectangle.
+                    let axis = |a: u32, b: u32| -> Vec<u32> {
+                        let n = (b - a + 1).min(8);
+                        let mut v: Vec<u32> = (0..n)
+                            .map(|i| {
+                                a + ((b - a) as u64 * (2 * i as u64 + 1) / (2 * n as u64)) as u32
+                            })
+                            .collect();
+                        v.dedup();
+                        v
+                    };
+                    'grid: for y in axis(y0.min(y1), y0.max(y1)) {
+                        for x in axis(x0.min(x1), x0.max(x1)) {
+                            if !self.add_tree(x, y) {
+                                break 'grid;
+                            }
+                        }
+                    }
+                }
                 Command::Pick(x, y) => {
+                    self.extra_trees.clear();
                     self.tree = pixel_tree(&self.tracer, x, y);
                     self.tree_state.selected = Some(Vec::new());
                     if let Some(hit) = self.tree.as_ref().and_then(|t| t.root.hit.as_ref()) {
@@ -444,7 +563,7 @@ impl ViewerApp {
             }
         }
         if restart {
-            self.restart(rebuild);
+            self.restart_views(rebuild, !camera_only);
         }
     }
 
@@ -457,6 +576,10 @@ impl ViewerApp {
         self.selected_material = None;
         self.selected_light = None;
         self.tree = None;
+        // Pins and extra trees belong to the old scene; the scene view frames the new one.
+        self.extra_trees.clear();
+        self.tree_state = tree_view::TreeState::default();
+        self.scene_view.unframe();
     }
 
     /// Writes the film at full resolution (never a window grab), stamped with its progress.
@@ -521,33 +644,18 @@ impl eframe::App for ViewerApp {
         panels::status_bar(self, ui);
         // Hover is transient: the views set it again while the pointer stays on a node.
         self.tree_state.hovered = None;
-        let tree = self.tree.clone();
-        if let Some(tree) = &tree {
-            let export_svg = egui::Panel::bottom("diagram")
-                .resizable(true)
-                .default_size(320.0)
-                .show(ui, |ui| tree_view::diagram(ui, tree, &mut self.tree_state))
-                .inner;
-            if export_svg {
-                let name = format!("tree-{}-{}.svg", tree.pixel[0], tree.pixel[1]);
-                let dir = self.start_dir();
-                self.browser = Some(FileBrowser::new(BrowseFor::ExportDiagram, dir, &name));
-            }
-        }
+        scene_pane::advance_playback(self, &ctx);
         egui::Panel::left("settings")
             .resizable(true)
-            .default_size(330.0)
+            .default_size(300.0)
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| panels::side_panel(self, ui));
             });
-        if tree.is_some() {
-            egui::Panel::right("tree")
-                .resizable(true)
-                .default_size(420.0)
-                .max_size(560.0)
-                .show(ui, |ui| panels::tree_panel(self, ui));
-        }
-        egui::CentralPanel::default().show(ui, |ui| self.viewport(ui));
+        // The panes fill the central panel edge to edge.
+        let frame = egui::Frame::central_panel(ui.style()).inner_margin(0);
+        egui::CentralPanel::default()
+            .frame(frame)
+            .show(ui, |ui| workspace::show(self, ui, pane_ui));
         if let Some(browser) = &mut self.browser {
             match browser.show(&ctx) {
                 file_browser::Outcome::Open => {}
@@ -577,13 +685,43 @@ impl eframe::App for ViewerApp {
         }
         self.apply();
         self.refresh_if_mode_changed();
-        if !self.is_finished() {
+        if !self.is_finished() || !self.scene_view.is_finished() {
             ctx.request_repaint();
         }
     }
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
         eframe::set_value(storage, eframe::APP_KEY, &self.prefs);
+    }
+}
+
+/// What each pane of the workspace shows.
+fn pane_ui(app: &mut ViewerApp, ui: &mut egui::Ui, pane: workspace::Pane) {
+    use workspace::Pane;
+    match pane {
+        Pane::Render => app.viewport(ui),
+        Pane::SceneView => scene_pane::scene_view_ui(app, ui),
+        Pane::Diagram => match app.tree.clone() {
+            Some(tree) => {
+                if tree_view::diagram(ui, &tree, &mut app.tree_state) {
+                    let name = format!("tree-{}-{}.svg", tree.pixel[0], tree.pixel[1]);
+                    let dir = app.start_dir();
+                    app.browser = Some(FileBrowser::new(BrowseFor::ExportDiagram, dir, &name));
+                }
+            }
+            None => {
+                ui.weak("click a pixel in the render view for its ray tree");
+            }
+        },
+        Pane::TreeList => {
+            if app.tree.is_some() {
+                panels::tree_panel(app, ui);
+            } else {
+                ui.weak(
+                    "click a pixel in the render view for its ray tree; shift-click adds more pixels",
+                );
+            }
+        }
     }
 }
 

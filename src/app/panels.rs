@@ -110,6 +110,8 @@ pub fn top_bar(app: &mut ViewerApp, ui: &mut Ui) {
                 for mode in ImageMode::ALL {
                     ui.radio_value(&mut app.prefs.mode, mode, mode.label());
                 }
+                ui.separator();
+                super::workspace::pane_toggles(app, ui);
             });
             if ui.button("Speed vs accuracy").clicked() {
                 app.sweep.open = true;

@@ -10,11 +10,8 @@ pub use crate::diagram::end_text as end_label;
 use crate::diagram::{self, Glyph, Mark};
 use crate::ray_tree::{Node, RayTree};
 use crate::scene::Shading;
-use crate::scene_view::{Style, style_rgba};
-use crate::trace::{EndReason, RayKind};
-
-/// A node's place: the child indices from the root.
-pub type NodePath = Vec<usize>;
+use crate::scene_view::{NodePath, Style, kind_rgb, node_at, style_rgba};
+use crate::trace::RayKind;
 
 /// Which node is hovered and selected, and the pinned tree; shared by the views.
 #[derive(Clone, Debug, Default)]
@@ -26,23 +23,11 @@ pub struct TreeState {
     pub reveal: Option<u32>,
 }
 
-/// The one palette of ray kinds, shared by every view of the tree and by the overlay (sRGB).
-pub fn kind_rgb(kind: RayKind) -> [u8; 3] {
-    match kind {
-        RayKind::Primary => [235, 235, 235],
-        RayKind::Reflected => [80, 170, 255],
-        RayKind::Refracted => [90, 220, 120],
-        RayKind::Shadow => [255, 200, 60],
-    }
+/// The sRGB colour of `style`, without its opacity.
+fn rgb(style: Style) -> [u8; 3] {
+    let [r, g, b, _] = style_rgba(style);
+    [r, g, b]
 }
-
-/// Shadow rays that are blocked, up to the blocker; past it they are drawn darker.
-pub const SHADOW_BLOCKED_RGB: [u8; 3] = [220, 60, 60];
-pub const SHADOW_PAST_BLOCKER_RGB: [u8; 3] = [90, 30, 30];
-/// Normals at hits.
-pub const NORMAL_RGB: [u8; 3] = [255, 0, 255];
-/// The hovered or selected node.
-pub const HIGHLIGHT_RGB: [u8; 3] = [255, 255, 255];
 
 fn color(rgb: [u8; 3]) -> Color32 {
     Color32::from_rgb(rgb[0], rgb[1], rgb[2])
@@ -50,14 +35,6 @@ fn color(rgb: [u8; 3]) -> Color32 {
 
 pub fn kind_color(kind: RayKind) -> Color32 {
     color(kind_rgb(kind))
-}
-
-pub fn node_at<'a>(root: &'a Node, path: &[usize]) -> Option<&'a Node> {
-    let mut node = root;
-    for &i in path {
-        node = node.children.get(i)?;
-    }
-    Some(node)
 }
 
 fn fmt3(v: Vec3) -> String {
@@ -680,7 +657,7 @@ pub fn detail(ui: &mut Ui, tree: &RayTree, path: &[usize]) {
         ui.label(
             RichText::new(format!("light {}: {verdict}", s.light)).color(
                 if s.blocked_by.is_some() {
-                    color(SHADOW_BLOCKED_RGB)
+                    color(rgb(Style::ShadowBlocked))
                 } else {
                     color(kind_rgb(RayKind::Shadow))
                 },
@@ -752,97 +729,4 @@ pub fn detail(ui: &mut Ui, tree: &RayTree, path: &[usize]) {
                 );
             });
     }
-}
-
-// ---- the overlay --------------------------------------------------------------------------
-
-fn rgba(rgb: [u8; 3], alpha: f32) -> [f32; 4] {
-    [
-        rgb[0] as f32 / 255.0,
-        rgb[1] as f32 / 255.0,
-        rgb[2] as f32 / 255.0,
-        alpha,
-    ]
-}
-
-/// Segments for `shaders/overlay.wgsl`: every ray of the tree to its hit (or out of the scene),
-/// each shadow ray to its light (red up to a blocker, dark past it), and the normal at each hit
-/// as a short tick. `extent` is the scene's size, for rays that hit nothing and for ticks.
-pub fn overlay_vertices(
-    tree: &RayTree,
-    state: &TreeState,
-    extent: f32,
-) -> Vec<super::viewport::OverlayVertex> {
-    use super::viewport::OverlayVertex;
-    let mut out = Vec::new();
-    let mut segment = |a: Vec3, b: Vec3, c: [f32; 4]| {
-        out.push(OverlayVertex {
-            position: a.to_array(),
-            color: c,
-        });
-        out.push(OverlayVertex {
-            position: b.to_array(),
-            color: c,
-        });
-    };
-    let mut stack: Vec<(NodePath, &Node)> = vec![(Vec::new(), &tree.root)];
-    while let Some((path, node)) = stack.pop() {
-        let active = state.selected.as_deref() == Some(path.as_slice())
-            || state.hovered.as_deref() == Some(path.as_slice());
-        let kind = if active {
-            rgba(HIGHLIGHT_RGB, 1.0)
-        } else {
-            rgba(kind_rgb(node.kind), 1.0)
-        };
-        match (&node.hit, node.end) {
-            (Some(hit), _) => {
-                segment(node.origin, hit.point, kind);
-                segment(
-                    hit.point,
-                    hit.point + hit.normal * extent * 0.04,
-                    rgba(NORMAL_RGB, 1.0),
-                );
-                for s in node.shadow_rays.iter().filter(|s| !s.facing_away) {
-                    let light = hit.point + s.to_light * s.distance;
-                    match s.blocked_at {
-                        Some(d) if s.blocked_by.is_some() => {
-                            let blocker = hit.point + s.to_light * d;
-                            segment(hit.point, blocker, rgba(SHADOW_BLOCKED_RGB, 1.0));
-                            segment(blocker, light, rgba(SHADOW_PAST_BLOCKER_RGB, 0.8));
-                        }
-                        _ => segment(hit.point, light, rgba(kind_rgb(RayKind::Shadow), 0.9)),
-                    }
-                }
-            }
-            (None, Some(EndReason::NoHit)) => {
-                segment(
-                    node.origin,
-                    node.origin + node.direction * extent * 2.0,
-                    kind,
-                );
-            }
-            // Not traced (past max depth, below the cutoff or past the ray budget): a short,
-            // faint stub.
-            (None, Some(EndReason::MaxDepth | EndReason::Cutoff | EndReason::Budget)) => {
-                let mut faint = kind;
-                faint[3] = 0.45;
-                segment(
-                    node.origin,
-                    node.origin + node.direction * extent * 0.08,
-                    faint,
-                );
-            }
-            // A visible light ends the ray at its surface.
-            (None, _) => {
-                let t = node.light.as_ref().map_or(extent * 0.2, |l| l.t);
-                segment(node.origin, node.origin + node.direction * t, kind);
-            }
-        }
-        for (i, child) in node.children.iter().enumerate() {
-            let mut p = path.clone();
-            p.push(i);
-            stack.push((p, child));
-        }
-    }
-    out
 }

@@ -1,9 +1,10 @@
 //! The render on screen: a float texture that finished tiles are written into with
 //! `queue.write_texture` in the paint callback's prepare step, drawn by `shaders/display.wgsl`
 //! (exposure, tonemap, sRGB). The UI thread only marks rectangles dirty; the GPU side uploads
-//! just those. The clicked pixel's ray tree is drawn on top by `shaders/overlay.wgsl`, as
-//! world-space segments projected with the render camera.
+//! just those. One pipeline draws any number of such displays, each its own texture keyed by a
+//! [`DisplayId`] (the render view's and the scene view's).
 
+use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
 use eframe::egui_wgpu::{self, CallbackResources, CallbackTrait, ScreenDescriptor, wgpu};
@@ -78,41 +79,29 @@ impl DisplayState {
 
 pub type SharedDisplay = Arc<Mutex<DisplayState>>;
 
-/// One end of an overlay segment: a world position and an sRGB colour with alpha.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct OverlayVertex {
-    pub position: [f32; 3],
-    pub color: [f32; 4],
+/// Which display a paint callback draws: the render view's or the scene view's.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum DisplayId {
+    Render,
+    SceneView,
 }
 
-/// Line segments (vertex pairs) to draw over the image, and the camera that projects them.
-#[derive(Clone, Debug)]
-pub struct Overlay {
-    pub clip_from_world: glam::Mat4,
-    pub vertices: Vec<OverlayVertex>,
+/// One display's texture and its parameters on the GPU.
+struct Slot {
+    texture: wgpu::Texture,
+    bind_group: wgpu::BindGroup,
+    uniform: wgpu::Buffer,
+    width: u32,
+    height: u32,
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct OverlayUniform {
-    clip_from_world: [f32; 16],
-    linearize: u32,
-    _pad: [u32; 3],
-}
-
-/// GPU objects, created once and kept in egui_wgpu's callback resources.
+/// GPU objects, created once and kept in egui_wgpu's callback resources: one pipeline, and a
+/// texture per [`DisplayId`].
 pub struct GpuDisplay {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
-    uniform: wgpu::Buffer,
-    texture: Option<(wgpu::Texture, wgpu::BindGroup, u32, u32)>,
+    slots: HashMap<DisplayId, Slot>,
     encode_srgb: bool,
-    overlay_pipeline: wgpu::RenderPipeline,
-    overlay_uniform: wgpu::Buffer,
-    overlay_bind_group: wgpu::BindGroup,
-    overlay_vertices: Option<(wgpu::Buffer, u64)>,
-    overlay_count: u32,
 }
 
 #[repr(C)]
@@ -183,33 +172,32 @@ impl GpuDisplay {
             multiview_mask: None,
             cache: None,
         });
+        let gpu = GpuDisplay {
+            pipeline,
+            layout,
+            slots: HashMap::new(),
+            encode_srgb: !render_state.target_format.is_srgb(),
+        };
+        render_state.renderer.write().callback_resources.insert(gpu);
+    }
+
+    /// Makes display `id`'s texture `width × height`; true when it was (re)created.
+    fn ensure_texture(
+        &mut self,
+        device: &wgpu::Device,
+        id: DisplayId,
+        width: u32,
+        height: u32,
+    ) -> bool {
+        if matches!(self.slots.get(&id), Some(s) if (s.width, s.height) == (width, height)) {
+            return false;
+        }
         let uniform = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("raytree display params"),
             size: std::mem::size_of::<Uniform>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let (overlay_pipeline, overlay_uniform, overlay_bind_group) =
-            overlay_pipeline(device, render_state.target_format);
-        let gpu = GpuDisplay {
-            pipeline,
-            layout,
-            uniform,
-            texture: None,
-            encode_srgb: !render_state.target_format.is_srgb(),
-            overlay_pipeline,
-            overlay_uniform,
-            overlay_bind_group,
-            overlay_vertices: None,
-            overlay_count: 0,
-        };
-        render_state.renderer.write().callback_resources.insert(gpu);
-    }
-
-    fn ensure_texture(&mut self, device: &wgpu::Device, width: u32, height: u32) -> bool {
-        if matches!(self.texture, Some((_, _, w, h)) if (w, h) == (width, height)) {
-            return false;
-        }
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("raytree render"),
             size: wgpu::Extent3d {
@@ -231,7 +219,7 @@ impl GpuDisplay {
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
-                    resource: self.uniform.as_entire_binding(),
+                    resource: uniform.as_entire_binding(),
                 },
                 wgpu::BindGroupEntry {
                     binding: 1,
@@ -239,91 +227,24 @@ impl GpuDisplay {
                 },
             ],
         });
-        self.texture = Some((texture, bind_group, width, height));
+        self.slots.insert(
+            id,
+            Slot {
+                texture,
+                bind_group,
+                uniform,
+                width,
+                height,
+            },
+        );
         true
     }
 }
 
-fn overlay_pipeline(
-    device: &wgpu::Device,
-    format: wgpu::TextureFormat,
-) -> (wgpu::RenderPipeline, wgpu::Buffer, wgpu::BindGroup) {
-    let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("raytree overlay.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(include_str!("../../shaders/overlay.wgsl").into()),
-    });
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("raytree overlay"),
-        entries: &[wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        }],
-    });
-    let uniform = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("raytree overlay camera"),
-        size: std::mem::size_of::<OverlayUniform>() as u64,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("raytree overlay"),
-        layout: &layout,
-        entries: &[wgpu::BindGroupEntry {
-            binding: 0,
-            resource: uniform.as_entire_binding(),
-        }],
-    });
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("raytree overlay"),
-        bind_group_layouts: &[Some(&layout)],
-        immediate_size: 0,
-    });
-    let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x4];
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("raytree overlay"),
-        layout: Some(&pipeline_layout),
-        vertex: wgpu::VertexState {
-            module: &shader,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[Some(wgpu::VertexBufferLayout {
-                array_stride: std::mem::size_of::<OverlayVertex>() as u64,
-                step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &attributes,
-            })],
-        },
-        fragment: Some(wgpu::FragmentState {
-            module: &shader,
-            entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
-            targets: &[Some(wgpu::ColorTargetState {
-                format,
-                blend: Some(wgpu::BlendState::ALPHA_BLENDING),
-                write_mask: wgpu::ColorWrites::ALL,
-            })],
-        }),
-        primitive: wgpu::PrimitiveState {
-            topology: wgpu::PrimitiveTopology::LineList,
-            ..Default::default()
-        },
-        depth_stencil: None,
-        multisample: wgpu::MultisampleState::default(),
-        multiview_mask: None,
-        cache: None,
-    });
-    (pipeline, uniform, bind_group)
-}
-
 /// The paint callback of one frame.
 pub struct DisplayCallback {
+    pub id: DisplayId,
     pub shared: SharedDisplay,
-    pub overlay: Option<Arc<Overlay>>,
 }
 
 fn upload(queue: &wgpu::Queue, texture: &wgpu::Texture, state: &DisplayState, rect: Rect) {
@@ -370,8 +291,12 @@ impl CallbackTrait for DisplayCallback {
         if state.width == 0 || state.height == 0 {
             return Vec::new();
         }
-        let recreated = gpu.ensure_texture(device, state.width, state.height);
-        if let Some((texture, _, _, _)) = &gpu.texture {
+        let recreated = gpu.ensure_texture(device, self.id, state.width, state.height);
+        let encode_srgb = gpu.encode_srgb;
+        if let Some(Slot {
+            texture, uniform, ..
+        }) = gpu.slots.get(&self.id)
+        {
             if recreated || state.full {
                 let all = Rect {
                     x: 0,
@@ -385,45 +310,16 @@ impl CallbackTrait for DisplayCallback {
                     upload(queue, texture, &state, rect);
                 }
             }
+            let u = Uniform {
+                exposure: state.params.exposure,
+                tonemap: state.params.tonemap,
+                encode_srgb: encode_srgb as u32,
+                raw: state.params.raw as u32,
+            };
+            queue.write_buffer(uniform, 0, bytemuck::bytes_of(&u));
         }
         state.full = false;
         state.dirty.clear();
-        let u = Uniform {
-            exposure: state.params.exposure,
-            tonemap: state.params.tonemap,
-            encode_srgb: gpu.encode_srgb as u32,
-            raw: state.params.raw as u32,
-        };
-        queue.write_buffer(&gpu.uniform, 0, bytemuck::bytes_of(&u));
-        gpu.overlay_count = 0;
-        if let Some(overlay) = self.overlay.as_ref().filter(|o| !o.vertices.is_empty()) {
-            let ou = OverlayUniform {
-                clip_from_world: overlay.clip_from_world.to_cols_array(),
-                linearize: (!gpu.encode_srgb) as u32,
-                _pad: [0; 3],
-            };
-            queue.write_buffer(&gpu.overlay_uniform, 0, bytemuck::bytes_of(&ou));
-            let bytes: &[u8] = bytemuck::cast_slice(&overlay.vertices);
-            let needed = bytes.len() as u64;
-            if gpu
-                .overlay_vertices
-                .as_ref()
-                .is_none_or(|(_, cap)| *cap < needed)
-            {
-                let capacity = needed.next_power_of_two().max(4096);
-                let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("raytree overlay segments"),
-                    size: capacity,
-                    usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                });
-                gpu.overlay_vertices = Some((buffer, capacity));
-            }
-            if let Some((buffer, _)) = &gpu.overlay_vertices {
-                queue.write_buffer(buffer, 0, bytes);
-                gpu.overlay_count = overlay.vertices.len() as u32;
-            }
-        }
         Vec::new()
     }
 
@@ -436,18 +332,10 @@ impl CallbackTrait for DisplayCallback {
         let Some(gpu) = resources.get::<GpuDisplay>() else {
             return;
         };
-        if let Some((_, bind_group, _, _)) = &gpu.texture {
+        if let Some(slot) = gpu.slots.get(&self.id) {
             render_pass.set_pipeline(&gpu.pipeline);
-            render_pass.set_bind_group(0, bind_group, &[]);
+            render_pass.set_bind_group(0, &slot.bind_group, &[]);
             render_pass.draw(0..3, 0..1);
-        }
-        if gpu.overlay_count > 0
-            && let Some((buffer, _)) = &gpu.overlay_vertices
-        {
-            render_pass.set_pipeline(&gpu.overlay_pipeline);
-            render_pass.set_bind_group(0, &gpu.overlay_bind_group, &[]);
-            render_pass.set_vertex_buffer(0, buffer.slice(..));
-            render_pass.draw(0..gpu.overlay_count, 0..1);
         }
     }
 }

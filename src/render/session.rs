@@ -252,6 +252,23 @@ impl Session {
         self.stale_dropped.get()
     }
 
+    /// The next event of `generation`, if one is waiting and `since` is less than `budget` ago:
+    /// the UI's per-frame loop, which must leave time to draw.
+    pub fn next_within(
+        &self,
+        generation: u64,
+        since: Instant,
+        budget: std::time::Duration,
+    ) -> Option<SessionEvent> {
+        while since.elapsed() < budget {
+            let event = self.try_next()?;
+            if event.generation() == generation {
+                return Some(event);
+            }
+        }
+        None
+    }
+
     /// The next event, if one is waiting; stale generations are dropped here too.
     pub fn try_next(&self) -> Option<SessionEvent> {
         if let Some(ev) = self.start_failure.take() {

@@ -1,0 +1,472 @@
+//! The scene view (SPEC §5c): the scene seen from a camera of its own, independent of the render
+//! camera, with the render camera (frustum, image plane, clicked pixel), the lights and the ray
+//! trees drawn over it, parts behind surfaces dimmed.
+//!
+//! The scene is shaded by raytree's own tracer, progressively: a second
+//! [`Session`] renders a copy of the scene whose camera is the scene view's and whose size
+//! follows the pane (at most [`MAX_SIDE`] pixels on the long side, for speed). Why our tracer
+//! rather than a wgpu raster pass: the picture follows the same model as the render (the same
+//! materials, shadows, reflections and refraction, the same accelerator), so there is no second
+//! renderer to keep equal to the first, and the render's depth of each pixel comes with it for
+//! free. The cost: after an orbit the view refines progressively (a coarse preview first)
+//! instead of appearing at once as a raster would.
+//!
+//! Orbiting, panning or zooming restarts only this session; the trees are never re-traced.
+
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use eframe::egui::{self, Color32, Sense, Ui};
+use glam::Vec3;
+
+use super::film::Film;
+use super::modes::ImageMode;
+use super::paint3d::{self, Drawn, Look, ScreenView};
+use super::viewport::{DisplayCallback, DisplayId, DisplayState, SharedDisplay};
+use super::{ViewerApp, tree_view};
+use crate::render::session::{Session, SessionEvent};
+use crate::scene::{Camera, CameraFrame, Scene};
+use crate::scene_view::{self, Filter, Segment};
+use crate::trace::{EndReason, Tracer};
+
+/// The longest side of the scene view's image, in pixels.
+pub const MAX_SIDE: u32 = 640;
+/// Samples per pixel of the scene view: enough to read the scene, few enough to follow an orbit.
+const SAMPLES: u32 = 2;
+
+/// The scene view's camera, its render and what it shows.
+pub struct SceneView {
+    pub camera: Camera,
+    session: Session,
+    generation: u64,
+    /// The image size the session renders (follows the pane).
+    size: (u32, u32),
+    film: Film,
+    display: SharedDisplay,
+    /// Which rays are shown (the step-through sets the generation).
+    pub filter: Filter,
+    /// The step-through's playback: when the last generation was revealed, and generations
+    /// revealed per second.
+    pub playing: Option<Instant>,
+    pub speed: f32,
+    /// Segments drawn in the last frame, for picking.
+    drawn: Vec<Drawn>,
+    /// Whether the camera has been framed on a scene yet.
+    framed: bool,
+    /// Whether the current render reached its samples.
+    finished: bool,
+}
+
+impl SceneView {
+    pub fn new(threads: usize) -> Result<Self, String> {
+        Ok(Self {
+            camera: Camera::default(),
+            session: Session::new(threads)?,
+            generation: 0,
+            size: (320, 200),
+            film: Film::new(320, 200),
+            display: Arc::new(Mutex::new(DisplayState::new(320, 200))),
+            filter: Filter::default(),
+            playing: None,
+            speed: 1.5,
+            drawn: Vec::new(),
+            framed: false,
+            finished: false,
+        })
+    }
+
+    /// Frames the camera on the scene's bounds and the render camera's eye, from the render
+    /// camera's side (a little above), so the frustum and the rays are seen across.
+    pub fn frame(&mut self, scene: &Scene) {
+        let eye = scene.camera.position;
+        let (lo, hi) = scene
+            .bounds()
+            .map_or((eye - Vec3::ONE, eye + Vec3::ONE), |(lo, hi)| {
+                (lo.min(eye), hi.max(eye))
+            });
+        let view = (scene.camera.look_at - eye).normalize_or(Vec3::NEG_Z);
+        let up = scene.camera.up.normalize_or(Vec3::Y);
+        let side = view.cross(up).normalize_or(Vec3::X);
+        let direction = (side + up * 0.45 - view * 0.25).normalize();
+        let base = Camera {
+            fov_y_deg: 45.0,
+            up,
+            ..scene.camera.clone()
+        };
+        self.camera = base.framing(lo, hi, direction);
+        self.framed = true;
+    }
+
+    /// Frames the next scene when it is rendered (another scene was opened).
+    pub fn unframe(&mut self) {
+        self.framed = false;
+    }
+
+    /// Changes the worker count (takes effect at the next start).
+    pub fn set_threads(&mut self, threads: usize) -> Result<(), String> {
+        self.session.set_threads(threads)
+    }
+
+    /// The current image's size.
+    pub fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
+    /// Renders the scene of `tracer` from this view's camera, reusing its accelerator.
+    pub fn restart(&mut self, tracer: &Tracer) {
+        if !self.framed {
+            self.frame(&tracer.scene);
+        }
+        let mut scene = (*tracer.scene).clone();
+        scene.camera = self.camera.clone();
+        let (w, h) = self.size;
+        scene.render.width = w;
+        scene.render.height = h;
+        scene.render.samples = scene.render.samples.clamp(1, SAMPLES);
+        let samples = scene.render.samples;
+        let tracer = Tracer::with_accel(Arc::new(scene), tracer.settings, tracer.accel.clone());
+        self.film.resize(w, h);
+        self.display
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .resize(w, h);
+        self.finished = false;
+        self.generation = self.session.start(Arc::new(tracer), samples, None);
+    }
+
+    /// Takes the tiles that arrived, within a time budget.
+    pub fn poll(&mut self) {
+        let budget = Instant::now();
+        let mut display = self.display.lock().unwrap_or_else(|p| p.into_inner());
+        while let Some(event) =
+            self.session
+                .next_within(self.generation, budget, Duration::from_millis(4))
+        {
+            match event {
+                SessionEvent::Tile(tile) => {
+                    self.film
+                        .write_tile(&tile, ImageMode::Render, 0, &mut display);
+                }
+                SessionEvent::Finished { .. } | SessionEvent::Failed { .. } => {
+                    self.finished = true;
+                }
+                SessionEvent::PassDone { .. } => {}
+            }
+        }
+    }
+
+    /// Matches the display's exposure and tonemap to the render view's.
+    fn set_params(&self, exposure: f32, tonemap: u32) {
+        let mut d = self.display.lock().unwrap_or_else(|p| p.into_inner());
+        if d.params.exposure != exposure || d.params.tonemap != tonemap {
+            d.params.exposure = exposure;
+            d.params.tonemap = tonemap;
+            d.mark_all();
+        }
+    }
+
+    /// The image size for a pane of `rect`: its aspect, at most [`MAX_SIDE`] on the long side.
+    fn size_for(rect: egui::Rect) -> (u32, u32) {
+        let k = (MAX_SIDE as f32 / rect.width().max(rect.height())).min(1.0);
+        (
+            ((rect.width() * k).round() as u32).max(1),
+            ((rect.height() * k).round() as u32).max(1),
+        )
+    }
+}
+
+/// The deepest generation among `trees`.
+pub fn deepest<'a>(trees: impl IntoIterator<Item = &'a crate::ray_tree::RayTree>) -> u32 {
+    fn walk(n: &crate::ray_tree::Node) -> u32 {
+        n.children.iter().map(walk).max().unwrap_or(0).max(n.depth)
+    }
+    trees.into_iter().map(|t| walk(&t.root)).max().unwrap_or(0)
+}
+
+/// Advances the step-through's playback: one more generation every `1 / speed` seconds, stopping
+/// at the deepest.
+pub fn advance_playback(app: &mut ViewerApp, ctx: &egui::Context) {
+    let Some(since) = app.scene_view.playing else {
+        return;
+    };
+    let deepest = deepest(app.trees());
+    let step = 1.0 / app.scene_view.speed.max(0.05);
+    if since.elapsed().as_secs_f32() >= step {
+        let next = app.tree_state.reveal.map_or(0, |g| g + 1);
+        if next > deepest {
+            app.scene_view.playing = None;
+            app.tree_state.reveal = None;
+        } else {
+            app.tree_state.reveal = Some(next);
+            app.scene_view.playing = Some(Instant::now());
+        }
+    }
+    ctx.request_repaint();
+}
+
+/// The toolbar: the step-through (depth slider, play, speed) and the filters.
+fn toolbar(app: &mut ViewerApp, ui: &mut Ui) {
+    let deepest = deepest(app.trees());
+    ui.horizontal(|ui| {
+        let mut depth = app.tree_state.reveal.unwrap_or(deepest).min(deepest);
+        let l = ui.label("depth");
+        let r = ui
+            .add(egui::Slider::new(&mut depth, 0..=deepest.max(1)))
+            .labelled_by(l.id)
+            .on_hover_text("show the tree down to this generation");
+        if r.changed() {
+            app.tree_state.reveal = (depth < deepest).then_some(depth);
+            app.scene_view.playing = None;
+        }
+        let playing = app.scene_view.playing.is_some();
+        if ui
+            .button(if playing { "Pause" } else { "Play" })
+            .on_hover_text("reveal the tree generation by generation")
+            .clicked()
+        {
+            if playing {
+                app.scene_view.playing = None;
+            } else {
+                app.tree_state.reveal = Some(0);
+                app.scene_view.playing = Some(Instant::now());
+            }
+        }
+        let l = ui.label("speed");
+        ui.add(
+            egui::DragValue::new(&mut app.scene_view.speed)
+                .range(0.25..=8.0)
+                .speed(0.05)
+                .suffix(" gen/s"),
+        )
+        .labelled_by(l.id);
+        if ui.button("Frame").clicked() {
+            let scene = app.scene.clone();
+            app.scene_view.frame(&scene);
+            app.scene_view.restart(&app.tracer);
+        }
+    });
+    ui.horizontal_wrapped(|ui| {
+        let f = &mut app.scene_view.filter;
+        ui.checkbox(&mut f.primary, "primary");
+        ui.checkbox(&mut f.reflected, "reflected");
+        ui.checkbox(&mut f.refracted, "refracted");
+        ui.checkbox(&mut f.shadow, "shadow");
+        ui.checkbox(&mut f.normals, "normals");
+        ui.menu_button("ends", |ui| {
+            for end in [
+                EndReason::NoHit,
+                EndReason::HitLight,
+                EndReason::MaxDepth,
+                EndReason::Cutoff,
+                EndReason::Budget,
+            ] {
+                let mut shown = !f.hidden_ends.contains(&end);
+                if ui.checkbox(&mut shown, tree_view::end_label(end)).changed() {
+                    f.hidden_ends.retain(|e| *e != end);
+                    if !shown {
+                        f.hidden_ends.push(end);
+                    }
+                }
+            }
+        });
+    });
+}
+
+/// Every segment the scene view and the overlay draw for `tree`, shown by `filter`.
+pub fn shown_segments(
+    tree: &crate::ray_tree::RayTree,
+    extent: f32,
+    filter: &Filter,
+) -> Vec<Segment> {
+    scene_view::tree_segments(tree, extent)
+        .into_iter()
+        .filter(|s| filter.shows(s))
+        .collect()
+}
+
+/// Draws the trees through `view` (the current tree, the extra trees, the pinned tree in its
+/// own style) and returns what was drawn, tree 0 being the current tree, 1.. the extra trees.
+pub(super) fn draw_trees(
+    app: &ViewerApp,
+    painter: &egui::Painter,
+    view: &ScreenView,
+    depth: &crate::scene_view::occlusion::DepthImage,
+    filter: &Filter,
+) -> Vec<Drawn> {
+    let extent = scene_view::extent(&app.scene);
+    let state = &app.tree_state;
+    let active: Vec<&[usize]> = [state.selected.as_deref(), state.hovered.as_deref()]
+        .into_iter()
+        .flatten()
+        .collect();
+    // Back to front: the pinned tree (dashed, fainter, not pickable), the extra trees
+    // (numbered 1..), the current tree (0) with its hovered and selected nodes.
+    let pinned = Look {
+        alpha: 0.55,
+        dashed: true,
+    };
+    let extra = Look {
+        alpha: 0.7,
+        dashed: false,
+    };
+    let layers = state
+        .pinned
+        .iter()
+        .map(|t| (t, None, pinned))
+        .chain(
+            app.extra_trees
+                .iter()
+                .enumerate()
+                .map(|(i, t)| (t, Some(i + 1), extra)),
+        )
+        .chain(app.tree.iter().map(|t| (t, Some(0), Look::default())));
+    let mut drawn = Vec::new();
+    let mut unpickable = Vec::new();
+    for (tree, number, look) in layers {
+        let segments = shown_segments(tree, extent, filter);
+        let (out, lit) = match number {
+            Some(0) => (&mut drawn, active.as_slice()),
+            Some(_) => (&mut drawn, &[][..]),
+            None => (&mut unpickable, &[][..]),
+        };
+        paint3d::draw_segments(
+            painter,
+            view,
+            depth,
+            &segments,
+            number.unwrap_or(usize::MAX),
+            lit,
+            look,
+            out,
+        );
+    }
+    drawn
+}
+
+/// The scene view pane: toolbar, the image, the camera, lights and trees over it; drag to
+/// orbit, right/middle drag to pan, wheel to zoom, click a ray to select its node.
+pub fn scene_view_ui(app: &mut ViewerApp, ui: &mut Ui) {
+    toolbar(app, ui);
+    let rect = ui.available_rect_before_wrap();
+    if rect.width() < 8.0 || rect.height() < 8.0 {
+        return;
+    }
+    let response = ui.allocate_rect(rect, Sense::click_and_drag());
+    response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, "scene view"));
+    let size = SceneView::size_for(rect);
+    let mut restart = size != app.scene_view.size;
+    app.scene_view.size = size;
+    // Camera moves: only this view's render restarts.
+    let delta = response.drag_delta();
+    if delta != egui::Vec2::ZERO {
+        if response.dragged_by(egui::PointerButton::Primary) {
+            app.scene_view.camera.orbit(delta.x * 0.01, delta.y * 0.01);
+            restart = true;
+        } else if response.dragged_by(egui::PointerButton::Secondary)
+            || response.dragged_by(egui::PointerButton::Middle)
+        {
+            app.scene_view
+                .camera
+                .pan(delta.x / rect.height(), delta.y / rect.height());
+            restart = true;
+        }
+    }
+    if response.hovered() {
+        let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+        if scroll != 0.0 {
+            app.scene_view.camera.zoom((-scroll * 0.002).exp());
+            restart = true;
+        }
+    }
+    if restart {
+        let tracer = app.tracer.clone();
+        app.scene_view.restart(&tracer);
+    }
+    app.scene_view
+        .set_params(app.prefs.exposure, app.prefs.tonemap);
+    ui.painter()
+        .add(eframe::egui_wgpu::Callback::new_paint_callback(
+            rect,
+            DisplayCallback {
+                id: DisplayId::SceneView,
+                shared: app.scene_view.display.clone(),
+            },
+        ));
+    let (w, h) = app.scene_view.size;
+    let view = ScreenView {
+        rect,
+        frame: CameraFrame::new(&app.scene_view.camera, w, h),
+        width: w,
+        height: h,
+    };
+    let depth = app.scene_view.film.depth();
+    let painter = ui.painter_at(rect);
+    // The render camera: its frustum out to a plane a fifth of the way to its target.
+    let plane = (app.scene.camera.look_at - app.scene.camera.position).length() * 0.2;
+    let pixel = app.tree.as_ref().map(|t| t.pixel);
+    let camera = scene_view::camera_segments(&app.scene, plane.max(1e-3), pixel);
+    paint3d::draw_segments(
+        &painter,
+        &view,
+        &depth,
+        &camera,
+        usize::MAX,
+        &[],
+        Look::default(),
+        &mut Vec::new(),
+    );
+    paint3d::draw_lights(&painter, &view, &app.scene.lights);
+    let filter = Filter {
+        max_generation: app.tree_state.reveal.unwrap_or(u32::MAX),
+        ..app.scene_view.filter.clone()
+    };
+    let drawn = draw_trees(app, &painter, &view, &depth, &filter);
+    pick_and_hover(app, &response, &drawn);
+    app.scene_view.drawn = drawn;
+    if app.tree.is_none() {
+        painter.text(
+            rect.left_top() + egui::vec2(8.0, 8.0),
+            egui::Align2::LEFT_TOP,
+            "click a pixel in the render view to see its rays here",
+            egui::FontId::proportional(14.0),
+            Color32::from_gray(220),
+        );
+    }
+}
+
+/// Hover on drawn rays: the current tree's node under the pointer lights up everywhere.
+pub(super) fn pick_and_hover_only(app: &mut ViewerApp, response: &egui::Response, drawn: &[Drawn]) {
+    if let Some(pos) = response.hover_pos()
+        && let Some(d) = paint3d::pick(drawn, pos)
+        && d.tree == 0
+    {
+        app.tree_state.hovered = Some(d.path.clone());
+    }
+}
+
+/// Hover and click on drawn rays: the node lights up everywhere, a click selects it (a ray of
+/// an extra tree makes that tree the current one).
+pub(super) fn pick_and_hover(app: &mut ViewerApp, response: &egui::Response, drawn: &[Drawn]) {
+    pick_and_hover_only(app, response, drawn);
+    if response.clicked()
+        && let Some(pos) = response.interact_pointer_pos()
+        && let Some(d) = paint3d::pick(drawn, pos)
+    {
+        if d.tree > 0 {
+            app.make_current(d.tree - 1);
+        }
+        app.tree_state.selected = Some(d.path.clone());
+    }
+}
+
+impl SceneView {
+    /// Pieces of rays drawn in the last frame (for tests: how many the view shows).
+    pub fn drawn_count(&self) -> usize {
+        self.drawn.len()
+    }
+
+    /// Whether the view's render reached its samples (or stopped).
+    pub fn is_finished(&self) -> bool {
+        self.finished
+    }
+}
