@@ -456,6 +456,20 @@ pub fn tree_panel(app: &mut ViewerApp, ui: &mut Ui) {
         });
     ui.separator();
     let selected = state.selected.clone().unwrap_or_default();
+    // What the accelerator did for the selected ray (replayed: one query, cheap).
+    if let Some((_, visits)) = crate::scene_view::visit_segments(&app.tracer, &tree, &selected) {
+        let mut prims = visits.prims.clone();
+        prims.sort_unstable();
+        prims.dedup();
+        ui.label(format!(
+            "accelerator ({}): this ray entered {} boxes and tested {} primitives ({} tests)",
+            crate::choice::Choice::name(app.tracer.accel.kind()),
+            visits.boxes.len(),
+            prims.len(),
+            visits.prims.len(),
+        ))
+        .on_hover_text("drawn as cyan boxes in the scene view (\"visits\")");
+    }
     egui::ScrollArea::both()
         .id_salt("tree detail")
         .show(ui, |ui| {

@@ -55,6 +55,10 @@ pub struct SceneView {
     framed: bool,
     /// Whether the current render reached its samples.
     finished: bool,
+    /// Draw the boxes the selected ray's traversal entered.
+    pub show_visits: bool,
+    /// Draw every box of this BVH level (or the grid's cells).
+    pub bvh_level: Option<u32>,
 }
 
 impl SceneView {
@@ -72,6 +76,8 @@ impl SceneView {
             drawn: Vec::new(),
             framed: false,
             finished: false,
+            show_visits: true,
+            bvh_level: None,
         })
     }
 
@@ -252,6 +258,23 @@ fn toolbar(app: &mut ViewerApp, ui: &mut Ui) {
         ui.checkbox(&mut f.refracted, "refracted");
         ui.checkbox(&mut f.shadow, "shadow");
         ui.checkbox(&mut f.normals, "normals");
+        ui.checkbox(&mut app.scene_view.show_visits, "visits")
+            .on_hover_text(
+                "the boxes the selected ray's traversal entered (BVH nodes or grid cells)",
+            );
+        let levels = app.tracer.accel.levels();
+        let mut on = app.scene_view.bvh_level.is_some();
+        if ui
+            .checkbox(&mut on, "BVH level")
+            .on_hover_text("every box of one level of the accelerator")
+            .changed()
+        {
+            app.scene_view.bvh_level = on.then_some(0);
+        }
+        if let Some(level) = &mut app.scene_view.bvh_level {
+            ui.add(egui::DragValue::new(level).range(0..=levels.saturating_sub(1)));
+        }
+        let f = &mut app.scene_view.filter;
         ui.menu_button("ends", |ui| {
             for end in [
                 EndReason::NoHit,
@@ -401,10 +424,26 @@ pub fn scene_view_ui(app: &mut ViewerApp, ui: &mut Ui) {
     };
     let depth = app.scene_view.film.depth();
     let painter = ui.painter_at(rect);
-    // The render camera: its frustum out to a plane a fifth of the way to its target.
-    let plane = (app.scene.camera.look_at - app.scene.camera.position).length() * 0.2;
-    let pixel = app.tree.as_ref().map(|t| t.pixel);
-    let camera = scene_view::camera_segments(&app.scene, plane.max(1e-3), pixel);
+    // The render camera with its image plane where the headless scene view puts it.
+    let (plane, pixel) = match &app.tree {
+        Some(t) => (
+            scene_view::headless::image_plane_distance(&app.scene, t),
+            Some(t.pixel),
+        ),
+        None => (0.15 * scene_view::extent(&app.scene), None),
+    };
+    let mut camera = scene_view::camera_segments(&app.scene, plane.max(1e-6), pixel);
+    // The accelerator made visible: the boxes the selected ray's traversal entered, and all
+    // boxes of one BVH level.
+    if app.scene_view.show_visits
+        && let (Some(tree), Some(path)) = (&app.tree, &app.tree_state.selected)
+        && let Some((boxes, _)) = scene_view::visit_segments(&app.tracer, tree, path)
+    {
+        camera.extend(boxes);
+    }
+    if let Some(level) = app.scene_view.bvh_level {
+        camera.extend(scene_view::level_segments(&app.tracer, level));
+    }
     paint3d::draw_segments(
         &painter,
         &view,

@@ -179,7 +179,10 @@ struct DiagramView {
     fit: bool,
     /// The tree (pixel, nodes, max depth) and generations the view was made for.
     key: Option<([u32; 2], usize, u32, Option<u32>)>,
-    legend: bool,
+    /// The legend as the user set it; `None`: shown when it fits beside the tree.
+    legend: Option<bool>,
+    /// Whether the legend fitted beside the tree in the last frame.
+    legend_fits: bool,
 }
 
 impl Default for DiagramView {
@@ -189,7 +192,8 @@ impl Default for DiagramView {
             offset: Vec2::ZERO,
             fit: true,
             key: None,
-            legend: true,
+            legend: None,
+            legend_fits: true,
         }
     }
 }
@@ -350,7 +354,10 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
         {
             view.fit = true;
         }
-        ui.toggle_value(&mut view.legend, "Legend");
+        let mut legend = view.legend.unwrap_or(view.legend_fits);
+        if ui.toggle_value(&mut legend, "Legend").changed() {
+            view.legend = Some(legend);
+        }
         if ui
             .button("Export SVG...")
             .on_hover_text("the figure for slides, with its legend")
@@ -381,7 +388,9 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
         legend_box,
     );
     // The tree fits beside the open legend, unless that leaves it too little room.
-    let area = if view.legend && legend_rect.min.x - rect.min.x > 240.0 {
+    view.legend_fits = legend_rect.min.x - rect.min.x > 240.0;
+    let legend_on = view.legend.unwrap_or(view.legend_fits);
+    let area = if legend_on && view.legend_fits {
         Rect::from_min_max(rect.min, Pos2::new(legend_rect.min.x - 6.0, rect.max.y))
     } else {
         rect
@@ -575,7 +584,7 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
             }
         }
     }
-    if view.legend {
+    if legend_on {
         paint_legend(&painter, legend_rect, legend_rows);
     }
     ui.data_mut(|d| d.insert_temp(id, view));
