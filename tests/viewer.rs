@@ -14,6 +14,7 @@ use std::time::{Duration, Instant};
 
 use eframe::egui;
 use egui::accesskit::Role;
+use egui_kittest::kittest::NodeT as _;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use raytree::app::ViewerApp;
@@ -130,13 +131,14 @@ fn dropping_a_bad_scene_shows_its_error_and_keeps_the_old_scene() {
     assert!(h.state().scene().spheres.is_empty());
 }
 
-#[test]
-fn ctrl_s_exports_a_stamped_png() {
-    let dir = tempfile::tempdir().expect("temp dir");
-    let out = dir.path().join("shot.png");
-    let mut h = harness(small("glass"));
-    settle(&mut h);
+/// Ctrl+S, the picture `choice` in the Export window, then `out` in the file dialog.
+fn export_via(h: &mut Harness<'static, ViewerApp>, choice: &str, out: &std::path::Path) {
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
+    // A new window lays itself out in its first frame and takes clicks from the second.
+    h.step();
+    h.step();
+    h.get_by_role_and_label(Role::Button, choice).click();
+    h.step();
     h.step();
     h.step();
     h.get_by_role(Role::TextInput)
@@ -145,22 +147,80 @@ fn ctrl_s_exports_a_stamped_png() {
     h.get_by_role_and_label(Role::Button, "Save").click();
     h.step();
     h.step();
-    let file = std::fs::File::open(&out).expect("the PNG was written");
-    let reader = png::Decoder::new(std::io::BufReader::new(file))
+}
+
+/// The size and RGBA pixels of a PNG, and its text chunks.
+fn read_png(path: &std::path::Path) -> ((u32, u32), Vec<u8>, Vec<(String, String)>) {
+    let file = std::fs::File::open(path).expect("the PNG was written");
+    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
         .read_info()
         .expect("a valid PNG");
-    assert_eq!((reader.info().width, reader.info().height), (160, 120));
-    let text: Vec<_> = reader
+    let text = reader
         .info()
         .uncompressed_latin1_text
         .iter()
         .map(|t| (t.keyword.clone(), t.text.clone()))
         .collect();
+    let size = (reader.info().width, reader.info().height);
+    let mut buf = vec![0; reader.output_buffer_size().expect("a size")];
+    let frame = reader.next_frame(&mut buf).expect("pixels");
+    buf.truncate(frame.buffer_size());
+    (size, buf, text)
+}
+
+#[test]
+fn ctrl_s_exports_a_stamped_png() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("shot.png");
+    let mut h = harness(small("glass"));
+    settle(&mut h);
+    export_via(&mut h, "Render (PNG or EXR)", &out);
+    let (size, _, text) = read_png(&out);
+    assert_eq!(size, (160, 120));
     assert!(
         text.iter()
             .any(|(k, v)| k == "raytree.samples" && v == "1/1"),
         "{text:?}"
     );
+}
+
+#[test]
+fn ctrl_s_offers_the_render_with_rays_and_the_scene_view() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut h = harness(small("glass"));
+    settle(&mut h);
+    // Without a tree, only the clean render can be chosen.
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
+    h.step();
+    h.step();
+    let rays_button = h.get_by_role_and_label(Role::Button, "Render with rays (PNG)");
+    assert!(rays_button.accesskit_node().is_disabled());
+    h.key_press(egui::Key::Escape);
+    h.step();
+    let at = pixel_pos(&h, GLASS.0, GLASS.1);
+    click(&mut h, at, egui::Modifiers::NONE);
+    assert!(h.state().tree.is_some());
+    let (plain, rays, view) = (
+        dir.path().join("plain.png"),
+        dir.path().join("rays.png"),
+        dir.path().join("view.png"),
+    );
+    export_via(&mut h, "Render (PNG or EXR)", &plain);
+    export_via(&mut h, "Render with rays (PNG)", &rays);
+    export_via(&mut h, "Scene view (PNG)", &view);
+    let (plain_size, plain_px, _) = read_png(&plain);
+    let (rays_size, rays_px, rays_text) = read_png(&rays);
+    let (view_size, view_px, _) = read_png(&view);
+    // Both at the scene's size, stamped like the render, and the rays change pixels.
+    assert_eq!((plain_size, rays_size, view_size), ((160, 120), (160, 120), (160, 120)));
+    assert!(rays_text.iter().any(|(k, _)| k == "raytree.settings"), "{rays_text:?}");
+    let rgb = |px: &[u8], stride: usize| -> Vec<[u8; 3]> {
+        px.chunks(stride).map(|c| [c[0], c[1], c[2]]).collect()
+    };
+    let (a, b) = (rgb(&plain_px, 3), rgb(&rays_px, 4));
+    let changed = a.iter().zip(&b).filter(|(p, q)| p != q).count();
+    assert!(changed > 100 && changed < a.len() / 2, "{changed} pixels changed by the rays");
+    assert_ne!(rgb(&view_px, 4), b, "the scene view is another picture");
 }
 
 /// Where pixel (`x`, `y`) of the render is on screen.

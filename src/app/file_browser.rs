@@ -11,6 +11,8 @@ pub enum BrowseFor {
     Open,
     SaveScene,
     Export,
+    ExportOverlay,
+    ExportSceneView,
     ExportTree,
     ExportDiagram,
 }
@@ -21,6 +23,8 @@ impl BrowseFor {
             BrowseFor::Open => "Open scene or OBJ",
             BrowseFor::SaveScene => "Save scene as TOML",
             BrowseFor::Export => "Export render (.png or .exr)",
+            BrowseFor::ExportOverlay => "Export render with the rays drawn over it (.png)",
+            BrowseFor::ExportSceneView => "Export the scene view at the scene's size (.png)",
             BrowseFor::ExportTree => "Export ray tree (.json)",
             BrowseFor::ExportDiagram => "Export ray tree diagram (.svg)",
         }
@@ -31,6 +35,7 @@ impl BrowseFor {
             BrowseFor::Open => &["toml", "obj"],
             BrowseFor::SaveScene => &["toml"],
             BrowseFor::Export => &["png", "exr"],
+            BrowseFor::ExportOverlay | BrowseFor::ExportSceneView => &["png"],
             BrowseFor::ExportTree => &["json"],
             BrowseFor::ExportDiagram => &["svg"],
         }

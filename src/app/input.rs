@@ -30,8 +30,7 @@ impl ViewerApp {
             )
         });
         if do_save {
-            let name = format!("{}.png", self.file_stem());
-            self.browser = Some(FileBrowser::new(BrowseFor::Export, self.start_dir(), &name));
+            self.export_choice = true;
         }
         if do_open {
             self.browser = Some(FileBrowser::new(BrowseFor::Open, self.start_dir(), ""));

@@ -75,6 +75,10 @@ pub enum Command {
     OpenBuiltin(String),
     SaveScene(PathBuf),
     Export(PathBuf),
+    /// The render with the trees drawn over it, as PNG.
+    ExportOverlay(PathBuf),
+    /// The scene view at the scene's size, as PNG.
+    ExportSceneView(PathBuf),
     ExportTree(PathBuf),
     /// The tree's figure as SVG, to the generations shown.
     ExportDiagram(PathBuf),
@@ -135,6 +139,8 @@ pub struct ViewerApp {
     hover: Option<(u32, u32)>,
     browser: Option<FileBrowser>,
     show_help: bool,
+    /// The Ctrl+S window: which picture to export.
+    export_choice: bool,
     /// The "Speed vs accuracy" window and its background sweep.
     pub sweep: sweep::SweepWindow,
     /// The largest texture side the GPU allows: the render is never larger on screen.
@@ -234,6 +240,7 @@ impl ViewerApp {
             hover: None,
             browser: None,
             show_help: false,
+            export_choice: false,
             sweep: sweep::SweepWindow::default(),
             max_side: max_side.max(1),
             last_mode: ImageMode::Render,
@@ -501,6 +508,8 @@ impl ViewerApp {
                     }
                 }
                 Command::Export(path) => self.export(&path),
+                Command::ExportOverlay(path) => self.export_drawn(&path, false),
+                Command::ExportSceneView(path) => self.export_drawn(&path, true),
                 Command::ExportTree(path) => {
                     let json = self
                         .tree
@@ -618,6 +627,54 @@ impl ViewerApp {
         }
     }
 
+    /// Writes the render with the trees drawn over it (`scene_view`: false) or the scene view
+    /// at the scene's size (true) as a stamped PNG, drawn by the headless scene view's rules.
+    fn export_drawn(&mut self, path: &Path, scene_view: bool) {
+        let Some(tree) = self.tree.clone() else {
+            self.error("no ray tree to draw: click a pixel first");
+            return;
+        };
+        let filter = crate::scene_view::Filter {
+            max_generation: self.tree_state.reveal.unwrap_or(u32::MAX),
+            ..self.scene_view.filter.clone()
+        };
+        let drawn = if scene_view {
+            let (w, h) = (self.scene.render.width, self.scene.render.height);
+            let camera = self.scene_view.camera.clone();
+            crate::scene_view::headless::scene_view_image(
+                &self.scene,
+                self.settings.trace,
+                &tree,
+                &camera,
+                w,
+                h,
+                &filter,
+            )
+        } else {
+            let trees: Vec<&RayTree> = self.trees().collect();
+            crate::scene_view::headless::overlay_image(&self.tracer, &self.image(), &trees, &filter)
+        };
+        let canvas = match drawn {
+            Ok(c) => c,
+            Err(e) => return self.error(e.to_string()),
+        };
+        let text = export::stamp(
+            &self.scene_label,
+            self.progress.samples_done,
+            self.scene.render.samples,
+            &self.scene.render,
+            &self.settings.trace,
+            self.tracer.accel.kind(),
+        );
+        let (w, h) = (canvas.width(), canvas.height());
+        match export::write_png_rgba8(path, w, h, canvas.rgba(), &text) {
+            Ok(()) => self
+                .messages
+                .push((false, format!("exported {}", path.display()))),
+            Err(e) => self.error(e.to_string()),
+        }
+    }
+
     fn file_stem(&self) -> String {
         Path::new(&self.scene_label)
             .file_stem()
@@ -666,6 +723,8 @@ impl eframe::App for ViewerApp {
                         BrowseFor::Open => Command::OpenFile(path),
                         BrowseFor::SaveScene => Command::SaveScene(path),
                         BrowseFor::Export => Command::Export(path),
+                        BrowseFor::ExportOverlay => Command::ExportOverlay(path),
+                        BrowseFor::ExportSceneView => Command::ExportSceneView(path),
                         BrowseFor::ExportTree => Command::ExportTree(path),
                         BrowseFor::ExportDiagram => Command::ExportDiagram(path),
                     });
@@ -674,6 +733,7 @@ impl eframe::App for ViewerApp {
             }
         }
         panels::help_window(&ctx, &mut self.show_help);
+        panels::export_window(self, &ctx);
         if self.sweep.open
             && let Some(point) = self.sweep.show(&ctx, &self.scene)
         {

@@ -101,9 +101,8 @@ pub fn top_bar(app: &mut ViewerApp, ui: &mut Ui) {
                         &name,
                     ));
                 }
-                if ui.button("Export render... (Ctrl+S)").clicked() {
-                    let name = format!("{}.png", app.file_stem());
-                    app.browser = Some(FileBrowser::new(BrowseFor::Export, app.start_dir(), &name));
+                if ui.button("Export... (Ctrl+S)").clicked() {
+                    app.export_choice = true;
                 }
             });
             ui.menu_button("View", |ui| {
@@ -475,6 +474,42 @@ pub fn tree_panel(app: &mut ViewerApp, ui: &mut Ui) {
         .show(ui, |ui| {
             tree_view::detail(ui, &tree, &selected);
         });
+}
+
+/// What Ctrl+S offers: the clean render, the render with the rays drawn over it, or the scene
+/// view; each then asks for a file name.
+pub fn export_window(app: &mut ViewerApp, ctx: &egui::Context) {
+    let mut open = app.export_choice;
+    let mut chosen = None;
+    egui::Window::new("Export")
+        .open(&mut open)
+        .collapsible(false)
+        .resizable(false)
+        .show(ctx, |ui| {
+            let has_tree = app.tree.is_some();
+            for (what, label, enabled, hint) in [
+                (BrowseFor::Export, "Render (PNG or EXR)", true, "the film at full resolution, as rendered"),
+                (BrowseFor::ExportOverlay, "Render with rays (PNG)", has_tree, "the render with the trees drawn over it, as in the render view"),
+                (BrowseFor::ExportSceneView, "Scene view (PNG)", has_tree, "the scene view's camera at the scene's size, with the render camera, lights and tree"),
+            ] {
+                if ui.add_enabled(enabled, egui::Button::new(label)).on_hover_text(hint).clicked() {
+                    chosen = Some(what);
+                }
+            }
+            if !has_tree {
+                ui.weak("click a pixel for a ray tree to export the rays");
+            }
+        });
+    app.export_choice = open && chosen.is_none();
+    if let Some(what) = chosen {
+        let suffix = match what {
+            BrowseFor::ExportOverlay => "-rays",
+            BrowseFor::ExportSceneView => "-scene-view",
+            _ => "",
+        };
+        let name = format!("{}{suffix}.png", app.file_stem());
+        app.browser = Some(FileBrowser::new(what, app.start_dir(), &name));
+    }
 }
 
 pub fn help_window(ctx: &egui::Context, open: &mut bool) {

@@ -9,7 +9,7 @@ use super::raster::Canvas;
 use super::{Filter, Segment, camera_segments, extent, light_markers, tree_segments};
 use crate::export::srgb8_bytes;
 use crate::ray_tree::RayTree;
-use crate::render::{RenderError, render};
+use crate::render::{Image, RenderError, render};
 use crate::scene::{Camera, CameraFrame, Scene};
 use crate::trace::{TraceSettings, Tracer};
 
@@ -68,6 +68,33 @@ pub fn scene_view_image(
     let mut segments = camera_segments(scene, image_plane_distance(scene, tree), Some(tree.pixel));
     segments.extend(tree_segments(tree, extent(scene)));
     let shown: Vec<&Segment> = segments.iter().filter(|s| filter.shows(s)).collect();
+    canvas.draw_segments(&frame, &depth, &shown, None);
+    canvas.draw_light_markers(&frame, &depth, &light_markers(scene));
+    Ok(canvas)
+}
+
+/// The render `image` of `tracer`'s scene (its own camera and size) with `trees` drawn over it
+/// by the scene view's rules, parts behind surfaces dimmed: the viewer's "render with overlay"
+/// export, at full resolution.
+pub fn overlay_image(
+    tracer: &Tracer,
+    image: &Image,
+    trees: &[&RayTree],
+    filter: &Filter,
+) -> Result<Canvas, SceneViewError> {
+    let scene = &tracer.scene;
+    let (width, height) = (image.width, image.height);
+    let frame = CameraFrame::new(&scene.camera, width, height);
+    let depth = DepthImage::of(tracer, &frame, width, height);
+    let mut canvas = Canvas::from_srgb8(width, height, &srgb8_bytes(image))
+        .ok_or(SceneViewError::Empty { width, height })?;
+    let extent = extent(scene);
+    let segments: Vec<Segment> = trees
+        .iter()
+        .flat_map(|t| tree_segments(t, extent))
+        .filter(|s| filter.shows(s))
+        .collect();
+    let shown: Vec<&Segment> = segments.iter().collect();
     canvas.draw_segments(&frame, &depth, &shown, None);
     canvas.draw_light_markers(&frame, &depth, &light_markers(scene));
     Ok(canvas)
