@@ -149,8 +149,10 @@ fn export_via(h: &mut Harness<'static, ViewerApp>, choice: &str, out: &std::path
     h.step();
 }
 
-/// The size and RGBA pixels of a PNG, and its text chunks.
-fn read_png(path: &std::path::Path) -> ((u32, u32), Vec<u8>, Vec<(String, String)>) {
+/// A PNG as read back: its size, its pixels (RGB or RGBA) and its text chunks.
+type Png = ((u32, u32), Vec<u8>, Vec<(String, String)>);
+
+fn read_png(path: &std::path::Path) -> Png {
     let file = std::fs::File::open(path).expect("the PNG was written");
     let mut reader = png::Decoder::new(std::io::BufReader::new(file))
         .read_info()
