@@ -8,8 +8,9 @@
 //!    input is held to ([`scene::rules`]), TOML and OBJ loading, built-in scenes.
 //! 3. [`accel`]: none / uniform grid / BVH behind one type.
 //! 4. [`shade`], [`trace`], [`ray_tree`]: the local model, the one recursive trace, the tree.
-//! 5. [`render`] (tiles, film, the viewer's worker session, statistics), [`export`], and
-//!    [`scene_view`] (the ray tree in 3D as segments every view draws alike).
+//! 5. [`render`] (tiles, film, the viewer's worker session, statistics), [`export`],
+//!    [`scene_view`] (the ray tree in 3D as segments every view draws alike) and [`diagram`]
+//!    (the tree as the lecture's figure: layout, legend, SVG).
 //! 6. `experiments` (feature `lab`: sweeps, charts, image metrics) and `app` (feature `viewer`:
 //!    the egui window; the only module that uses egui, eframe or wgpu).
 //! 7. The `raytree` command (`src/main.rs`).
