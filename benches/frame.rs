@@ -57,8 +57,10 @@ fn main() {
 
     // 64 trees: one clicked, 63 more over an 8x8 grid of the image.
     h.state_mut().command(Command::Pick(w / 2, h_px / 2));
-    h.state_mut()
-        .command(Command::PickRect([w / 8, h_px / 8], [w * 7 / 8, h_px * 7 / 8]));
+    h.state_mut().command(Command::PickRect(
+        [w / 8, h_px / 8],
+        [w * 7 / 8, h_px * 7 / 8],
+    ));
     h.step();
     let trees = h.state().trees().count();
     let nodes: usize = h.state().trees().map(|t| t.nodes).sum();

@@ -14,8 +14,8 @@ use std::time::{Duration, Instant};
 
 use eframe::egui;
 use egui::accesskit::Role;
-use egui_kittest::kittest::NodeT as _;
 use egui_kittest::Harness;
+use egui_kittest::kittest::NodeT as _;
 use egui_kittest::kittest::Queryable;
 use raytree::app::ViewerApp;
 use raytree::render::render;
@@ -214,14 +214,23 @@ fn ctrl_s_offers_the_render_with_rays_and_the_scene_view() {
     let (rays_size, rays_px, rays_text) = read_png(&rays);
     let (view_size, view_px, _) = read_png(&view);
     // Both at the scene's size, stamped like the render, and the rays change pixels.
-    assert_eq!((plain_size, rays_size, view_size), ((160, 120), (160, 120), (160, 120)));
-    assert!(rays_text.iter().any(|(k, _)| k == "raytree.settings"), "{rays_text:?}");
+    assert_eq!(
+        (plain_size, rays_size, view_size),
+        ((160, 120), (160, 120), (160, 120))
+    );
+    assert!(
+        rays_text.iter().any(|(k, _)| k == "raytree.settings"),
+        "{rays_text:?}"
+    );
     let rgb = |px: &[u8], stride: usize| -> Vec<[u8; 3]> {
         px.chunks(stride).map(|c| [c[0], c[1], c[2]]).collect()
     };
     let (a, b) = (rgb(&plain_px, 3), rgb(&rays_px, 4));
     let changed = a.iter().zip(&b).filter(|(p, q)| p != q).count();
-    assert!(changed > 100 && changed < a.len() / 2, "{changed} pixels changed by the rays");
+    assert!(
+        changed > 100 && changed < a.len() / 2,
+        "{changed} pixels changed by the rays"
+    );
     assert_ne!(rgb(&view_px, 4), b, "the scene view is another picture");
 }
 
