@@ -236,9 +236,25 @@ enum Found {
 
 /// Records that a branch ended, and why, in the tree and in the pixel's facts.
 #[inline(always)]
-fn ended<R: Recorder>(rec: &mut R, info: &mut SampleInfo, reason: EndReason) {
-    rec.end(reason);
-    info.ends |= 1 << reason as u8;
+fn ended<R: Recorder>(s: &mut Sample<'_, R>, reason: EndReason) {
+    s.rec.end(reason);
+    s.info.ends |= 1 << reason as u8;
+}
+
+/// One ray of the tree: its kind, its depth (the primary ray has depth 0) and the weight of
+/// its contribution to the pixel (the product of kr / kt from the root).
+#[derive(Clone, Copy, Debug)]
+struct Branch {
+    kind: RayKind,
+    depth: u32,
+    weight: Vec3,
+}
+
+/// What every ray of one sample adds to: the ray counts, the pixel's facts and the recorder.
+struct Sample<'a, R> {
+    counts: &'a mut RayCounts,
+    info: &'a mut SampleInfo,
+    rec: &'a mut R,
 }
 
 impl Tracer {
@@ -302,7 +318,6 @@ impl Tracer {
 
     /// Traces one ray of `kind` at `depth` (the primary ray has depth 0) whose contribution to
     /// the pixel is scaled by `weight`; returns its colour.
-    // The hot path takes its tallies as plain arguments rather than a context struct.
     #[allow(clippy::too_many_arguments)]
     pub fn trace<R: Recorder>(
         &self,
@@ -314,32 +329,42 @@ impl Tracer {
         info: &mut SampleInfo,
         rec: &mut R,
     ) -> Vec3 {
-        rec.enter(kind, depth, ray, weight);
+        let branch = Branch {
+            kind,
+            depth,
+            weight,
+        };
+        self.trace_ray(ray, branch, &mut Sample { counts, info, rec })
+    }
+
+    /// [`Tracer::trace`] of one ray of a sample.
+    fn trace_ray<R: Recorder>(&self, ray: &Ray, b: Branch, s: &mut Sample<'_, R>) -> Vec3 {
+        s.rec.enter(b.kind, b.depth, ray, b.weight);
         let background = self.scene.render.background;
-        let color = if let Some(reason) = self.ends_untraced(depth, weight, info) {
-            ended(rec, info, reason);
+        let color = if let Some(reason) = self.ends_untraced(b.depth, b.weight, s.info) {
+            ended(s, reason);
             background
         } else {
-            counts.count(kind);
-            info.rays += 1;
-            info.depth_reached = info.depth_reached.max(depth);
+            s.counts.count(b.kind);
+            s.info.rays += 1;
+            s.info.depth_reached = s.info.depth_reached.max(b.depth);
             match self.intersect(ray) {
                 Found::Nothing => {
-                    ended(rec, info, EndReason::NoHit);
+                    ended(s, EndReason::NoHit);
                     background
                 }
                 Found::Light(i, t) => {
-                    if depth == 0 {
-                        info.hit_t = t;
+                    if b.depth == 0 {
+                        s.info.hit_t = t;
                     }
-                    ended(rec, info, EndReason::HitLight);
-                    rec.light(i, t);
+                    ended(s, EndReason::HitLight);
+                    s.rec.light(i, t);
                     self.scene.lights[i].color
                 }
-                Found::Prim(hit) => self.shade(ray, &hit, depth, weight, counts, info, rec),
+                Found::Prim(hit) => self.shade(ray, &hit, b, s),
             }
         };
-        rec.leave(color);
+        s.rec.leave(color);
         color
     }
 
@@ -390,26 +415,24 @@ impl Tracer {
         (surface, error)
     }
 
-    #[allow(clippy::too_many_arguments)]
+    /// The colour of a ray `b` that hit `hit`: the local model with a shadow ray per light,
+    /// then the reflected and refracted children.
     fn shade<R: Recorder>(
         &self,
         ray: &Ray,
         hit: &PrimHit,
-        depth: u32,
-        weight: Vec3,
-        counts: &mut RayCounts,
-        info: &mut SampleInfo,
-        rec: &mut R,
+        b: Branch,
+        s: &mut Sample<'_, R>,
     ) -> Vec3 {
         let scene = &*self.scene;
         let offset = self.methods().offset;
         let (surface, error) = self.surface(ray, hit);
         let (p, n) = (surface.point, surface.normal);
         let v = -ray.dir;
-        rec.hit(&surface, v);
-        if depth == 0 {
-            info.normal = n;
-            info.hit_t = surface.t;
+        s.rec.hit(&surface, v);
+        if b.depth == 0 {
+            s.info.normal = n;
+            s.info.hit_t = surface.t;
         }
         let material = scene.material(surface.material);
 
@@ -431,8 +454,8 @@ impl Tracer {
             if n_dot_l > 0.0 {
                 // Only objects count as blockers, never lights.
                 let (shadow_ray, length) = shadow_ray(offset, p, error, n, l, light.position);
-                counts.count(RayKind::Shadow);
-                info.rays += 1;
+                s.counts.count(RayKind::Shadow);
+                s.info.rays += 1;
                 let blocked = if R::ENABLED {
                     let blocker = self
                         .accel
@@ -453,7 +476,7 @@ impl Tracer {
                 }
             }
             if let Some(terms) = terms {
-                rec.shadow(&ShadowTest {
+                s.rec.shadow(&ShadowTest {
                     light: i,
                     to_light: l,
                     distance,
@@ -463,7 +486,7 @@ impl Tracer {
                 });
             }
         }
-        rec.local(ambient, diffuse, specular);
+        s.rec.local(ambient, diffuse, specular);
         let mut color = ambient + diffuse + specular;
 
         // Children: refraction first decides whether its weight moves to the reflected ray
@@ -482,41 +505,31 @@ impl Tracer {
             match refract(ray.dir, n, eta) {
                 Some(t) => refracted = Some(t),
                 None => {
-                    rec.total_internal_reflection();
+                    s.rec.total_internal_reflection();
                     reflected_weight += kt;
                 }
             }
         }
-        rec.child_weights(
+        s.rec.child_weights(
             reflected_weight,
             if refracted.is_some() { kt } else { Vec3::ZERO },
         );
+        // Each child leaves the surface on the side it goes to and carries its weight.
+        let child = |kind, dir: Vec3, k: Vec3, s: &mut Sample<'_, R>| {
+            let ray = Ray::new(offset_ray_origin(offset, p, error, n, dir), dir);
+            let branch = Branch {
+                kind,
+                depth: b.depth + 1,
+                weight: b.weight * k,
+            };
+            k * self.trace_ray(&ray, branch, s)
+        };
         if reflected_weight != Vec3::ZERO {
             let r = reflect(ray.dir, n).normalize();
-            let child = Ray::new(offset_ray_origin(offset, p, error, n, r), r);
-            let c = self.trace(
-                &child,
-                RayKind::Reflected,
-                depth + 1,
-                weight * reflected_weight,
-                counts,
-                info,
-                rec,
-            );
-            color += reflected_weight * c;
+            color += child(RayKind::Reflected, r, reflected_weight, s);
         }
         if let Some(t) = refracted {
-            let child = Ray::new(offset_ray_origin(offset, p, error, n, t), t);
-            let c = self.trace(
-                &child,
-                RayKind::Refracted,
-                depth + 1,
-                weight * kt,
-                counts,
-                info,
-                rec,
-            );
-            color += kt * c;
+            color += child(RayKind::Refracted, t, kt, s);
         }
         color
     }

@@ -243,6 +243,20 @@ pub fn grazing_non_monotone(
     bad
 }
 
+/// `n` random trials of `trial`: each returns `None` when its setup is not one the oracle can
+/// judge (skipped), else whether the method failed. Returns (trials judged, failures).
+fn trials(
+    n: usize,
+    rng: &mut Pcg,
+    mut trial: impl FnMut(&mut Pcg) -> Option<bool>,
+) -> (usize, usize) {
+    (0..n)
+        .filter_map(|_| trial(rng))
+        .fold((0, 0), |(tested, failed), f| {
+            (tested + 1, failed + usize::from(f))
+        })
+}
+
 /// S4, inside origins: rays starting `r·10⁻ᵏ` inside the surface (a refracted ray's origin),
 /// going inwards at a random angle. Returns (rays the oracle confirms start inside, rays whose
 /// `t` is not the far root within `1e-4` relative).
@@ -252,26 +266,20 @@ pub fn inside_origin_wrong(
     n: usize,
     rng: &mut Pcg,
 ) -> (usize, usize) {
-    let (mut tested, mut wrong) = (0, 0);
-    for _ in 0..n {
+    trials(n, rng, |rng| {
         let center = rng.unit() * rng.range(0.0, 2.0);
         let r = rng.range(0.5, 2.0);
         let nrm = rng.unit();
         let origin = center + nrm * (r * (1.0 - p10(-k)));
         let tilt = rng.range(0.0, 3.0) * rng.perpendicular(nrm);
         let ray = Ray::new(origin, (-nrm + tilt).normalize());
-        let Some((n0, far)) = sphere_roots_f64(center, r, &ray) else {
-            continue;
-        };
+        let (n0, far) = sphere_roots_f64(center, r, &ray)?;
         if n0 >= 0.0 {
-            continue; // rounded to the outside
+            return None; // rounded to the outside
         }
-        tested += 1;
         let t = intersect_sphere(method, center, r, &ray, 0.0, f32::INFINITY);
-        let ok = t.is_some_and(|t| (t as f64 - far).abs() <= 1e-4 * far.max(r as f64));
-        wrong += usize::from(!ok);
-    }
-    (tested, wrong)
+        Some(!t.is_some_and(|t| (t as f64 - far).abs() <= 1e-4 * far.max(r as f64)))
+    })
 }
 
 // =============================================================================================
@@ -416,8 +424,7 @@ pub fn centroid_misses(
     n: usize,
     rng: &mut Pcg,
 ) -> (usize, usize) {
-    let (mut tested, mut misses) = (0, 0);
-    for _ in 0..n {
+    trials(n, rng, |rng| {
         let base = rng.in_box(Vec3::splat(-base_extent), Vec3::splat(base_extent));
         let a = rng.unit();
         let b = rng.perpendicular(a);
@@ -429,22 +436,18 @@ pub fn centroid_misses(
         let normal = (v[1] - v[0]).cross(v[2] - v[0]);
         let thin = normal.length() < 0.5 * edge * edge / aspect;
         if thin || !normal.is_finite() {
-            continue; // the rounded vertices are too thin to aim at reliably
+            return None; // the rounded vertices are too thin to aim at reliably
         }
         let centroid = (v[0] + v[1] + v[2]) / 3.0;
         let dir_out = (normal.normalize() + 0.3 * rng.unit()).normalize();
         let origin = centroid + dir_out * (10.0 * edge);
         let ray = Ray::new(origin, (centroid - origin).normalize());
-        let Some((_, b0, b1, b2)) = triangle_hit_f64(&v, &ray) else {
-            continue;
-        };
+        let (_, b0, b1, b2) = triangle_hit_f64(&v, &ray)?;
         if b0.min(b1).min(b2) < 0.05 {
-            continue;
+            return None;
         }
-        tested += 1;
-        misses += usize::from(intersect_triangle(method, &v, &ray, 0.0, f32::INFINITY).is_none());
-    }
-    (tested, misses)
+        Some(intersect_triangle(method, &v, &ray, 0.0, f32::INFINITY).is_none())
+    })
 }
 
 // =============================================================================================
@@ -462,9 +465,8 @@ pub fn far_triangle_misses(
     n: usize,
     rng: &mut Pcg,
 ) -> (usize, usize) {
-    let (mut tested, mut misses) = (0, 0);
     let max_tilt = max_tilt_deg.to_radians();
-    for _ in 0..n {
+    trials(n, rng, |rng| {
         let a = rng.unit();
         let b = rng.perpendicular(a);
         let c = rng.in_box(Vec3::splat(-1.0), Vec3::ONE);
@@ -478,16 +480,12 @@ pub fn far_triangle_misses(
         let target = v[0] + w1 * (v[1] - v[0]) + w2 * (v[2] - v[0]);
         let origin = target + towards * distance;
         let ray = Ray::new(origin, (target - origin).normalize());
-        let Some((t, b0, b1, b2)) = triangle_hit_f64(&v, &ray) else {
-            continue;
-        };
+        let (t, b0, b1, b2) = triangle_hit_f64(&v, &ray)?;
         if t <= 0.0 || b0.min(b1).min(b2) < 0.1 {
-            continue;
+            return None;
         }
-        tested += 1;
-        misses += usize::from(intersect_triangle(method, &v, &ray, 0.0, f32::INFINITY).is_none());
-    }
-    (tested, misses)
+        Some(intersect_triangle(method, &v, &ray, 0.0, f32::INFINITY).is_none())
+    })
 }
 
 // =============================================================================================
