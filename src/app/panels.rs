@@ -204,14 +204,22 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                 .changed();
             restart |= ui
                 .add(
-                    egui::Slider::new(&mut r.samples, 1..=1024)
+                    egui::Slider::new(&mut r.samples, rules::SAMPLES)
                         .logarithmic(true)
                         .text("samples"),
                 )
                 .changed();
             ui.horizontal(|ui| {
-                restart |= drag(ui, "width", DragValue::new(&mut r.width).range(1..=8192));
-                restart |= drag(ui, "height", DragValue::new(&mut r.height).range(1..=8192));
+                restart |= drag(
+                    ui,
+                    "width",
+                    DragValue::new(&mut r.width).range(rules::IMAGE_SIZE),
+                );
+                restart |= drag(
+                    ui,
+                    "height",
+                    DragValue::new(&mut r.height).range(rules::IMAGE_SIZE),
+                );
             });
             restart |= combo(ui, "shading", &mut r.shading);
             restart |= color_edit(ui, "background", &mut r.background);
@@ -225,14 +233,17 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                 restart |= drag(
                     ui,
                     "weight cutoff",
-                    DragValue::new(&mut t.cutoff).speed(0.001).range(0.0..=0.99),
+                    DragValue::new(&mut t.cutoff)
+                        .speed(0.001)
+                        // rules::CUTOFF: at least 0, below 1.
+                        .range(0.0..=0.999),
                 );
             });
             ui.horizontal(|ui| {
                 restart |= drag(
                     ui,
                     "threads (0 = all)",
-                    DragValue::new(&mut app.settings.threads).range(0..=256),
+                    DragValue::new(&mut app.settings.threads).range(0..=rules::MAX_THREADS),
                 );
             });
             ui.label(format!("accelerator in use: {:?}", app.tracer.accel.kind()));
