@@ -213,7 +213,7 @@ pub fn advance_playback(app: &mut ViewerApp, ctx: &egui::Context) {
 /// The toolbar: the step-through (depth slider, play, speed) and the filters.
 fn toolbar(app: &mut ViewerApp, ui: &mut Ui) {
     let deepest = deepest(app.trees());
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         let mut depth = app.tree_state.reveal.unwrap_or(deepest).min(deepest);
         let l = ui.label("depth");
         let r = ui

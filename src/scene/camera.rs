@@ -6,7 +6,7 @@
 //! `((2(x+0.5)/W − 1)·a·tan(fov_y/2), (1 − 2(y+0.5)/H)·tan(fov_y/2), −1)` in camera space
 //! (a = W/H), camera looking down −z, for the pixel centre.
 
-use glam::{Mat4, Vec3, Vec4};
+use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 use super::sampling::sample_offset;
@@ -87,31 +87,6 @@ impl CameraFrame {
         let x = (cx / (self.aspect * self.tan_half_fov_y) + 1.0) * 0.5 * self.width;
         let y = (1.0 - cy / self.tan_half_fov_y) * 0.5 * self.height;
         Some((x, y))
-    }
-}
-
-impl CameraFrame {
-    /// The matrix taking world points to wgpu clip space (depth 0..1 between `near` and
-    /// `far`) such that the image position of [`CameraFrame::project`] is where the point lands
-    /// on screen: the GPU overlay and the CPU projection agree.
-    pub fn clip_from_world(&self, near: f32, far: f32) -> Mat4 {
-        let o = self.origin;
-        let view = Mat4::from_cols(
-            Vec4::new(self.right.x, self.up.x, self.back.x, 0.0),
-            Vec4::new(self.right.y, self.up.y, self.back.y, 0.0),
-            Vec4::new(self.right.z, self.up.z, self.back.z, 0.0),
-            Vec4::new(-self.right.dot(o), -self.up.dot(o), -self.back.dot(o), 1.0),
-        );
-        let sx = 1.0 / (self.aspect * self.tan_half_fov_y);
-        let sy = 1.0 / self.tan_half_fov_y;
-        let a = far / (near - far);
-        let proj = Mat4::from_cols(
-            Vec4::new(sx, 0.0, 0.0, 0.0),
-            Vec4::new(0.0, sy, 0.0, 0.0),
-            Vec4::new(0.0, 0.0, a, -1.0),
-            Vec4::new(0.0, 0.0, a * near, 0.0),
-        );
-        proj * view
     }
 }
 
@@ -210,34 +185,6 @@ mod tests {
             .project(Vec3::new(1.0, 2.0, 3.0) + 5.0 * c)
             .expect("in front");
         assert!(x.abs() < 1e-3 && y.abs() < 1e-3, "{x} {y}");
-    }
-
-    #[test]
-    fn clip_matrix_agrees_with_project() {
-        let cam = Camera {
-            position: Vec3::new(0.3, 1.7, 6.5),
-            look_at: Vec3::new(0.0, 0.9, 0.0),
-            up: Vec3::Y,
-            fov_y_deg: 45.0,
-        };
-        let frame = CameraFrame::new(&cam, 640, 480);
-        let m = frame.clip_from_world(0.01, 1000.0);
-        for p in [
-            Vec3::new(1.0, 1.0, -1.2),
-            Vec3::new(-2.0, 0.0, 3.0),
-            Vec3::ZERO,
-        ] {
-            let c = m * p.extend(1.0);
-            let (ndc_x, ndc_y, ndc_z) = (c.x / c.w, c.y / c.w, c.z / c.w);
-            let x = (ndc_x + 1.0) * 0.5 * 640.0;
-            let y = (1.0 - ndc_y) * 0.5 * 480.0;
-            let (px, py) = frame.project(p).expect("in front");
-            assert!(
-                (x - px).abs() < 1e-2 && (y - py).abs() < 1e-2,
-                "{x},{y} vs {px},{py}"
-            );
-            assert!((0.0..=1.0).contains(&ndc_z), "depth {ndc_z}");
-        }
     }
 
     fn camera() -> Camera {
