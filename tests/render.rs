@@ -4,9 +4,11 @@
 //! Regenerate the golden images (after a deliberate change, looking at them first) with:
 //! `RAYTREE_BLESS=1 cargo test --release --test render golden`
 
-use std::path::PathBuf;
 use std::sync::Arc;
 
+mod golden_support;
+
+use golden_support::{golden_path, mismatch, read_png};
 use raytree::accel::AccelKind;
 use raytree::export::srgb8_bytes;
 use raytree::ray_tree::pixel_tree;
@@ -81,73 +83,28 @@ fn clicked_tree_colour_equals_the_render() {
     }
 }
 
-fn golden_path(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/golden")
-        .join(format!("{name}.png"))
-}
+/// Golden images at 320×240, 4 samples, within [`golden_support::mismatch`]'s tolerance.
+const REGENERATE: &str = "RAYTREE_BLESS=1 cargo test --release --test render golden";
 
-fn read_png(path: &PathBuf) -> (u32, u32, Vec<u8>) {
-    let file = std::fs::File::open(path).unwrap_or_else(|e| {
-        panic!(
-            "{}: {e}; regenerate with RAYTREE_BLESS=1 cargo test --release --test render golden",
-            path.display()
-        )
-    });
-    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
-        .read_info()
-        .expect("golden PNG header");
-    let mut buf = vec![0; reader.output_buffer_size().expect("size")];
-    let info = reader.next_frame(&mut buf).expect("golden PNG data");
-    assert_eq!(info.color_type, png::ColorType::Rgb);
-    buf.truncate(info.buffer_size());
-    (info.width, info.height, buf)
-}
-
-/// Golden images at 320×240, 4 samples. Tolerance: a channel may differ by at most 2/255 on
-/// 99.5% of pixels and by any amount on the rest (different libm `powf`/`sqrt` rounding can
-/// flip a shadow-edge pixel), and the mean absolute difference stays below 0.25/255.
 #[test]
 fn golden_images() {
     let bless = std::env::var_os("RAYTREE_BLESS").is_some();
     for name in NAMES {
         let s = scene(name, 320, 240);
         let img = render_with(&s, AccelKind::Auto, 4, 0);
-        let path = golden_path(name);
+        let path = golden_path(&format!("{name}.png"));
         if bless {
             std::fs::create_dir_all(path.parent().expect("folder")).expect("mkdir");
             raytree::export::write_png(&path, &img, &[]).expect("write golden");
             continue;
         }
-        let (w, h, want) = read_png(&path);
+        let (w, h, want) = read_png(&path, png::ColorType::Rgb, REGENERATE);
         assert_eq!((w, h), (img.width, img.height), "{name}: size");
-        let got = srgb8_bytes(&img);
-        let mut off_pixels = 0;
-        let mut total_diff = 0u64;
-        for (a, b) in got.chunks(3).zip(want.chunks(3)) {
-            let d = a
-                .iter()
-                .zip(b)
-                .map(|(x, y)| x.abs_diff(*y))
-                .max()
-                .unwrap_or(0);
-            total_diff += a
-                .iter()
-                .zip(b)
-                .map(|(x, y)| x.abs_diff(*y) as u64)
-                .sum::<u64>();
-            if d > 2 {
-                off_pixels += 1;
-            }
-        }
-        let n = (w * h) as f64;
-        let mean = total_diff as f64 / (3.0 * n);
-        if off_pixels as f64 > 0.005 * n || mean > 0.25 {
+        if let Some(why) = mismatch(&srgb8_bytes(&img), &want, 3) {
             let new = path.with_extension("new.png");
             raytree::export::write_png(&new, &img, &[]).expect("write new");
             panic!(
-                "{name}: {off_pixels} pixels off by more than 2/255, mean difference {mean:.3}/255; \
-                 see {}; regenerate with RAYTREE_BLESS=1 cargo test --release --test render golden",
+                "{name}: {why}; see {}; regenerate with {REGENERATE}",
                 new.display()
             );
         }

@@ -5,11 +5,13 @@
 //! Regenerate the golden picture (after a deliberate change, looking at it first) with:
 //! `RAYTREE_BLESS=1 cargo test --release --test scene_view golden`
 
-use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::Arc;
 
+mod golden_support;
+
 use glam::Vec3;
+use golden_support::{golden_path, mismatch, read_png};
 use raytree::scene::{Camera, CameraFrame, Object, ObjectId, ObjectSource, Scene, Sphere};
 use raytree::scene_view::occlusion::DepthImage;
 use raytree::scene_view::raster::{Canvas, line_width};
@@ -140,29 +142,6 @@ fn the_part_behind_a_sphere_is_drawn_dimmed_not_left_out() {
     assert!(clear > 200, "in the clear: {clear}");
 }
 
-fn golden_path(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/golden")
-        .join(format!("scene_view_{name}.png"))
-}
-
-fn read_rgba(path: &Path) -> (u32, u32, Vec<u8>) {
-    let file = std::fs::File::open(path).unwrap_or_else(|e| {
-        panic!(
-            "{}: {e}; regenerate with RAYTREE_BLESS=1 cargo test --release --test scene_view golden",
-            path.display()
-        )
-    });
-    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
-        .read_info()
-        .expect("PNG header");
-    let mut buf = vec![0; reader.output_buffer_size().expect("size")];
-    let info = reader.next_frame(&mut buf).expect("PNG data");
-    assert_eq!(info.color_type, png::ColorType::Rgba);
-    buf.truncate(info.buffer_size());
-    (info.width, info.height, buf)
-}
-
 /// The default scene's glass sphere seen from the right of the render camera, at 320 × 240:
 /// pixel (125, 135) looks into the glass sphere, so its tree refracts through it; the picture
 /// shows the frustum, the image plane with the pixel's cross, both lights and the tree.
@@ -198,33 +177,19 @@ fn golden_glass_sphere_from_the_side() {
         .status()
         .expect("runs");
     assert!(status.success());
-    let path = golden_path("glass");
+    let path = golden_path("scene_view_glass.png");
     if std::env::var_os("RAYTREE_BLESS").is_some() {
         std::fs::copy(&out, &path).expect("write golden");
         return;
     }
-    let (w, h, want) = read_rgba(&path);
-    let (gw, gh, got) = read_rgba(&out);
+    let regenerate = "RAYTREE_BLESS=1 cargo test --release --test scene_view golden";
+    let (w, h, want) = read_png(&path, png::ColorType::Rgba, regenerate);
+    let (gw, gh, got) = read_png(&out, png::ColorType::Rgba, regenerate);
     assert_eq!((gw, gh), (w, h), "size");
-    let mut off_pixels = 0;
-    let mut total = 0u64;
-    for (a, b) in got.chunks(4).zip(want.chunks(4)) {
-        let d: Vec<u8> = a.iter().zip(b).map(|(x, y)| x.abs_diff(*y)).collect();
-        total += d.iter().map(|&x| u64::from(x)).sum::<u64>();
-        if d.iter().any(|&x| x > 2) {
-            off_pixels += 1;
-        }
-    }
-    let n = f64::from(w * h);
-    let mean = total as f64 / (4.0 * n);
-    if off_pixels as f64 > 0.005 * n || mean > 0.25 {
+    if let Some(why) = mismatch(&got, &want, 4) {
         let new = path.with_extension("new.png");
         std::fs::copy(&out, &new).expect("write new");
-        panic!(
-            "{off_pixels} pixels off by more than 2/255, mean difference {mean:.3}/255; see {}; \
-             regenerate with RAYTREE_BLESS=1 cargo test --release --test scene_view golden",
-            new.display()
-        );
+        panic!("{why}; see {}; regenerate with {regenerate}", new.display());
     }
 }
 
