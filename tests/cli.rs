@@ -143,6 +143,56 @@ fn stats_json_has_consistent_figures() {
     );
 }
 
+/// `--frames K` (issue 15, the peer bench's first and warm frames): one load and build, K
+/// renders, each frame's render phase in the JSON, the statistics the first frame's, and the
+/// image the same as a single frame's; `--frames 0` is refused.
+#[test]
+fn frames_render_several_times_after_one_build() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let run = |frames: &str, name: &str| {
+        let (out, stats) = (
+            dir.path().join(format!("{name}.png")),
+            dir.path().join(format!("{name}.json")),
+        );
+        raytree()
+            .args([
+                "render", "glass", "--width", "40", "--height", "30", "--quiet",
+            ])
+            .args(["--threads", "1", "--frames", frames, "-o"])
+            .arg(&out)
+            .arg("--stats-json")
+            .arg(&stats)
+            .assert()
+            .success();
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&stats).expect("stats written"))
+                .expect("stats are JSON");
+        (std::fs::read(&out).expect("image written"), json)
+    };
+    let (one_image, one) = run("1", "one");
+    let (three_image, three) = run("3", "three");
+    assert!(
+        one.get("frame_render_secs").is_none(),
+        "one frame: the JSON as before"
+    );
+    let frames = three["frame_render_secs"]
+        .as_array()
+        .expect("frame_render_secs is a list");
+    assert_eq!(frames.len(), 3);
+    assert!(frames.iter().all(|f| f.as_f64().is_some_and(|s| s > 0.0)));
+    assert_eq!(frames[0], three["stats"]["render_secs"], "stats of frame 1");
+    assert_eq!(
+        one["stats"]["rays"], three["stats"]["rays"],
+        "a frame's rays"
+    );
+    assert_eq!(one_image, three_image, "every frame is the same image");
+    raytree()
+        .args(["render", "glass", "--frames", "0", "-o"])
+        .arg(dir.path().join("never.png"))
+        .assert()
+        .failure();
+}
+
 #[test]
 fn bad_scene_is_one_sentence_and_no_file() {
     let dir = tempfile::tempdir().expect("temp dir");

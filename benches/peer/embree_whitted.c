@@ -1,20 +1,25 @@
-/* embree_whitted.c: the peer of raytree's issue-7 benchmark. A Whitted ray tracer over
- * Embree 3 (single rays: rtcIntersect1 for camera, reflected and refracted rays, rtcOccluded1
- * for shadow rays) that renders the scene `benches/peer.rs` hands it with the same camera,
- * materials, recursion and ray-origin offsets as raytree's `src/trace.rs`, on N pthreads over
- * 32x32 tiles taken from an atomic counter.
+/* embree_whitted.c: the peer of raytree's peer benchmark (issues 7 and 15). A Whitted ray
+ * tracer over Embree 3 (single rays: rtcIntersect1 for camera, reflected and refracted rays,
+ * rtcOccluded1 for shadow rays) that renders the scene `benches/peer.rs` hands it with the same
+ * camera, materials, recursion, shadow-ray rule and ray-origin offsets as raytree's
+ * `src/trace.rs`, on N pthreads over 32x32 tiles taken from an atomic counter.
  *
- * Usage: embree_whitted SCENE.bin THREADS [IMAGE.f32]
- * The environment variable EMBREE_WHITTED_QUALITY (low, medium or high) sets the scene's and
- * the triangle mesh's build quality; Embree's default, medium, without it.
- * Prints `key value` lines (load/build/render seconds, rays by kind, Mrays/s, memory); writes
- * the linear RGB image as raw little-endian f32 when IMAGE is given.
+ * Usage: embree_whitted [--spheres builtin|user] [--quality low|medium|high] [--frames K]
+ *                       SCENE.bin THREADS [IMAGE.f32]
  *
- * Spheres are analytic in both renderers: here an Embree user geometry whose intersection is
- * raytree's robust (Ray Tracing Gems ch. 7) root pair, because Embree's built-in sphere points
- * solve the quadratic with the cancellation-prone formula and let offset rays re-hit the
- * sphere they leave. Triangles use Embree's own triangle intersector and BVH (default build
- * quality), which is the point of the comparison.
+ * --spheres builtin (the default) gives the spheres to Embree as its own sphere geometry
+ *   (RTC_GEOMETRY_TYPE_SPHERE_POINT, a float4 centre and radius each): Embree's ray-sphere
+ *   intersector, the fast path an Embree user takes. `user` is the configuration of issue 7: an
+ *   Embree user geometry whose callback is raytree's robust (Ray Tracing Gems ch. 7) root pair.
+ * --quality sets the scene's and every geometry's build quality (default high: the triangles'
+ *   BVH with spatial splits, as an Embree user after render speed chooses). Scene flags stay
+ *   RTC_SCENE_FLAG_NONE (not robust, not dynamic, no filter callbacks).
+ * --frames K renders the image K times after one build: frame 1 is the first frame, the rest
+ *   are warm frames (default 1).
+ *
+ * Prints `key value` lines: load and build seconds, `frame_secs` (each frame's render phase),
+ * `render_secs` (frame 1), rays by kind of one frame, Mrays/s, memory. Writes the last frame's
+ * linear RGB image as raw little-endian f32 when IMAGE is given.
  *
  * Build: cc -O2 -ffp-contract=off embree_whitted.c -lembree3 -lpthread -lm */
 #include <embree3/rtcore.h>
@@ -328,7 +333,12 @@ static vec3 trace(vec3 o, vec3 d, Kind kind, uint32_t depth, Counts *counts,
         float dist = length(to_light);
         vec3 l = scale(1.0f / dist, to_light);
         float n_dot_l = dot(n, l);
+        /* raytree's rule: no shadow ray where the light's unshadowed contribution is exactly
+         * zero: the light behind the surface, or no diffuse and no specular in the light's
+         * channels. */
         if (!(n_dot_l > 0.0f)) continue;
+        if (is_zero(mul(light->color, m->diffuse)) && is_zero(mul(light->color, m->specular)))
+            continue;
         vec3 origin = offset_origin(p, err, n, l);
         vec3 seg = sub(light->position, origin);
         float seg_len = length(seg);
@@ -417,13 +427,58 @@ static void rtc_error(void *user, enum RTCError code, const char *str) {
     exit(2);
 }
 
+static const char *usage =
+    "usage: embree_whitted [--spheres builtin|user] [--quality low|medium|high] [--frames K] "
+    "SCENE.bin THREADS [IMAGE.f32]";
+
+/* One frame on `threads` pthreads: its render-phase seconds; its ray counts in `total`. */
+static double render_frame(int threads, Worker *workers, pthread_t *ids, Counts *total) {
+    memset(workers, 0, sizeof(Worker) * threads);
+    atomic_store(&next_tile, 0);
+    double start = now_secs();
+    for (int i = 0; i < threads; i++)
+        if (pthread_create(&ids[i], NULL, worker, &workers[i]) != 0) die("pthread_create failed");
+    for (int i = 0; i < threads; i++) pthread_join(ids[i], NULL);
+    double secs = now_secs() - start;
+    memset(total, 0, sizeof *total);
+    for (int i = 0; i < threads; i++) {
+        total->primary += workers[i].counts.primary;
+        total->reflected += workers[i].counts.reflected;
+        total->refracted += workers[i].counts.refracted;
+        total->shadow += workers[i].counts.shadow;
+    }
+    return secs;
+}
+
 int main(int argc, char **argv) {
-    if (argc < 3) die("usage: embree_whitted SCENE.bin THREADS [IMAGE.f32]");
-    int threads = atoi(argv[2]);
+    const char *spheres_name = "builtin", *quality_name = "high";
+    int frames = 1;
+    int argi = 1;
+    while (argi < argc && strncmp(argv[argi], "--", 2) == 0) {
+        if (argi + 1 >= argc) die(usage);
+        if (strcmp(argv[argi], "--spheres") == 0) spheres_name = argv[argi + 1];
+        else if (strcmp(argv[argi], "--quality") == 0) quality_name = argv[argi + 1];
+        else if (strcmp(argv[argi], "--frames") == 0) frames = atoi(argv[argi + 1]);
+        else die(usage);
+        argi += 2;
+    }
+    if (argc - argi < 2) die(usage);
+    const char *scene_path = argv[argi], *image_path = argc - argi > 2 ? argv[argi + 2] : NULL;
+    int threads = atoi(argv[argi + 1]);
     if (threads < 1 || threads > 256) die("THREADS must be 1..256");
+    if (frames < 1 || frames > 1000) die("--frames must be 1..1000");
+    int builtin_spheres;
+    if (strcmp(spheres_name, "builtin") == 0) builtin_spheres = 1;
+    else if (strcmp(spheres_name, "user") == 0) builtin_spheres = 0;
+    else die("--spheres must be builtin or user");
+    enum RTCBuildQuality quality;
+    if (strcmp(quality_name, "low") == 0) quality = RTC_BUILD_QUALITY_LOW;
+    else if (strcmp(quality_name, "medium") == 0) quality = RTC_BUILD_QUALITY_MEDIUM;
+    else if (strcmp(quality_name, "high") == 0) quality = RTC_BUILD_QUALITY_HIGH;
+    else die("--quality must be low, medium or high");
 
     double t0 = now_secs();
-    load_scene(argv[1]);
+    load_scene(scene_path);
     char config[64];
     snprintf(config, sizeof config, "threads=%d", threads);
     RTCDevice device = rtcNewDevice(config);
@@ -431,13 +486,7 @@ int main(int argc, char **argv) {
     rtcSetDeviceErrorFunction(device, rtc_error, NULL);
     rtcSetDeviceMemoryMonitorFunction(device, memory_monitor, NULL);
     scene = rtcNewScene(device);
-    const char *quality_name = getenv("EMBREE_WHITTED_QUALITY");
-    if (!quality_name || !*quality_name) quality_name = "medium";
-    enum RTCBuildQuality quality;
-    if (strcmp(quality_name, "low") == 0) quality = RTC_BUILD_QUALITY_LOW;
-    else if (strcmp(quality_name, "medium") == 0) quality = RTC_BUILD_QUALITY_MEDIUM;
-    else if (strcmp(quality_name, "high") == 0) quality = RTC_BUILD_QUALITY_HIGH;
-    else die("EMBREE_WHITTED_QUALITY must be low, medium or high");
+    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_NONE);
     rtcSetSceneBuildQuality(scene, quality);
 
     uint32_t *indices = alloc(sizeof(uint32_t) * 3 * (size_t)S.n_triangles);
@@ -453,8 +502,26 @@ int main(int argc, char **argv) {
         if (rtcAttachGeometry(scene, g) != GEOM_TRIANGLES) die("unexpected geometry id");
         rtcReleaseGeometry(g);
     }
-    if (S.n_spheres > 0) {
+    float *sphere_points = NULL;
+    if (S.n_spheres > 0 && builtin_spheres) {
+        /* Embree's own spheres: x, y, z, radius per point. */
+        sphere_points = alloc(sizeof(float) * 4 * S.n_spheres);
+        for (uint32_t i = 0; i < S.n_spheres; i++) {
+            sphere_points[4 * i + 0] = S.spheres[i].center.x;
+            sphere_points[4 * i + 1] = S.spheres[i].center.y;
+            sphere_points[4 * i + 2] = S.spheres[i].center.z;
+            sphere_points[4 * i + 3] = S.spheres[i].radius;
+        }
+        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+        rtcSetGeometryBuildQuality(g, quality);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, sphere_points,
+                                   0, 16, S.n_spheres);
+        rtcCommitGeometry(g);
+        rtcAttachGeometryByID(scene, g, GEOM_SPHERES);
+        rtcReleaseGeometry(g);
+    } else if (S.n_spheres > 0) {
         RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
+        rtcSetGeometryBuildQuality(g, quality);
         rtcSetGeometryUserPrimitiveCount(g, S.n_spheres);
         rtcSetGeometryUserData(g, S.spheres);
         rtcSetGeometryBoundsFunction(g, sphere_bounds, NULL);
@@ -480,37 +547,37 @@ int main(int argc, char **argv) {
 
     Worker *workers = alloc(sizeof(Worker) * threads);
     pthread_t *ids = alloc(sizeof(pthread_t) * threads);
-    double t3 = now_secs();
-    for (int i = 0; i < threads; i++)
-        if (pthread_create(&ids[i], NULL, worker, &workers[i]) != 0) die("pthread_create failed");
-    for (int i = 0; i < threads; i++) pthread_join(ids[i], NULL);
-    double t4 = now_secs();
-
-    Counts total = {0, 0, 0, 0};
-    for (int i = 0; i < threads; i++) {
-        total.primary += workers[i].counts.primary;
-        total.reflected += workers[i].counts.reflected;
-        total.refracted += workers[i].counts.refracted;
-        total.shadow += workers[i].counts.shadow;
+    double *frame_secs = alloc(sizeof(double) * frames);
+    Counts total, first;
+    for (int f = 0; f < frames; f++) {
+        frame_secs[f] = render_frame(threads, workers, ids, &total);
+        if (f == 0) first = total;
+        else if (memcmp(&first, &total, sizeof total) != 0)
+            die("a warm frame traced other rays than the first");
     }
+
     uint64_t rays = total.primary + total.reflected + total.refracted + total.shadow;
-    double render = t4 - t3;
     printf("embree_version %d.%d.%d\n", RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH);
     printf("threads %d\n", threads);
+    printf("spheres_geometry %s\n", builtin_spheres ? "builtin" : "user");
     printf("build_quality %s\n", quality_name);
     printf("triangles %u\nspheres %u\n", S.n_triangles, S.n_spheres);
-    printf("load_secs %.6f\nbuild_secs %.6f\nrender_secs %.6f\n", t1 - t0, t2 - t1, render);
+    printf("load_secs %.6f\nbuild_secs %.6f\nrender_secs %.6f\n", t1 - t0, t2 - t1, frame_secs[0]);
+    printf("frame_secs");
+    for (int f = 0; f < frames; f++) printf(" %.6f", frame_secs[f]);
+    printf("\n");
     printf("primary %llu\nreflected %llu\nrefracted %llu\nshadow %llu\n",
            (unsigned long long)total.primary, (unsigned long long)total.reflected,
            (unsigned long long)total.refracted, (unsigned long long)total.shadow);
-    printf("mrays_per_sec %.4f\n", (double)rays / render / 1e6);
+    printf("mrays_per_sec %.4f\n", (double)rays / frame_secs[0] / 1e6);
     printf("embree_peak_bytes %lld\n", (long long)atomic_load(&embree_peak));
     printf("geometry_bytes %llu\n",
-           (unsigned long long)(S.n_triangles * (36ull + 12ull) + S.n_spheres * sizeof(Sphere)));
+           (unsigned long long)(S.n_triangles * (36ull + 12ull) +
+                                S.n_spheres * (builtin_spheres ? 16ull : sizeof(Sphere))));
     printf("peak_rss_kb %ld\n", peak_rss_kb());
 
-    if (argc > 3) {
-        FILE *f = fopen(argv[3], "wb");
+    if (image_path) {
+        FILE *f = fopen(image_path, "wb");
         if (!f) die("cannot write the image");
         fwrite(image, sizeof(float), 3 * (size_t)S.width * S.height, f);
         fclose(f);

@@ -39,6 +39,11 @@ pub struct RenderArgs {
     /// primitive.
     #[arg(long)]
     stats: bool,
+    /// Render the image this many times after one load and build (first and warm frames, for
+    /// the peer benchmark): the statistics are the first frame's, the JSON's
+    /// `frame_render_secs` lists each frame's render phase, the image written is the last.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    frames: u32,
     #[command(flatten)]
     overrides: SceneOverrides,
 }
@@ -84,9 +89,17 @@ pub fn run_render(args: &RenderArgs) -> Result<()> {
         )
         .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
-    let (image, stats) = render(&tracer, samples, settings.threads, &|done, _| {
+    let (mut image, stats) = render(&tracer, samples, settings.threads, &|done, _| {
         bar.set_position(done)
     })?;
+    let mut frame_secs = vec![stats.render_secs];
+    for _ in 1..args.frames {
+        let (warm, warm_stats) = render(&tracer, samples, settings.threads, &|done, _| {
+            bar.set_position(done)
+        })?;
+        frame_secs.push(warm_stats.render_secs);
+        image = warm;
+    }
     bar.finish_and_clear();
 
     let text = export::stamp(
@@ -100,11 +113,19 @@ pub fn run_render(args: &RenderArgs) -> Result<()> {
     export::write_image(&args.output, &image, &text)?;
     let report = RunReport::new(&tracer, stats, load_secs);
     if let Some(path) = &args.stats_json {
-        let json = serde_json::to_string_pretty(&report).context("cannot encode the statistics")?;
+        let mut json = serde_json::to_value(&report).context("cannot encode the statistics")?;
+        if args.frames > 1 {
+            json["frame_render_secs"] = frame_secs.clone().into();
+        }
+        let json = serde_json::to_string_pretty(&json).context("cannot encode the statistics")?;
         export::write_text(path, &json)?;
     }
     for line in report.lines(&args.output.display().to_string(), args.stats) {
         out!("{line}");
+    }
+    if args.frames > 1 {
+        let secs: Vec<String> = frame_secs.iter().map(|s| format!("{s:.3}")).collect();
+        out!("render phase of each frame (s): {}", secs.join(", "));
     }
     Ok(())
 }
