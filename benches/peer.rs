@@ -1,24 +1,35 @@
-//! Issue 7: raytree against a peer in the same run. The peer is `benches/peer/embree_whitted.c`,
-//! a Whitted renderer over Debian's Embree 3 (`apt-get install libembree-dev`), compiled here
-//! with the system C compiler (`$CC`, else `cc`) into a temp dir; without Embree the peer is
-//! skipped with a message and raytree runs alone.
+//! Issues 7 and 15: raytree against a peer in the same run, the peer held at its best. The
+//! peer is `benches/peer/embree_whitted.c`, a Whitted renderer over Debian's Embree 3
+//! (`apt-get install libembree-dev`), compiled here with the system C compiler (`$CC`, else
+//! `cc`) into a temp dir; without Embree the peer is skipped with a message and raytree runs
+//! alone.
 //!
 //! Both render the procedural scene of [`raytree::scene::procedural`] (a bumpy torus of N
 //! triangles, a mirror sphere, a glass sphere, a floor, two point lights; 640×480, 1 sample,
 //! depth 4 below the primary ray) on the same number of threads, each in its own process:
-//! raytree through `raytree render bench.toml --stats-json`, the peer from a binary copy of the
-//! very scene raytree loaded, runs alternating. Reported: render-phase Mrays/s (median of the
-//! runs), their ratio (the median, smallest and largest of the ratios of each raytree run to
-//! the Embree run after it), load and build seconds, bytes per triangle, peak memory, rays by
-//! kind (which must agree within a few percent) and how many pixels differ between the two
-//! images.
+//! raytree through `raytree render bench.toml --frames K --stats-json`, the peer from a binary
+//! copy of the very scene raytree loaded. Both shade alike and trace the same rays (a shadow
+//! ray only where N·L > 0 and the light meets some diffuse or specular colour); rays are
+//! counted by kind on both sides and the bench fails when one kind differs by more than 1 %.
 //!
-//! Run: `cargo bench --bench peer` (80k and 320k triangles, 2 threads, 7 runs each), or e.g.
-//! `cargo bench --bench peer -- --sizes 1000,1000000 --threads 1 --runs 5 --keep /tmp/b`.
+//! Peer configurations (`--peer-config`, a comma list; default `best,issue7`): `best` gives the
+//! spheres to Embree as its built-in sphere geometry and builds every BVH at
+//! `RTC_BUILD_QUALITY_HIGH`; `issue7` is the configuration of issue 7 (user-geometry spheres
+//! whose callback is raytree's robust intersection, medium quality); `SPHERES:QUALITY` (e.g.
+//! `builtin:medium`) any other.
+//!
+//! Each process builds once and renders K frames (`--frames`, default 5): the first frame is
+//! frame 1, the warm frame the median of frames 2..K. Rounds alternate (who goes first turns
+//! each round); each round's Embree time is divided by the same round's raytree time, and the
+//! median, smallest and largest of those ratios are reported (above 1: raytree faster). Also
+//! load and build seconds, bytes per triangle, peak memory, rays by kind and how many pixels
+//! of the two images differ.
+//!
+//! Run: `cargo bench --bench peer` (80k, 320k and 1.28M triangles, 2 threads, 5 rounds), or
+//! e.g. `cargo bench --bench peer -- --sizes 1000,1000000 --threads 1 --runs 3 --keep /tmp/b`.
 //! `--size 1280x960` renders more rays than the scene's 640×480 (a longer, steadier render
-//! phase on a noisy machine). `--embree-quality high` (or `low`) builds Embree's BVH at that
-//! quality instead of its default, medium. `--scaling` instead prints raytree's build and render time against
-//! triangle count (1k to 4M) on 1 and 2 threads, and with `--chart FILE.png` draws it.
+//! phase on a noisy machine). `--scaling` instead prints raytree's build and render time
+//! against triangle count (1k to 4M) on 1 and 2 threads, and with `--chart FILE.png` draws it.
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -30,14 +41,60 @@ use raytree::scene::{Scene, Shading, load_scene_file};
 
 const HARNESS_SOURCE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/benches/peer/embree_whitted.c");
 
+/// One Embree configuration of the peer: its sphere geometry and build quality.
+#[derive(Clone, Debug)]
+struct PeerConfig {
+    /// `builtin` (Embree's RTC_GEOMETRY_TYPE_SPHERE_POINT) or `user` (a callback per test).
+    spheres: String,
+    /// `low`, `medium` or `high`.
+    quality: String,
+}
+
+impl PeerConfig {
+    /// `best` (built-in spheres, high quality: the peer at its best), `issue7` (user-geometry
+    /// spheres, medium quality: the configuration of issue 7), or `SPHERES:QUALITY`.
+    fn parse(text: &str) -> Self {
+        let (spheres, quality) = match text {
+            "best" => ("builtin", "high"),
+            "issue7" => ("user", "medium"),
+            other => other.split_once(':').unwrap_or_else(|| {
+                panic!("--peer-config: best, issue7 or SPHERES:QUALITY, not {other}")
+            }),
+        };
+        assert!(
+            matches!(spheres, "builtin" | "user"),
+            "--peer-config: spheres are builtin or user, not {spheres}"
+        );
+        assert!(
+            matches!(quality, "low" | "medium" | "high"),
+            "--peer-config: quality is low, medium or high, not {quality}"
+        );
+        Self {
+            spheres: spheres.into(),
+            quality: quality.into(),
+        }
+    }
+
+    fn label(&self) -> String {
+        let spheres = if self.spheres == "builtin" {
+            "built-in spheres"
+        } else {
+            "user-geometry spheres"
+        };
+        format!("{spheres}, {} quality", self.quality)
+    }
+}
+
 struct Options {
     sizes: Vec<usize>,
     threads: usize,
     runs: usize,
+    /// Renders per process after one build: frame 1 is the first frame, 2..K the warm ones.
+    frames: usize,
     keep: Option<PathBuf>,
     scaling: bool,
     peer: bool,
-    embree_quality: Option<String>,
+    peer_configs: Vec<PeerConfig>,
     chart: Option<PathBuf>,
     /// Image size instead of the scene's 640×480 (more rays: a longer, steadier render phase).
     size: Option<(u32, u32)>,
@@ -45,13 +102,14 @@ struct Options {
 
 fn parse_options() -> Options {
     let mut o = Options {
-        sizes: vec![80_000, 320_000],
+        sizes: vec![80_000, 320_000, 1_280_000],
         threads: 2,
-        runs: 7,
+        runs: 5,
+        frames: 5,
         keep: None,
         scaling: false,
         peer: true,
-        embree_quality: None,
+        peer_configs: vec![PeerConfig::parse("best"), PeerConfig::parse("issue7")],
         chart: None,
         size: None,
     };
@@ -70,10 +128,16 @@ fn parse_options() -> Options {
             }
             "--threads" => o.threads = value("--threads").parse().expect("--threads: a number"),
             "--runs" => o.runs = value("--runs").parse().expect("--runs: a number"),
+            "--frames" => o.frames = value("--frames").parse().expect("--frames: a number"),
             "--keep" => o.keep = Some(PathBuf::from(value("--keep"))),
             "--scaling" => o.scaling = true,
             "--no-peer" => o.peer = false,
-            "--embree-quality" => o.embree_quality = Some(value("--embree-quality")),
+            "--peer-config" => {
+                o.peer_configs = value("--peer-config")
+                    .split(',')
+                    .map(|c| PeerConfig::parse(c.trim()))
+                    .collect();
+            }
             "--chart" => o.chart = Some(PathBuf::from(value("--chart"))),
             "--size" => {
                 let v = value("--size");
@@ -88,15 +152,18 @@ fn parse_options() -> Options {
         }
     }
     o.runs = o.runs.max(1);
+    o.frames = o.frames.clamp(1, 1000);
     o
 }
 
-/// One render's figures, from either renderer.
+/// One process's figures, from either renderer.
 #[derive(Clone, Debug, Default)]
 struct Run {
     load_secs: f64,
     build_secs: f64,
-    render_secs: f64,
+    /// The render phase of each frame after the one build.
+    frame_secs: Vec<f64>,
+    /// Rays of one frame by kind: primary, reflected, refracted, shadow.
     rays: [u64; 4],
     /// Bytes the ray tracer keeps per triangle (raytree: scene triangles + accelerator;
     /// Embree: vertex and index buffers + what its memory monitor saw at peak).
@@ -108,31 +175,62 @@ impl Run {
     fn total_rays(&self) -> u64 {
         self.rays.iter().sum()
     }
+    /// Millions of rays per second of the first frame.
     fn mrays(&self) -> f64 {
-        self.total_rays() as f64 / self.render_secs / 1e6
+        self.total_rays() as f64 / self.first_secs() / 1e6
+    }
+    /// The first frame's render phase.
+    fn first_secs(&self) -> f64 {
+        self.frame_secs.first().copied().unwrap_or(f64::NAN)
+    }
+    /// The median render phase of frames 2..K (NaN with one frame).
+    fn warm_secs(&self) -> f64 {
+        self.frame_secs
+            .get(1..)
+            .map_or(f64::NAN, |warm| median(warm.to_vec()))
     }
 }
 
-fn median_by(runs: &[Run], key: impl Fn(&Run) -> f64) -> f64 {
-    let mut v: Vec<f64> = runs.iter().map(key).collect();
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
-/// The median run by render time, with load and build replaced by their own medians.
+/// Medians of `runs` (a frame each: the scaling table's), as one run.
 fn summary(runs: &[Run]) -> Run {
-    let render = median_by(runs, |r| r.render_secs);
-    let mut out = runs
-        .iter()
-        .find(|r| r.render_secs == render)
-        .cloned()
-        .unwrap_or_default();
-    out.load_secs = median_by(runs, |r| r.load_secs);
-    out.build_secs = median_by(runs, |r| r.build_secs);
-    out
+    let m = |key: fn(&Run) -> f64| median(runs.iter().map(key).collect());
+    Run {
+        load_secs: m(|r| r.load_secs),
+        build_secs: m(|r| r.build_secs),
+        frame_secs: vec![m(Run::first_secs)],
+        bytes_per_triangle: m(|r| r.bytes_per_triangle),
+        ..runs.first().cloned().unwrap_or_default()
+    }
 }
 
-fn raytree_run(scene_file: &Path, image: &Path, threads: usize, size: Option<(u32, u32)>) -> Run {
+/// The median (the mean of the middle two for an even count); NaN of nothing.
+fn median(mut v: Vec<f64>) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Median, smallest and largest.
+fn spread(v: Vec<f64>) -> (f64, f64, f64) {
+    let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    (median(v), lo, hi)
+}
+
+fn raytree_run(
+    scene_file: &Path,
+    image: &Path,
+    threads: usize,
+    frames: usize,
+    size: Option<(u32, u32)>,
+) -> Run {
     let stats = image.with_extension("json");
     let mut command = Command::new(env!("CARGO_BIN_EXE_raytree"));
     command.arg("render").arg(scene_file);
@@ -142,7 +240,8 @@ fn raytree_run(scene_file: &Path, image: &Path, threads: usize, size: Option<(u3
     let output = command
         .arg("-o")
         .arg(image)
-        .args(["--quiet", "--threads", &threads.to_string(), "--stats-json"])
+        .args(["--quiet", "--threads", &threads.to_string()])
+        .args(["--frames", &frames.to_string(), "--stats-json"])
         .arg(&stats)
         .output()
         .expect("run raytree");
@@ -156,10 +255,14 @@ fn raytree_run(scene_file: &Path, image: &Path, threads: usize, size: Option<(u3
     let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
     let s = &json["stats"];
     let r = &s["rays"];
+    let frame_secs = match json["frame_render_secs"].as_array() {
+        Some(list) => list.iter().map(f).collect(),
+        None => vec![f(&s["render_secs"])],
+    };
     Run {
         load_secs: f(&json["load_secs"]),
         build_secs: f(&s["build_secs"]),
-        render_secs: f(&s["render_secs"]),
+        frame_secs,
         rays: ["primary", "reflected", "refracted", "shadow"]
             .map(|k| r[k].as_u64().unwrap_or_default()),
         bytes_per_triangle: f(&json["memory"]["bytes_per_triangle"]),
@@ -260,13 +363,12 @@ fn harness_run(
     scene_bin: &Path,
     image: &Path,
     threads: usize,
-    quality: Option<&str>,
+    frames: usize,
+    config: &PeerConfig,
 ) -> Run {
-    let mut command = Command::new(exe);
-    if let Some(q) = quality {
-        command.env("EMBREE_WHITTED_QUALITY", q);
-    }
-    let output = command
+    let output = Command::new(exe)
+        .args(["--spheres", &config.spheres, "--quality", &config.quality])
+        .args(["--frames", &frames.to_string()])
         .arg(scene_bin)
         .arg(threads.to_string())
         .arg(image)
@@ -278,9 +380,12 @@ fn harness_run(
         String::from_utf8_lossy(&output.stderr)
     );
     let text = String::from_utf8_lossy(&output.stdout);
-    let get = |key: &str| -> f64 {
+    let value = |key: &str| -> Option<&str> {
         text.lines()
             .find_map(|l| l.strip_prefix(key)?.strip_prefix(' '))
+    };
+    let get = |key: &str| -> f64 {
+        value(key)
             .and_then(|v| v.trim().parse().ok())
             .unwrap_or(f64::NAN)
     };
@@ -288,16 +393,20 @@ fn harness_run(
     Run {
         load_secs: get("load_secs"),
         build_secs: get("build_secs"),
-        render_secs: get("render_secs"),
+        frame_secs: value("frame_secs")
+            .unwrap_or_default()
+            .split_whitespace()
+            .map(|v| v.parse().unwrap_or(f64::NAN))
+            .collect(),
         rays: ["primary", "reflected", "refracted", "shadow"].map(|k| get(k) as u64),
         bytes_per_triangle: (get("embree_peak_bytes") + get("geometry_bytes")) / triangles,
         peak_rss_bytes: (get("peak_rss_kb") * 1024.0) as u64,
     }
 }
 
-/// Pixels whose 8-bit sRGB values differ by more than 2 in some channel: raytree's PNG
-/// against the harness's linear float image.
-fn differing_pixels(png_path: &Path, f32_path: &Path, width: u32, height: u32) -> usize {
+/// Pixels whose 8-bit sRGB values differ at all, and by more than 2, in some channel:
+/// raytree's PNG against the harness's linear float image.
+fn differing_pixels(png_path: &Path, f32_path: &Path, width: u32, height: u32) -> [usize; 2] {
     let decoder = png::Decoder::new(std::io::BufReader::new(
         std::fs::File::open(png_path).expect("open raytree's PNG"),
     ));
@@ -309,13 +418,18 @@ fn differing_pixels(png_path: &Path, f32_path: &Path, width: u32, height: u32) -
         .chunks_exact(4)
         .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
         .collect();
-    (0..(width * height) as usize)
-        .filter(|&i| {
-            let c = glam::Vec3::new(theirs[3 * i], theirs[3 * i + 1], theirs[3 * i + 2]);
-            let t = raytree::export::to_srgb8(c);
-            (0..3).any(|k| (ours[3 * i + k] as i32 - t[k] as i32).abs() > 2)
-        })
-        .count()
+    let mut counts = [0, 0];
+    for i in 0..(width * height) as usize {
+        let c = glam::Vec3::new(theirs[3 * i], theirs[3 * i + 1], theirs[3 * i + 2]);
+        let t = raytree::export::to_srgb8(c);
+        let most = (0..3)
+            .map(|k| (ours[3 * i + k] as i32 - t[k] as i32).abs())
+            .max()
+            .unwrap_or(0);
+        counts[0] += usize::from(most > 0);
+        counts[1] += usize::from(most > 2);
+    }
+    counts
 }
 
 fn load_average() -> String {
@@ -328,16 +442,54 @@ fn mb(bytes: u64) -> f64 {
     bytes as f64 / (1024.0 * 1024.0)
 }
 
+/// One scene size's results: raytree's runs and each peer configuration's runs, round by
+/// round (the same index is the same round), and the pixels each peer's image differs in.
+struct SizeResult {
+    triangles: usize,
+    ours: Vec<Run>,
+    theirs: Vec<Vec<Run>>,
+    differing: Vec<[usize; 2]>,
+    pixels: usize,
+}
+
+/// The largest relative difference between two renderers' rays of one kind (of the larger
+/// count), over the four kinds.
+fn ray_difference(a: &Run, b: &Run) -> f64 {
+    a.rays
+        .iter()
+        .zip(&b.rays)
+        .map(|(&x, &y)| x.abs_diff(y) as f64 / x.max(y).max(1) as f64)
+        .fold(0.0, f64::max)
+}
+
+/// Equal work means the same rays: a run whose counts differ by more than this from
+/// raytree's is flagged, and the bench fails.
+const MAX_RAY_DIFFERENCE: f64 = 0.01;
+
 fn peer_comparison(o: &Options, root: &Path) {
     let harness = if o.peer { build_harness(root) } else { None };
+    let configs: &[PeerConfig] = if harness.is_some() {
+        &o.peer_configs
+    } else {
+        &[]
+    };
     println!(
-        "issue-7 peer bench: {} threads, {} runs each (median), Embree build quality {}, load average before: {}",
+        "peer bench (issue 15): {} threads, {} alternating rounds, {} frames per process (first = frame 1 after the build, warm = median of frames 2..{}), load average before: {}",
         o.threads,
         o.runs,
-        o.embree_quality.as_deref().unwrap_or("medium (default)"),
+        o.frames,
+        o.frames,
         load_average()
     );
-    let mut rows = Vec::new();
+    for (i, c) in configs.iter().enumerate() {
+        println!(
+            "peer {}: Embree 3 ({}), {}; triangles in Embree's own BVH, scene flags none, rtcIntersect1/rtcOccluded1, pthreads over 32x32 tiles",
+            i + 1,
+            embree_version(),
+            c.label()
+        );
+    }
+    let mut results = Vec::new();
     for &size in &o.sizes {
         let dir = root.join(format!("tris_{size}"));
         let scene_file = write_bench_scene(&dir, size).expect("write the bench scene");
@@ -347,122 +499,245 @@ fn peer_comparison(o: &Options, root: &Path) {
         }
         let scene_bin = dir.join("scene.bin");
         write_peer_scene(&scene, &scene_bin);
-        let (ours_png, theirs_f32) = (dir.join("raytree.png"), dir.join("embree.f32"));
+        let ours_png = dir.join("raytree.png");
+        let images: Vec<PathBuf> = configs
+            .iter()
+            .map(|c| dir.join(format!("embree_{}_{}.f32", c.spheres, c.quality)))
+            .collect();
         let mut ours = Vec::new();
-        let mut theirs = Vec::new();
-        for _ in 0..o.runs {
-            ours.push(raytree_run(&scene_file, &ours_png, o.threads, o.size));
-            if let Some(exe) = &harness {
-                theirs.push(harness_run(
-                    exe,
-                    &scene_bin,
-                    &theirs_f32,
-                    o.threads,
-                    o.embree_quality.as_deref(),
-                ));
+        let mut theirs: Vec<Vec<Run>> = vec![Vec::new(); configs.len()];
+        for round in 0..o.runs {
+            // Alternating: who goes first turns with the round, so a slow spell of the
+            // machine falls on each renderer in turn.
+            let players = configs.len() + 1;
+            for k in 0..players {
+                match (round + k) % players {
+                    0 => ours.push(raytree_run(
+                        &scene_file,
+                        &ours_png,
+                        o.threads,
+                        o.frames,
+                        o.size,
+                    )),
+                    c => {
+                        if let Some(exe) = &harness {
+                            theirs[c - 1].push(harness_run(
+                                exe,
+                                &scene_bin,
+                                &images[c - 1],
+                                o.threads,
+                                o.frames,
+                                &configs[c - 1],
+                            ));
+                        }
+                    }
+                }
             }
         }
-        let diff = harness.as_ref().map(|_| {
-            differing_pixels(
-                &ours_png,
-                &theirs_f32,
-                scene.render.width,
-                scene.render.height,
-            )
-        });
-        // Each raytree run is paired with the Embree run right after it: the median of the
-        // pairs' ratios is steadier on a shared machine than the ratio of the two medians,
-        // and the pairs' spread shows how steady.
-        let mut ratios: Vec<f64> = ours
+        let (w, h) = (scene.render.width, scene.render.height);
+        let differing = images
             .iter()
-            .zip(&theirs)
-            .map(|(a, b)| a.mrays() / b.mrays())
+            .map(|image| differing_pixels(&ours_png, image, w, h))
             .collect();
-        ratios.sort_by(f64::total_cmp);
-        let ratio = (!ratios.is_empty()).then(|| {
-            (
-                ratios[ratios.len() / 2],
-                ratios[0],
-                ratios[ratios.len() - 1],
-            )
-        });
-        rows.push((
+        println!(
+            "{} triangles done; load average {}",
             scene.triangles.len(),
-            summary(&ours),
-            (!theirs.is_empty()).then(|| summary(&theirs)),
-            diff,
-            ratio,
-        ));
+            load_average()
+        );
         let _ = std::io::stdout().flush();
+        results.push(SizeResult {
+            triangles: scene.triangles.len(),
+            ours,
+            theirs,
+            differing,
+            pixels: (w * h) as usize,
+        });
     }
     println!("load average after: {}", load_average());
-    println!();
-    println!(
-        "| triangles | raytree Mrays/s | Embree Mrays/s | ratio (pairs: median, min–max) | load s (rt / E) | build s (rt / E) | render s (rt / E) | bytes/tri (rt / E) | peak MB (rt / E) |"
-    );
-    println!("|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    print_tables(&results, configs);
+
+    let mut flagged = Vec::new();
+    for r in &results {
+        for (c, runs) in r.theirs.iter().enumerate() {
+            for (mine, peer) in r.ours.iter().zip(runs) {
+                let d = ray_difference(mine, peer);
+                if d > MAX_RAY_DIFFERENCE {
+                    flagged.push(format!(
+                        "{} triangles, peer {}: rays differ by {:.2} % in one kind",
+                        r.triangles,
+                        c + 1,
+                        100.0 * d
+                    ));
+                }
+            }
+        }
+    }
+    if !flagged.is_empty() {
+        eprintln!(
+            "unequal work: the renderers did not trace the same rays (more than {} % apart):\n{}",
+            100.0 * MAX_RAY_DIFFERENCE,
+            flagged.join("\n")
+        );
+        std::process::exit(1);
+    }
+}
+
+/// The Embree version the harness reports (`embree_version` of `rtcore_config.h`), read from
+/// the header so the table names it without a run.
+fn embree_version() -> String {
+    let header =
+        std::fs::read_to_string("/usr/include/embree3/rtcore_config.h").unwrap_or_default();
+    let part = |name: &str| {
+        header
+            .lines()
+            .find_map(|l| l.strip_prefix(&format!("#define RTC_VERSION_{name} ")))
+            .map(str::trim)
+            .unwrap_or("?")
+            .to_string()
+    };
+    format!("{}.{}.{}", part("MAJOR"), part("MINOR"), part("PATCH"))
+}
+
+fn print_tables(results: &[SizeResult], configs: &[PeerConfig]) {
     let pair = |a: f64, b: Option<f64>, digits: usize| match b {
         Some(b) => format!("{a:.digits$} / {b:.digits$}"),
         None => format!("{a:.digits$} / –"),
     };
-    for (tris, r, e, _, ratio) in &rows {
-        let em = e.as_ref().map(Run::mrays);
-        println!(
-            "| {} | {:.2} | {} | {} | {} | {} | {} | {} | {} |",
-            tris,
-            r.mrays(),
-            em.map_or("–".into(), |m| format!("{m:.2}")),
-            ratio.map_or("–".into(), |(m, lo, hi)| format!(
-                "**{m:.2}** ({lo:.2}–{hi:.2})"
-            )),
-            pair(r.load_secs, e.as_ref().map(|e| e.load_secs), 3),
-            pair(r.build_secs, e.as_ref().map(|e| e.build_secs), 3),
-            pair(r.render_secs, e.as_ref().map(|e| e.render_secs), 3),
-            pair(
-                r.bytes_per_triangle,
-                e.as_ref().map(|e| e.bytes_per_triangle),
-                0
-            ),
-            pair(
-                mb(r.peak_rss_bytes),
-                e.as_ref().map(|e| mb(e.peak_rss_bytes)),
-                0
-            ),
-        );
+    let ratio = |(m, lo, hi): (f64, f64, f64)| {
+        if m.is_nan() {
+            "–".to_string()
+        } else {
+            format!("**{m:.2}** ({lo:.2}–{hi:.2})")
+        }
+    };
+    // Each round's raytree run is paired with the same round's Embree run: the median of
+    // the pairs' ratios is steadier on a shared machine than the ratio of two medians, and
+    // the pairs' spread shows how steady.
+    let ratios = |ours: &[Run], theirs: &[Run], key: fn(&Run) -> f64| {
+        spread(
+            ours.iter()
+                .zip(theirs)
+                .map(|(a, b)| key(b) / key(a))
+                .collect(),
+        )
+    };
+    let medians = |runs: &[Run], key: fn(&Run) -> f64| median(runs.iter().map(key).collect());
+    let mrays = |runs: &[Run], key: fn(&Run) -> f64| {
+        runs.first().map_or(f64::NAN, |r| {
+            r.total_rays() as f64 / medians(runs, key) / 1e6
+        })
+    };
+    // Rows: each size with each peer configuration (raytree alone without a peer).
+    let rows = || -> Vec<(String, Option<usize>)> {
+        if configs.is_empty() {
+            vec![("–".into(), None)]
+        } else {
+            (0..configs.len())
+                .map(|c| (format!("{}. {}", c + 1, configs[c].label()), Some(c)))
+                .collect()
+        }
+    };
+    println!();
+    println!(
+        "| triangles | peer | first frame s (raytree / Embree) | Embree / raytree, first (pairs: median, min–max) | warm frame s (raytree / Embree) | Embree / raytree, warm | Mrays/s warm (raytree / Embree) |"
+    );
+    println!("|---:|---|---:|---:|---:|---:|---:|");
+    for r in results {
+        for (label, c) in rows() {
+            let e = c.map(|c| r.theirs[c].as_slice());
+            println!(
+                "| {} | {label} | {} | {} | {} | {} | {} |",
+                r.triangles,
+                pair(
+                    medians(&r.ours, Run::first_secs),
+                    e.map(|e| medians(e, Run::first_secs)),
+                    3
+                ),
+                e.map_or("–".into(), |e| ratio(ratios(&r.ours, e, Run::first_secs))),
+                pair(
+                    medians(&r.ours, Run::warm_secs),
+                    e.map(|e| medians(e, Run::warm_secs)),
+                    3
+                ),
+                e.map_or("–".into(), |e| ratio(ratios(&r.ours, e, Run::warm_secs))),
+                pair(
+                    mrays(&r.ours, Run::warm_secs),
+                    e.map(|e| mrays(e, Run::warm_secs)),
+                    2
+                ),
+            );
+        }
     }
     println!();
     println!(
-        "| triangles | rays raytree (P / R / T / S) | rays Embree (P / R / T / S) | total differs | pixels differing (> 2/255) |"
+        "| triangles | peer | load s (raytree / Embree) | build s (raytree / Embree) | bytes/tri (raytree / Embree) | peak MB (raytree / Embree) |"
     );
-    println!("|---:|---:|---:|---:|---:|");
-    for (tris, r, e, diff, _) in &rows {
-        let kinds = |x: &Run| {
-            let [p, rf, t, s] = x.rays;
-            format!("{p} / {rf} / {t} / {s}")
-        };
-        let (their_kinds, delta) = match e {
-            Some(e) => {
-                let d = (r.total_rays() as f64 - e.total_rays() as f64) / e.total_rays() as f64;
-                (kinds(e), format!("{:+.2} %", 100.0 * d))
-            }
-            None => ("–".into(), "–".into()),
-        };
-        let diff = diff.map_or("–".into(), |d| {
-            format!(
-                "{d} ({:.2} %)",
-                100.0 * d as f64 / (r.rays[0].max(1)) as f64
-            )
-        });
-        println!(
-            "| {tris} | {} | {their_kinds} | {delta} | {diff} |",
-            kinds(r)
-        );
-        if let Some(e) = e {
-            let d = (r.total_rays() as f64 / e.total_rays() as f64 - 1.0).abs();
-            assert!(
-                d < 0.03,
-                "ray counts differ by {:.1} %: the renderers do not trace the same thing",
-                100.0 * d
+    println!("|---:|---|---:|---:|---:|---:|");
+    for r in results {
+        for (label, c) in rows() {
+            let e = c.map(|c| r.theirs[c].as_slice());
+            let m = |runs: &[Run], key: fn(&Run) -> f64| medians(runs, key);
+            println!(
+                "| {} | {label} | {} | {} | {} | {} |",
+                r.triangles,
+                pair(
+                    m(&r.ours, |x| x.load_secs),
+                    e.map(|e| m(e, |x| x.load_secs)),
+                    3
+                ),
+                pair(
+                    m(&r.ours, |x| x.build_secs),
+                    e.map(|e| m(e, |x| x.build_secs)),
+                    3
+                ),
+                pair(
+                    m(&r.ours, |x| x.bytes_per_triangle),
+                    e.map(|e| m(e, |x| x.bytes_per_triangle)),
+                    0
+                ),
+                pair(
+                    mb(m(&r.ours, |x| x.peak_rss_bytes as f64) as u64),
+                    e.map(|e| mb(m(e, |x| x.peak_rss_bytes as f64) as u64)),
+                    0
+                ),
+            );
+        }
+    }
+    println!();
+    println!(
+        "| triangles | peer | rays raytree (P / R / T / S) | rays Embree (P / R / T / S) | largest difference in one kind | pixels differing (at all / > 2 of 255) |"
+    );
+    println!("|---:|---|---:|---:|---:|---:|");
+    let kinds = |x: &Run| {
+        let [p, rf, t, s] = x.rays;
+        format!("{p} / {rf} / {t} / {s}")
+    };
+    for r in results {
+        let Some(mine) = r.ours.first() else { continue };
+        for (label, c) in rows() {
+            let peer = c.and_then(|c| r.theirs[c].first());
+            let (theirs, delta, diff) = match (peer, c) {
+                (Some(e), Some(c)) => {
+                    let d = ray_difference(mine, e);
+                    let flag = if d > MAX_RAY_DIFFERENCE {
+                        " **unequal**"
+                    } else {
+                        ""
+                    };
+                    let [any, far] = r.differing[c];
+                    let share = |n: usize| 100.0 * n as f64 / r.pixels.max(1) as f64;
+                    (
+                        kinds(e),
+                        format!("{:.3} %{flag}", 100.0 * d),
+                        format!("{any} / {far} ({:.3} % / {:.3} %)", share(any), share(far)),
+                    )
+                }
+                _ => ("–".into(), "–".into(), "–".into()),
+            };
+            println!(
+                "| {} | {label} | {} | {theirs} | {delta} | {diff} |",
+                r.triangles,
+                kinds(mine)
             );
         }
     }
@@ -497,18 +772,18 @@ fn scaling(o: &Options, root: &Path) {
         let mut by_threads = Vec::new();
         for (threads, points) in &mut series {
             let runs: Vec<Run> = (0..o.runs)
-                .map(|_| raytree_run(&scene_file, &png, *threads, o.size))
+                .map(|_| raytree_run(&scene_file, &png, *threads, 1, o.size))
                 .collect();
             let r = summary(&runs);
             csv.push_str(&format!(
                 "{triangles},{threads},{:.6},{:.6},{:.6},{:.4},{:.1}\n",
                 r.load_secs,
                 r.build_secs,
-                r.render_secs,
+                r.first_secs(),
                 r.mrays(),
                 r.bytes_per_triangle
             ));
-            points.push((triangles as f64, r.build_secs, r.render_secs));
+            points.push((triangles as f64, r.build_secs, r.first_secs()));
             by_threads.push(r);
         }
         let (one, two) = (&by_threads[0], &by_threads[1]);
@@ -517,8 +792,8 @@ fn scaling(o: &Options, root: &Path) {
             triangles,
             one.build_secs,
             two.build_secs,
-            one.render_secs,
-            two.render_secs,
+            one.first_secs(),
+            two.first_secs(),
             one.mrays(),
             two.mrays(),
             two.bytes_per_triangle,
