@@ -13,10 +13,12 @@
 //! counted by kind on both sides and the bench fails when one kind differs by more than 1 %.
 //!
 //! Peer configurations (`--peer-config`, a comma list; default `best,issue7`): `best` gives the
-//! spheres to Embree as its built-in sphere geometry and builds every BVH at
-//! `RTC_BUILD_QUALITY_HIGH`; `issue7` is the configuration of issue 7 (user-geometry spheres
-//! whose callback is raytree's robust intersection, medium quality); `SPHERES:QUALITY` (e.g.
-//! `builtin:medium`) any other.
+//! spheres to Embree as its built-in sphere geometry, builds every BVH at
+//! `RTC_BUILD_QUALITY_HIGH` and sets flush-to-zero/denormals-are-zero on its tracing threads
+//! (Embree's advice); `issue7` is the configuration of issue 7 (user-geometry spheres whose
+//! callback is raytree's robust intersection, medium quality, denormals kept);
+//! `SPHERES:QUALITY[:ftz]` (e.g. `builtin:medium`) any other. The harness is compiled with
+//! `-O3 -march=native -ffp-contract=off` (no FMA contraction: its shading rounds as raytree's).
 //!
 //! Each process builds once and renders K frames (`--frames`, default 5): the first frame is
 //! frame 1, the warm frame the median of frames 2..K. Rounds alternate (who goes first turns
@@ -48,18 +50,31 @@ struct PeerConfig {
     spheres: String,
     /// `low`, `medium` or `high`.
     quality: String,
+    /// Flush-to-zero and denormals-are-zero on the tracing threads (Embree's advice).
+    ftz: bool,
 }
 
 impl PeerConfig {
-    /// `best` (built-in spheres, high quality: the peer at its best), `issue7` (user-geometry
-    /// spheres, medium quality: the configuration of issue 7), or `SPHERES:QUALITY`.
+    /// `best` (built-in spheres, high quality, FTZ/DAZ: the peer at its best), `issue7`
+    /// (user-geometry spheres, medium quality, denormals kept: the configuration of issue 7),
+    /// or `SPHERES:QUALITY` with `:ftz` after it for FTZ/DAZ.
     fn parse(text: &str) -> Self {
-        let (spheres, quality) = match text {
-            "best" => ("builtin", "high"),
-            "issue7" => ("user", "medium"),
-            other => other.split_once(':').unwrap_or_else(|| {
-                panic!("--peer-config: best, issue7 or SPHERES:QUALITY, not {other}")
+        let text = match text {
+            "best" => "builtin:high:ftz",
+            "issue7" => "user:medium",
+            other => other,
+        };
+        let mut parts = text.split(':');
+        let (spheres, quality) = (
+            parts.next().unwrap_or_default(),
+            parts.next().unwrap_or_else(|| {
+                panic!("--peer-config: best, issue7 or SPHERES:QUALITY[:ftz], not {text}")
             }),
+        );
+        let ftz = match parts.next() {
+            None => false,
+            Some("ftz") => true,
+            Some(other) => panic!("--peer-config: after the quality only :ftz, not {other}"),
         };
         assert!(
             matches!(spheres, "builtin" | "user"),
@@ -72,6 +87,7 @@ impl PeerConfig {
         Self {
             spheres: spheres.into(),
             quality: quality.into(),
+            ftz,
         }
     }
 
@@ -81,7 +97,8 @@ impl PeerConfig {
         } else {
             "user-geometry spheres"
         };
-        format!("{spheres}, {} quality", self.quality)
+        let ftz = if self.ftz { ", FTZ/DAZ" } else { "" };
+        format!("{spheres}, {} quality{ftz}", self.quality)
     }
 }
 
@@ -334,7 +351,7 @@ fn build_harness(dir: &Path) -> Option<PathBuf> {
     let exe = dir.join("embree_whitted");
     let compiler = std::env::var("CC").unwrap_or_else(|_| "cc".into());
     let output = Command::new(&compiler)
-        .args(["-O2", "-ffp-contract=off", "-o"])
+        .args(["-O3", "-march=native", "-ffp-contract=off", "-o"])
         .arg(&exe)
         .arg(HARNESS_SOURCE)
         .args(["-lembree3", "-lpthread", "-lm"])
@@ -369,6 +386,7 @@ fn harness_run(
     let output = Command::new(exe)
         .args(["--spheres", &config.spheres, "--quality", &config.quality])
         .args(["--frames", &frames.to_string()])
+        .args(["--ftz", if config.ftz { "1" } else { "0" }])
         .arg(scene_bin)
         .arg(threads.to_string())
         .arg(image)
@@ -502,7 +520,8 @@ fn peer_comparison(o: &Options, root: &Path) {
         let ours_png = dir.join("raytree.png");
         let images: Vec<PathBuf> = configs
             .iter()
-            .map(|c| dir.join(format!("embree_{}_{}.f32", c.spheres, c.quality)))
+            .enumerate()
+            .map(|(i, c)| dir.join(format!("embree_{}_{}_{i}.f32", c.spheres, c.quality)))
             .collect();
         let mut ours = Vec::new();
         let mut theirs: Vec<Vec<Run>> = vec![Vec::new(); configs.len()];

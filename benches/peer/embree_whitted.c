@@ -5,7 +5,7 @@
  * `src/trace.rs`, on N pthreads over 32x32 tiles taken from an atomic counter.
  *
  * Usage: embree_whitted [--spheres builtin|user] [--quality low|medium|high] [--frames K]
- *                       SCENE.bin THREADS [IMAGE.f32]
+ *                       [--ftz 0|1] SCENE.bin THREADS [IMAGE.f32]
  *
  * --spheres builtin (the default) gives the spheres to Embree as its own sphere geometry
  *   (RTC_GEOMETRY_TYPE_SPHERE_POINT, a float4 centre and radius each): Embree's ray-sphere
@@ -16,13 +16,18 @@
  *   RTC_SCENE_FLAG_NONE (not robust, not dynamic, no filter callbacks).
  * --frames K renders the image K times after one build: frame 1 is the first frame, the rest
  *   are warm frames (default 1).
+ * --ftz 1 sets flush-to-zero and denormals-are-zero on every tracing thread, as Embree's
+ *   documentation asks (default 0).
  *
  * Prints `key value` lines: load and build seconds, `frame_secs` (each frame's render phase),
  * `render_secs` (frame 1), rays by kind of one frame, Mrays/s, memory. Writes the last frame's
  * linear RGB image as raw little-endian f32 when IMAGE is given.
  *
- * Build: cc -O2 -ffp-contract=off embree_whitted.c -lembree3 -lpthread -lm */
+ * Build: cc -O3 -march=native -ffp-contract=off embree_whitted.c -lembree3 -lpthread -lm
+ * (no FMA contraction: the shading rounds as raytree's does). */
 #include <embree3/rtcore.h>
+#include <pmmintrin.h>
+#include <xmmintrin.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -400,9 +405,15 @@ static uint32_t tiles_x, tiles_y;
 static atomic_uint next_tile;
 
 typedef struct { Counts counts; } Worker;
+static int flush_denormals;
 
 static void *worker(void *arg) {
     Worker *w = arg;
+    if (flush_denormals) {
+        /* What Embree asks of every thread that traces (its verbose start-up warns without). */
+        _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+        _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+    }
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     float fw = (float)S.width, fh = (float)S.height;
@@ -433,7 +444,7 @@ static void rtc_error(void *user, enum RTCError code, const char *str) {
 
 static const char *usage =
     "usage: embree_whitted [--spheres builtin|user] [--quality low|medium|high] [--frames K] "
-    "SCENE.bin THREADS [IMAGE.f32]";
+    "[--ftz 0|1] SCENE.bin THREADS [IMAGE.f32]";
 
 /* One frame on `threads` pthreads: its render-phase seconds; its ray counts in `total`. */
 static double render_frame(int threads, Worker *workers, pthread_t *ids, Counts *total) {
@@ -463,6 +474,7 @@ int main(int argc, char **argv) {
         if (strcmp(argv[argi], "--spheres") == 0) spheres_name = argv[argi + 1];
         else if (strcmp(argv[argi], "--quality") == 0) quality_name = argv[argi + 1];
         else if (strcmp(argv[argi], "--frames") == 0) frames = atoi(argv[argi + 1]);
+        else if (strcmp(argv[argi], "--ftz") == 0) flush_denormals = atoi(argv[argi + 1]);
         else die(usage);
         argi += 2;
     }
@@ -565,6 +577,7 @@ int main(int argc, char **argv) {
     printf("threads %d\n", threads);
     printf("spheres_geometry %s\n", builtin_spheres ? "builtin" : "user");
     printf("build_quality %s\n", quality_name);
+    printf("flush_denormals %d\n", flush_denormals);
     printf("triangles %u\nspheres %u\n", S.n_triangles, S.n_spheres);
     printf("load_secs %.6f\nbuild_secs %.6f\nrender_secs %.6f\n", t1 - t0, t2 - t1, frame_secs[0]);
     printf("frame_secs");
