@@ -26,8 +26,10 @@
  * Build: cc -O3 -march=native -ffp-contract=off embree_whitted.c -lembree3 -lpthread -lm
  * (no FMA contraction: the shading rounds as raytree's does). */
 #include <embree3/rtcore.h>
+#if defined(__SSE3__)
 #include <pmmintrin.h>
 #include <xmmintrin.h>
+#endif
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -411,8 +413,12 @@ static void *worker(void *arg) {
     Worker *w = arg;
     if (flush_denormals) {
         /* What Embree asks of every thread that traces (its verbose start-up warns without). */
+#if defined(__SSE3__)
         _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
         _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+#else
+        die("--ftz 1 needs an SSE3 target");
+#endif
     }
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
