@@ -726,6 +726,7 @@ fn flag() -> impl Strategy<Value = Vec<String>> {
         with("--offset", &["fixed", "normal", "error-bound"], &["x"]),
         with("--shading", &["phong", "blinn-phong"], &["gouraud"]),
         with("--stats-json", &["OUT/s.json"], &["OUT/no/s.json", "OUT"]),
+        with("--frames", &["1", "2"], &["0", "1001", "x"]),
         pick(&["--bogus", "-", "--", "-x", "--help"]).prop_map(|f| vec![f]),
     ]
 }
