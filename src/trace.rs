@@ -148,6 +148,9 @@ pub struct ShadowTest {
     pub blocked_by: Option<ObjectId>,
     /// Distance along the shadow ray (from its offset origin) to the blocker.
     pub blocked_at: Option<f32>,
+    /// Whether the shadow ray was cast: not when the light is behind the surface (`N·L ≤ 0`)
+    /// nor when its unshadowed contribution is exactly zero (see [`casts_shadow_ray`]).
+    pub traced: bool,
     pub terms: LightTerms,
 }
 
@@ -446,12 +449,22 @@ impl Tracer {
             // The recorder shows every light's terms; tiles need them only for lights that
             // are not blocked, so they compute them after the shadow ray (N·L is the same
             // product `light_terms` forms, so the answer is unchanged).
-            let terms = R::ENABLED
+            let mut terms = R::ENABLED
                 .then(|| light_terms(scene.render.shading, material, light.color, n, l, v));
             let n_dot_l = n.dot(l);
             let mut blocked_by = None;
             let mut blocked_at = None;
-            if n_dot_l > 0.0 {
+            let cast = n_dot_l > 0.0
+                && casts_shadow_ray(
+                    scene.render.shading,
+                    material,
+                    light.color,
+                    n,
+                    l,
+                    v,
+                    &mut terms,
+                );
+            if cast {
                 // Only objects count as blockers, never lights.
                 let (shadow_ray, length) = shadow_ray(offset, p, error, n, l, light.position);
                 s.counts.count(RayKind::Shadow);
@@ -482,6 +495,7 @@ impl Tracer {
                     distance,
                     blocked_by,
                     blocked_at,
+                    traced: cast,
                     terms,
                 });
             }
@@ -555,8 +569,11 @@ impl Tracer {
         let (surface, error) = self.surface(&ray, &hit);
         let to_light = light.position - surface.point;
         let l = div3(to_light, to_light.length());
-        // As in `shade`: no shadow ray unless N·L > 0.
-        if surface.normal.dot(l) > 0.0 {
+        // As in `shade`: no shadow ray unless N·L > 0 and the light can add something.
+        let material = self.scene.material(surface.material);
+        let (n, v) = (surface.normal, -ray.dir);
+        let shading = self.scene.render.shading;
+        if n.dot(l) > 0.0 && casts_shadow_ray(shading, material, light.color, n, l, v, &mut None) {
             let (p, n) = (surface.point, surface.normal);
             let (shadow, length) = shadow_ray(m.offset, p, error, n, l, light.position);
             self.accel.occluded_visits(m, &shadow, 0.0, length)
@@ -575,6 +592,31 @@ impl Tracer {
             self.scene.triangles[prim - n_spheres].object
         }
     }
+}
+
+/// Whether a light in front of the surface (`N·L > 0`) needs a shadow ray: not when its
+/// unshadowed contribution is exactly zero, so the ray could not change the pixel. The diffuse
+/// term is `(C_l ⊙ kd)·N·L` and the specular `(C_l ⊙ ks)·spec`: when `C_l ⊙ kd` has a non-zero
+/// channel the ray is cast; otherwise the terms are formed (into `terms`, when not already
+/// there) and the ray is cast only when the specular is not exactly zero (a NaN is cast, so
+/// it reaches the pixel as before). Both the render and the tree (and [`Tracer::visits_of`])
+/// decide here, so a light the tree marks "not traced: contributes nothing" is one the image
+/// did not trace.
+#[inline(always)]
+fn casts_shadow_ray(
+    shading: crate::scene::Shading,
+    material: &crate::scene::Material,
+    color: Vec3,
+    n: Vec3,
+    l: Vec3,
+    v: Vec3,
+    terms: &mut Option<LightTerms>,
+) -> bool {
+    if color * material.diffuse != Vec3::ZERO {
+        return true;
+    }
+    let t = *terms.get_or_insert_with(|| light_terms(shading, material, color, n, l, v));
+    t.specular != Vec3::ZERO || t.diffuse != Vec3::ZERO
 }
 
 /// The shadow ray from hit point `p` (error bound `error`, normal `n`) towards the light at
