@@ -143,14 +143,13 @@ pub fn accumulate_tile(
 ) {
     let (bw, bh) = PACKET_BLOCK;
     let base = first.as_ref().map_or(0, |f| f.len());
-    let first = first.filter(|_| samples.contains(&0));
-    let mut first = first.map(|f| {
+    let mut first = first.filter(|_| samples.contains(&0));
+    if let Some(f) = first.as_mut() {
         f.resize(
             base + (rect.width * rect.height) as usize,
             SampleInfo::default(),
         );
-        f
-    });
+    }
     let mut rays = [crate::geometry::Ray::new(Vec3::ZERO, Vec3::Z); PACKET_RAYS];
     let mut out = [(Vec3::ZERO, SampleInfo::default()); PACKET_RAYS];
     for by in (0..rect.height).step_by(bh as usize) {
