@@ -254,3 +254,26 @@ fn packet_queries_answer_as_single_queries() {
         );
     }
 }
+
+/// More lights than a packet's shadow answers hold (64, then one ray at a time), visible lights
+/// (balls that end rays) among them, and a light behind everything: still bit-identical.
+#[test]
+fn many_and_visible_lights_are_bit_identical() {
+    let mut scene = sized("glass", 53, 37);
+    let mut rng = Rng(99);
+    for k in 0..70 {
+        scene.lights.push(raytree::scene::Light {
+            name: format!("extra {k}"),
+            position: rng.vec() * 6.0 + Vec3::Y * 3.0,
+            color: Vec3::splat(0.01),
+            radius: if k % 9 == 0 { 0.2 } else { 0.0 },
+        });
+    }
+    let rays = assert_same(
+        &scene,
+        TraceSettings::default(),
+        1,
+        "glass with 70 more lights",
+    );
+    assert!(rays.shadow > 64 * rays.primary / 4, "{rays:?}");
+}
