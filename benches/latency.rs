@@ -1,7 +1,9 @@
 //! Viewer latency, measured (never asserted): from an edit to the coarse preview and to the
-//! full 1-sample image, default scene at 1280×720 on every core, median of 10 edits; and the
-//! UI thread's per-frame cost of taking tiles while a render runs. The baseline, measured in the
-//! same run, is the batch render of the same 1-sample image.
+//! full 1-sample image at 1280×720 on every core, median of 10 edits, on the default scene and
+//! on the 80k-triangle benchmark scene; and the UI thread's per-frame cost of taking tiles
+//! while a render runs. The baseline, measured in the same run, is the batch render of the same
+//! 1-sample image (camera rays in packets, as the viewer's passes trace them), beside the same
+//! batch render with every ray traced alone.
 //!
 //! Run: `cargo bench --bench latency`
 
@@ -9,9 +11,11 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use raytree::app::{Command, ViewerApp};
-use raytree::render::render;
 use raytree::render::session::{Pass, Session, SessionEvent};
+use raytree::render::{render, render_with, trace_tile_single};
+use raytree::scene::Scene;
 use raytree::scene::builtin::load_builtin;
+use raytree::scene::procedural::write_bench_scene;
 use raytree::trace::{TraceSettings, Tracer};
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -19,20 +23,22 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-fn main() {
-    let mut scene = load_builtin("default").expect("built-in scene");
+/// Batch (packets), batch (single rays), edit → preview and edit → full image, in seconds.
+fn latencies(mut scene: Scene) -> [f64; 4] {
     scene.render.width = 1280;
     scene.render.height = 720;
     let settings = TraceSettings::default();
     let base = Tracer::new(Arc::new(scene.clone()), settings);
 
-    let mut batch = Vec::new();
+    let (mut batch, mut single) = (Vec::new(), Vec::new());
     for _ in 0..3 {
         let t = Instant::now();
         render(&base, 1, 0, &|_, _| {}).expect("render");
         batch.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        render_with(&base, 1, 0, &|_, _| {}, &trace_tile_single).expect("render");
+        single.push(t.elapsed().as_secs_f64());
     }
-    let batch = median(batch);
 
     let mut session = Session::new(0).expect("pool");
     let (mut preview, mut full) = (Vec::new(), Vec::new());
@@ -59,7 +65,46 @@ fn main() {
             }
         }
     }
-    let (p, f) = (median(preview), median(full));
+    [median(batch), median(single), median(preview), median(full)]
+}
+
+fn main() {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let bench = write_bench_scene(dir.path(), 80_000).expect("the bench scene is written");
+    let scenes = [
+        (
+            "default scene",
+            load_builtin("default").expect("built-in scene"),
+        ),
+        (
+            "80k-triangle bench scene",
+            raytree::scene::load_scene_file(&bench).expect("the bench scene loads"),
+        ),
+    ];
+    let threads = Session::new(0).expect("pool").threads();
+    for (name, scene) in scenes {
+        let [batch, single, p, f] = latencies(scene);
+        println!("viewer latency, {name} 1280x720, {threads} threads, median of 10 edits");
+        println!("  batch 1-spp render (baseline): {:.1} ms", batch * 1e3);
+        println!(
+            "  batch 1-spp, single rays:      {:.1} ms ({:.2}x the baseline)",
+            single * 1e3,
+            single / batch
+        );
+        println!(
+            "  edit -> coarse preview:        {:.1} ms ({:.2}x the baseline)",
+            p * 1e3,
+            p / batch
+        );
+        println!(
+            "  edit -> full 1-sample image:   {:.1} ms ({:.2}x the baseline)",
+            f * 1e3,
+            f / batch
+        );
+    }
+    let mut scene = load_builtin("default").expect("built-in scene");
+    scene.render.width = 1280;
+    scene.render.height = 720;
 
     // The UI thread: a frame every 16 ms takes what arrived; time that work per frame.
     let mut app = ViewerApp::headless(scene.clone(), "default".into()).expect("viewer state");
@@ -75,19 +120,6 @@ fn main() {
         }
     }
     let worst = frames.iter().copied().fold(0.0, f64::max);
-    let threads = session.threads();
-    println!("viewer latency, default scene 1280x720, {threads} threads, median of 10 edits");
-    println!("  batch 1-spp render (baseline): {:.1} ms", batch * 1e3);
-    println!(
-        "  edit -> coarse preview:        {:.1} ms ({:.2}x the baseline)",
-        p * 1e3,
-        p / batch
-    );
-    println!(
-        "  edit -> full 1-sample image:   {:.1} ms ({:.2}x the baseline)",
-        f * 1e3,
-        f / batch
-    );
     println!(
         "  UI thread per frame taking tiles: median {:.2} ms, worst {:.2} ms over {} frames",
         median(frames.clone()) * 1e3,

@@ -67,7 +67,7 @@ impl Glyph {
     pub const ALL: [Glyph; 3] = [Glyph::Lit, Glyph::FacingAway, Glyph::Blocked];
 
     pub fn of(s: &ShadowRecord) -> Glyph {
-        if s.facing_away {
+        if s.facing_away || s.contributes_nothing {
             Glyph::FacingAway
         } else if s.blocked_by.is_some() {
             Glyph::Blocked
@@ -412,6 +412,9 @@ pub fn layout(tree: &RayTree, options: &Options) -> Layout {
                 let glyph = Glyph::of(s);
                 let verdict = match (glyph, &s.blocked_by) {
                     (Glyph::Blocked, Some(b)) => format!("blocked by {b}"),
+                    (Glyph::FacingAway, _) if s.contributes_nothing => {
+                        "not traced: contributes nothing".to_string()
+                    }
                     (Glyph::FacingAway, _) => "facing away".to_string(),
                     _ => "lit".to_string(),
                 };

@@ -59,6 +59,11 @@ pub struct ShadowRecord {
     pub blocked_at: Option<f32>,
     /// `N·L ≤ 0`: the light is behind the surface, adds nothing and needs no shadow ray.
     pub facing_away: bool,
+    /// In front of the surface but its unshadowed terms are exactly zero (kd and ks zero in
+    /// the light's channels, or no specular where kd is zero): no shadow ray traced, as in the
+    /// render ("not traced: contributes nothing").
+    #[serde(default)]
+    pub contributes_nothing: bool,
     pub n_dot_l: f32,
     pub n_dot_h: f32,
     pub r_dot_v: f32,
@@ -223,6 +228,7 @@ impl Recorder for TreeRecorder<'_> {
                 blocked_by: test.blocked_by.map(|o| scene.object(o).name.clone()),
                 blocked_at: test.blocked_at,
                 facing_away: test.terms.n_dot_l.is_nan() || test.terms.n_dot_l <= 0.0,
+                contributes_nothing: !test.traced && test.terms.n_dot_l > 0.0,
                 n_dot_l: test.terms.n_dot_l,
                 n_dot_h: test.terms.n_dot_h,
                 r_dot_v: test.terms.r_dot_v,
@@ -382,6 +388,7 @@ fn write_node(out: &mut String, node: &Node, indent: usize) {
     for s in &node.shadow_rays {
         let verdict = match (&s.blocked_by, s.facing_away) {
             (_, true) => "facing away".to_string(),
+            _ if s.contributes_nothing => "not traced: contributes nothing".to_string(),
             (Some(b), _) => format!(
                 "blocked by {b}{}",
                 s.blocked_at

@@ -148,6 +148,9 @@ pub struct ShadowTest {
     pub blocked_by: Option<ObjectId>,
     /// Distance along the shadow ray (from its offset origin) to the blocker.
     pub blocked_at: Option<f32>,
+    /// Whether the shadow ray was cast: not when the light is behind the surface (`N·L ≤ 0`)
+    /// nor when its unshadowed contribution is exactly zero (see [`casts_shadow_ray`]).
+    pub traced: bool,
     pub terms: LightTerms,
 }
 
@@ -227,12 +230,35 @@ pub enum VisitQuery {
     Shadow { light: usize },
 }
 
+#[derive(Clone, Copy)]
 enum Found {
     Nothing,
     /// A visible light and the distance to its surface.
     Light(usize, f32),
     Prim(PrimHit),
 }
+
+/// A primary ray's closest hit, its surface and its shadow rays' answers, found by packet
+/// queries ([`Tracer::trace_packet`]).
+#[derive(Clone, Copy)]
+struct Given {
+    found: Found,
+    /// The surface and error bound of `found`'s hit, as [`Tracer::surface`] gives them.
+    surface: Option<(SurfaceHit, Vec3)>,
+    /// Bit `i`: the shadow ray towards light `i` is blocked (lights from 64 on are asked one
+    /// ray at a time).
+    blocked: u64,
+}
+
+impl Given {
+    #[inline(always)]
+    fn blocked(&self, light: usize) -> Option<bool> {
+        (light < 64).then(|| self.blocked >> light & 1 != 0)
+    }
+}
+
+/// Most rays in one packet of [`Tracer::trace_packet`] (a mask of `u32` bits).
+pub const MAX_PACKET: usize = 32;
 
 /// Records that a branch ended, and why, in the tree and in the pixel's facts.
 #[inline(always)]
@@ -298,9 +324,19 @@ impl Tracer {
 
     /// Closest object or visible light along the ray, strictly after its origin (`t > 0`).
     fn intersect(&self, ray: &Ray) -> Found {
+        let hit = self
+            .accel
+            .closest_hit(self.methods(), ray, 0.0, f32::INFINITY);
+        self.with_lights(ray, hit)
+    }
+
+    /// The closest object hit `hit` of `ray` (from the accelerator), or a visible light
+    /// before it.
+    #[inline]
+    fn with_lights(&self, ray: &Ray, hit: Option<PrimHit>) -> Found {
         let mut found = Found::Nothing;
         let mut t_max = f32::INFINITY;
-        if let Some(hit) = self.accel.closest_hit(self.methods(), ray, 0.0, t_max) {
+        if let Some(hit) = hit {
             t_max = hit.t;
             found = Found::Prim(hit);
         }
@@ -339,6 +375,20 @@ impl Tracer {
 
     /// [`Tracer::trace`] of one ray of a sample.
     fn trace_ray<R: Recorder>(&self, ray: &Ray, b: Branch, s: &mut Sample<'_, R>) -> Vec3 {
+        self.trace_ray_given(ray, b, s, None)
+    }
+
+    /// [`Tracer::trace_ray`], with the ray's closest hit and its shadow rays' answers already
+    /// found by a packet query when `given` is set (the caller checked that the ray is traced:
+    /// [`Tracer::ends_untraced`] is `None`).
+    #[inline(always)]
+    fn trace_ray_given<R: Recorder>(
+        &self,
+        ray: &Ray,
+        b: Branch,
+        s: &mut Sample<'_, R>,
+        given: Option<&Given>,
+    ) -> Vec3 {
         s.rec.enter(b.kind, b.depth, ray, b.weight);
         let background = self.scene.render.background;
         let color = if let Some(reason) = self.ends_untraced(b.depth, b.weight, s.info) {
@@ -348,7 +398,11 @@ impl Tracer {
             s.counts.count(b.kind);
             s.info.rays += 1;
             s.info.depth_reached = s.info.depth_reached.max(b.depth);
-            match self.intersect(ray) {
+            let found = match given {
+                Some(g) => g.found,
+                None => self.intersect(ray),
+            };
+            match found {
                 Found::Nothing => {
                     ended(s, EndReason::NoHit);
                     background
@@ -361,11 +415,114 @@ impl Tracer {
                     s.rec.light(i, t);
                     self.scene.lights[i].color
                 }
-                Found::Prim(hit) => self.shade(ray, &hit, b, s),
+                Found::Prim(hit) => match given {
+                    Some(g) => {
+                        let blocked = |i: usize, r: &Ray, length: f32| match g.blocked(i) {
+                            Some(blocked) => blocked,
+                            None => self.accel.occluded(self.methods(), r, 0.0, length),
+                        };
+                        self.shade(ray, &hit, g.surface, b, s, blocked)
+                    }
+                    None => {
+                        let blocked = |_: usize, r: &Ray, length: f32| {
+                            self.accel.occluded(self.methods(), r, 0.0, length)
+                        };
+                        self.shade(ray, &hit, None, b, s, blocked)
+                    }
+                },
             }
         };
         s.rec.leave(color);
         color
+    }
+
+    /// Primary rays of neighbouring pixels traced together: sample colour and facts of
+    /// `rays[i]` into `out[i]` for each bit `i` of `active`, rays added to `counts`. The
+    /// closest hits are one packet query, the shadow rays of the hits towards each light
+    /// another; reflected and refracted rays are traced one by one. Every colour and fact is
+    /// the one [`Tracer::trace`] of the ray alone gives, bit for bit: the same intersection
+    /// answers (see [`Accel::closest_hits`]) go through the same shading code.
+    pub fn trace_packet<const K: usize>(
+        &self,
+        rays: &[Ray; K],
+        active: u32,
+        counts: &mut RayCounts,
+        out: &mut [(Vec3, SampleInfo); K],
+    ) {
+        const { assert!(K <= MAX_PACKET) };
+        let primary = Branch {
+            kind: RayKind::Primary,
+            depth: 0,
+            weight: Vec3::ONE,
+        };
+        let bits = || (0..K).filter(move |&i| active & (1 << i) != 0);
+        if self
+            .ends_untraced(0, Vec3::ONE, &SampleInfo::default())
+            .is_some()
+        {
+            for i in bits() {
+                let mut info = SampleInfo::default();
+                let s = &mut Sample {
+                    counts: &mut *counts,
+                    info: &mut info,
+                    rec: &mut NoRecord,
+                };
+                let c = self.trace_ray(&rays[i], primary, s);
+                out[i] = (c, info);
+            }
+            return;
+        }
+        let m = self.methods();
+        let scene = &*self.scene;
+        let mut hits = [None; K];
+        self.accel.closest_hits(m, rays, active, &mut hits);
+        let mut given: [Given; K] = std::array::from_fn(|i| {
+            let found = self.with_lights(&rays[i], hits[i]);
+            let surface = match found {
+                Found::Prim(hit) if active & (1 << i) != 0 => Some(self.surface(&rays[i], &hit)),
+                _ => None,
+            };
+            Given {
+                found,
+                surface,
+                blocked: 0,
+            }
+        });
+        for (li, light) in scene.lights.iter().enumerate().take(64) {
+            let mut shadow = [Ray::new(Vec3::ZERO, Vec3::Z); K];
+            let mut lengths = [0.0; K];
+            let mut cast = 0u32;
+            for (i, g) in given.iter().enumerate() {
+                if let Some((surface, error)) = &g.surface {
+                    let material = scene.material(surface.material);
+                    let v = -rays[i].dir;
+                    let mut terms = None;
+                    let (_, _, ray) =
+                        self.light_ray::<NoRecord>(surface, *error, material, v, light, &mut terms);
+                    if let Some((ray, length)) = ray {
+                        shadow[i] = ray;
+                        lengths[i] = length;
+                        cast |= 1 << i;
+                    }
+                }
+            }
+            if cast != 0 {
+                let blocked = self.accel.occluded_packet(m, &shadow, &lengths, cast);
+                for (i, g) in given.iter_mut().enumerate() {
+                    g.blocked |= u64::from(blocked >> i & 1) << li;
+                }
+            }
+        }
+        for i in bits() {
+            let mut info = SampleInfo::default();
+            let s = &mut Sample {
+                counts: &mut *counts,
+                info: &mut info,
+                rec: &mut NoRecord,
+            };
+            let c = self.trace_ray_given(&rays[i], primary, s, Some(&given[i]));
+            out[i] = (c, info);
+        }
     }
 
     /// Why a ray ends before it is traced, if it does: past the maximum depth; below the weight
@@ -415,18 +572,51 @@ impl Tracer {
         (surface, error)
     }
 
+    /// Light `light` at a hit (`surface`, its point's error bound `error`, its material, `v`
+    /// towards the viewer): the unit vector `L` to the light, the distance, and the shadow
+    /// ray with its length when one is cast (see [`casts_shadow_ray`]). `terms` gets the
+    /// light's terms when the recorder is on or the decision needed them. The one place that
+    /// decides, for the single and the packet trace alike.
+    #[inline(always)]
+    fn light_ray<R: Recorder>(
+        &self,
+        surface: &SurfaceHit,
+        error: Vec3,
+        material: &crate::scene::Material,
+        v: Vec3,
+        light: &crate::scene::Light,
+        terms: &mut Option<LightTerms>,
+    ) -> (Vec3, f32, Option<(Ray, f32)>) {
+        let (p, n) = (surface.point, surface.normal);
+        let shading = self.scene.render.shading;
+        let to_light = light.position - p;
+        let distance = to_light.length();
+        let l = div3(to_light, distance);
+        if R::ENABLED {
+            *terms = Some(light_terms(shading, material, light.color, n, l, v));
+        }
+        let cast =
+            n.dot(l) > 0.0 && casts_shadow_ray(shading, material, light.color, n, l, v, terms);
+        // Only objects count as blockers, never lights.
+        let offset = self.methods().offset;
+        let ray = cast.then(|| shadow_ray(offset, p, error, n, l, light.position));
+        (l, distance, ray)
+    }
+
     /// The colour of a ray `b` that hit `hit`: the local model with a shadow ray per light,
     /// then the reflected and refracted children.
     fn shade<R: Recorder>(
         &self,
         ray: &Ray,
         hit: &PrimHit,
+        at: Option<(SurfaceHit, Vec3)>,
         b: Branch,
         s: &mut Sample<'_, R>,
+        occluded: impl Fn(usize, &Ray, f32) -> bool,
     ) -> Vec3 {
         let scene = &*self.scene;
         let offset = self.methods().offset;
-        let (surface, error) = self.surface(ray, hit);
+        let (surface, error) = at.unwrap_or_else(|| self.surface(ray, hit));
         let (p, n) = (surface.point, surface.normal);
         let v = -ray.dir;
         s.rec.hit(&surface, v);
@@ -440,20 +630,15 @@ impl Tracer {
         let mut diffuse = Vec3::ZERO;
         let mut specular = Vec3::ZERO;
         for (i, light) in scene.lights.iter().enumerate() {
-            let to_light = light.position - p;
-            let distance = to_light.length();
-            let l = div3(to_light, distance);
             // The recorder shows every light's terms; tiles need them only for lights that
             // are not blocked, so they compute them after the shadow ray (N·L is the same
             // product `light_terms` forms, so the answer is unchanged).
-            let terms = R::ENABLED
-                .then(|| light_terms(scene.render.shading, material, light.color, n, l, v));
-            let n_dot_l = n.dot(l);
+            let mut terms = None;
+            let (l, distance, cast) =
+                self.light_ray::<R>(&surface, error, material, v, light, &mut terms);
             let mut blocked_by = None;
             let mut blocked_at = None;
-            if n_dot_l > 0.0 {
-                // Only objects count as blockers, never lights.
-                let (shadow_ray, length) = shadow_ray(offset, p, error, n, l, light.position);
+            if let Some((shadow_ray, length)) = cast {
                 s.counts.count(RayKind::Shadow);
                 s.info.rays += 1;
                 let blocked = if R::ENABLED {
@@ -464,8 +649,7 @@ impl Tracer {
                     blocked_at = blocker.map(|b| b.t);
                     blocker.is_some()
                 } else {
-                    self.accel
-                        .occluded(self.methods(), &shadow_ray, 0.0, length)
+                    occluded(i, &shadow_ray, length)
                 };
                 if !blocked {
                     let terms = terms.unwrap_or_else(|| {
@@ -482,6 +666,7 @@ impl Tracer {
                     distance,
                     blocked_by,
                     blocked_at,
+                    traced: cast.is_some(),
                     terms,
                 });
             }
@@ -553,15 +738,12 @@ impl Tracer {
             return Visits::default();
         };
         let (surface, error) = self.surface(&ray, &hit);
-        let to_light = light.position - surface.point;
-        let l = div3(to_light, to_light.length());
-        // As in `shade`: no shadow ray unless N·L > 0.
-        if surface.normal.dot(l) > 0.0 {
-            let (p, n) = (surface.point, surface.normal);
-            let (shadow, length) = shadow_ray(m.offset, p, error, n, l, light.position);
-            self.accel.occluded_visits(m, &shadow, 0.0, length)
-        } else {
-            Visits::default()
+        // As in `shade`: no shadow ray unless N·L > 0 and the light can add something.
+        let material = self.scene.material(surface.material);
+        let v = -ray.dir;
+        match self.light_ray::<NoRecord>(&surface, error, material, v, light, &mut None) {
+            (_, _, Some((shadow, length))) => self.accel.occluded_visits(m, &shadow, 0.0, length),
+            _ => Visits::default(),
         }
     }
 
@@ -575,6 +757,31 @@ impl Tracer {
             self.scene.triangles[prim - n_spheres].object
         }
     }
+}
+
+/// Whether a light in front of the surface (`N·L > 0`) needs a shadow ray: not when its
+/// unshadowed contribution is exactly zero, so the ray could not change the pixel. The diffuse
+/// term is `(C_l ⊙ kd)·N·L` and the specular `(C_l ⊙ ks)·spec`: when `C_l ⊙ kd` has a non-zero
+/// channel the ray is cast; otherwise the terms are formed (into `terms`, when not already
+/// there) and the ray is cast only when the specular is not exactly zero (a NaN is cast, so
+/// it reaches the pixel as before). Both the render and the tree (and [`Tracer::visits_of`])
+/// decide here, so a light the tree marks "not traced: contributes nothing" is one the image
+/// did not trace.
+#[inline(always)]
+fn casts_shadow_ray(
+    shading: crate::scene::Shading,
+    material: &crate::scene::Material,
+    color: Vec3,
+    n: Vec3,
+    l: Vec3,
+    v: Vec3,
+    terms: &mut Option<LightTerms>,
+) -> bool {
+    if color * material.diffuse != Vec3::ZERO {
+        return true;
+    }
+    let t = *terms.get_or_insert_with(|| light_terms(shading, material, color, n, l, v));
+    t.specular != Vec3::ZERO || t.diffuse != Vec3::ZERO
 }
 
 /// The shadow ray from hit point `p` (error bound `error`, normal `n`) towards the light at

@@ -22,6 +22,7 @@ fn shadow(light: usize, how: u64) -> ShadowRecord {
         blocked_by: (how == 1).then(|| "blocker".to_string()),
         blocked_at: (how == 1).then_some(0.5),
         facing_away: how == 2,
+        contributes_nothing: false,
         n_dot_l: 0.5,
         n_dot_h: 0.5,
         r_dot_v: 0.5,

@@ -172,3 +172,52 @@ fn phong_uses_mirror_direction_of_the_light() {
     let got = b.pixel(2, 2, AccelKind::None);
     assert!(close(got, expect.as_vec3(), 1e-5), "{got} vs {expect}");
 }
+
+/// A light whose unshadowed terms are exactly zero at a hit casts no shadow ray (it cannot
+/// change the pixel): a black-diffuse, black-specular mirror; a green-only light on a red-only
+/// surface; and a surface with no diffuse whose highlight points away (spec = 0). The tree
+/// still lists each light, marked "contributes nothing", and its pixel equals the render's.
+#[test]
+fn lights_that_contribute_nothing_cast_no_shadow_ray() {
+    use raytree::ray_tree::pixel_tree;
+    use raytree::render::render;
+    // (name, kd, ks, shininess, light colour); the last one has no diffuse but a highlight
+    // (N·H > 0 at every pixel), so its shadow rays are traced.
+    let cases: [(&str, Vec3, Vec3, f32, Vec3); 3] = [
+        ("black mirror", Vec3::ZERO, Vec3::ZERO, 8.0, Vec3::ONE),
+        ("red surface, green light", Vec3::X, Vec3::X, 8.0, Vec3::Y),
+        (
+            "no diffuse, specular seen",
+            Vec3::ZERO,
+            Vec3::ONE,
+            1.0,
+            Vec3::ONE,
+        ),
+    ];
+    for (name, kd, ks, n, light) in cases {
+        let mut m = mat(name, Vec3::splat(0.1), kd, 0.0, n, 0.5);
+        m.specular = ks;
+        let b = Build::new(looking(Vec3::ZERO, Vec3::NEG_Z, 60.0), 5, 5)
+            .material(m)
+            .light(Vec3::new(0.0, 3.0, 0.0), light)
+            .light(Vec3::new(0.0, -3.0, -2.5), light)
+            .quad("wall", wall_z(-3.0, 5.0, true), 0);
+        let tracer = b.tracer();
+        let (image, stats) = render(&tracer, 1, 1, &|_, _| {}).expect("render");
+        let tree = pixel_tree(&tracer, 2, 2).expect("the centre pixel's tree");
+        let hit = &tree.root;
+        assert_eq!(hit.shadow_rays.len(), 2, "{name}");
+        let traced = name == "no diffuse, specular seen";
+        for s in &hit.shadow_rays {
+            assert!(!s.facing_away, "{name}");
+            assert_eq!(s.contributes_nothing, !traced, "{name}");
+        }
+        let want_shadow = if traced { 2 * 25 } else { 0 };
+        assert_eq!(stats.rays.shadow, want_shadow, "{name}");
+        assert_eq!(tree.root.color, image.get(2, 2), "{name}");
+        if !traced {
+            let text = raytree::ray_tree::tree_text(&tree);
+            assert!(text.contains("not traced: contributes nothing"), "{text}");
+        }
+    }
+}

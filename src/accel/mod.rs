@@ -457,6 +457,71 @@ impl Accel {
         v.hit
     }
 
+    /// [`Accel::closest_hit`] in `(0, ∞)` of each ray of a packet whose bit is set in
+    /// `active` (bit `i` for `rays[i]`), into `out[i]`; the other entries of `out` are left
+    /// alone. The BVH walks the rays together ([`Bvh::walk_packet`](bvh::Bvh)); every answer
+    /// is the single query's, bit for bit.
+    pub fn closest_hits<const K: usize>(
+        &self,
+        m: &Methods,
+        rays: &[Ray; K],
+        active: u32,
+        out: &mut [Option<PrimHit>; K],
+    ) {
+        let Imp::Bvh(bvh) = &self.imp else {
+            for (i, ray) in rays.iter().enumerate() {
+                if active & (1 << i) != 0 {
+                    out[i] = self.closest_hit(m, ray, 0.0, f32::INFINITY);
+                }
+            }
+            return;
+        };
+        let usable = active & usable_mask(rays, |_| f32::INFINITY);
+        let mut vs: [Closest<'_>; K] =
+            std::array::from_fn(|i| Closest::new(m, &rays[i], 0.0, f32::INFINITY));
+        bvh.walk_packet(rays, 0.0, &mut vs, usable);
+        for (i, v) in vs.iter().enumerate() {
+            if active_bit(active, i) {
+                out[i] = if active_bit(usable, i) { v.hit() } else { None };
+            }
+        }
+    }
+
+    /// [`Accel::occluded`] in `(0, lengths[i])` of each ray of a packet whose bit is set in
+    /// `active`: the mask of those that are blocked. The BVH walks the rays together; every
+    /// answer is the single query's.
+    pub fn occluded_packet<const K: usize>(
+        &self,
+        m: &Methods,
+        rays: &[Ray; K],
+        lengths: &[f32; K],
+        active: u32,
+    ) -> u32 {
+        let Imp::Bvh(bvh) = &self.imp else {
+            let mut blocked = 0;
+            for (i, ray) in rays.iter().enumerate() {
+                if active & (1 << i) != 0 && self.occluded(m, ray, 0.0, lengths[i]) {
+                    blocked |= 1 << i;
+                }
+            }
+            return blocked;
+        };
+        let active = active & usable_mask(rays, |i| lengths[i]);
+        let mut vs: [AnyHit<'_>; K] = std::array::from_fn(|i| AnyHit {
+            q: Query::new(m, &rays[i], 0.0),
+            t_max: lengths[i],
+            hit: false,
+        });
+        bvh.walk_packet(rays, 0.0, &mut vs, active);
+        let mut blocked = 0;
+        for (i, v) in vs.iter().enumerate() {
+            if active_bit(active, i) && v.hit {
+                blocked |= 1 << i;
+            }
+        }
+        blocked
+    }
+
     #[inline]
     fn walk<V: Visitor>(&self, ray: &Ray, t_min: f32, t_max: f32, v: &mut V) {
         match &self.imp {
@@ -471,6 +536,23 @@ impl Accel {
             Imp::Bvh(b) => b.walk(ray, t_min, v),
         }
     }
+}
+
+/// The bits of the rays of a packet that [`ray_is_usable`] in `(0, t_max(i))`.
+#[inline]
+fn usable_mask(rays: &[Ray], t_max: impl Fn(usize) -> f32) -> u32 {
+    let mut mask = 0;
+    for (i, ray) in rays.iter().enumerate() {
+        if ray_is_usable(ray, 0.0, t_max(i)) {
+            mask |= 1 << i;
+        }
+    }
+    mask
+}
+
+#[inline(always)]
+fn active_bit(mask: u32, i: usize) -> bool {
+    mask & (1 << i) != 0
 }
 
 #[inline]

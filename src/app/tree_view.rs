@@ -653,6 +653,8 @@ pub fn detail(ui: &mut Ui, tree: &RayTree, path: &[usize]) {
         ui.separator();
         let verdict = if s.facing_away {
             "facing away (N·L <= 0): adds nothing".to_string()
+        } else if s.contributes_nothing {
+            "not traced: contributes nothing (kd and ks give zero)".to_string()
         } else if let Some(b) = &s.blocked_by {
             format!(
                 "blocked by {b}{}",

@@ -89,7 +89,8 @@ pub fn tiles(width: u32, height: u32, size: u32) -> Vec<Rect> {
 }
 
 /// Traces samples `samples` of every pixel of `rect`, adding each sample, in index order, to
-/// the running sums in `sums` (row-major within the rect). Returns the rays traced.
+/// the running sums in `sums` (row-major within the rect). Returns the rays traced. Camera
+/// rays go in packets ([`accumulate_tile`]).
 pub fn trace_tile(
     tracer: &Tracer,
     frame: &CameraFrame,
@@ -102,13 +103,88 @@ pub fn trace_tile(
     counts
 }
 
+/// [`trace_tile`] with every ray traced alone, no packets: the reference the packet path is
+/// tested against (bit for bit) and measured against. Use it with [`render_with`].
+pub fn trace_tile_single(
+    tracer: &Tracer,
+    frame: &CameraFrame,
+    rect: Rect,
+    samples: Range<u32>,
+    sums: &mut [Vec3],
+) -> RayCounts {
+    let mut counts = RayCounts::default();
+    accumulate_tile_single(tracer, frame, rect, samples, sums, &mut counts, None);
+    counts
+}
+
+/// Width and height in pixels of the block of neighbouring camera rays traced as one packet
+/// ([`Tracer::trace_packet`]).
+pub const PACKET_BLOCK: (u32, u32) = (4, 2);
+const PACKET_RAYS: usize = (PACKET_BLOCK.0 * PACKET_BLOCK.1) as usize;
+
 /// The one tile loop of the batch render ([`trace_tile`]) and the viewer's session: adds
 /// samples `samples` of every pixel of `rect` to its running sum in `sums` (row-major within
-/// the rect), one pixel after another and each pixel's samples in index order, so a pixel's sum
-/// never depends on how the samples were split into passes. Rays traced are added to `counts`;
-/// when `samples` holds sample 0, each pixel's [`SampleInfo`] of that sample is pushed to
-/// `first` (row-major), for the viewer's image modes.
+/// the rect), each pixel's samples in index order, so a pixel's sum never depends on how the
+/// samples were split into passes. Rays traced are added to `counts`; when `samples` holds
+/// sample 0, each pixel's [`SampleInfo`] of that sample is appended to `first` (row-major),
+/// for the viewer's image modes.
+///
+/// The camera rays of each [`PACKET_BLOCK`] of pixels are traced together, sample by sample
+/// (their closest hits one packet query, their shadow rays towards each light another); the
+/// colours and facts are those of [`accumulate_tile_single`] bit for bit.
 pub fn accumulate_tile(
+    tracer: &Tracer,
+    frame: &CameraFrame,
+    rect: Rect,
+    samples: Range<u32>,
+    sums: &mut [Vec3],
+    counts: &mut RayCounts,
+    first: Option<&mut Vec<SampleInfo>>,
+) {
+    let (bw, bh) = PACKET_BLOCK;
+    let base = first.as_ref().map_or(0, |f| f.len());
+    let mut first = first.filter(|_| samples.contains(&0));
+    if let Some(f) = first.as_mut() {
+        f.resize(
+            base + (rect.width * rect.height) as usize,
+            SampleInfo::default(),
+        );
+    }
+    let mut rays = [crate::geometry::Ray::new(Vec3::ZERO, Vec3::Z); PACKET_RAYS];
+    let mut out = [(Vec3::ZERO, SampleInfo::default()); PACKET_RAYS];
+    for by in (0..rect.height).step_by(bh as usize) {
+        for bx in (0..rect.width).step_by(bw as usize) {
+            // The block's pixels inside the rect, row-major: (index in `sums`, x, y).
+            let mut pixels = [(0usize, 0u32, 0u32); PACKET_RAYS];
+            let mut n = 0;
+            for j in by..(by + bh).min(rect.height) {
+                for i in bx..(bx + bw).min(rect.width) {
+                    pixels[n] = ((j * rect.width + i) as usize, rect.x + i, rect.y + j);
+                    n += 1;
+                }
+            }
+            let active = (1u32 << n) - 1;
+            for s in samples.clone() {
+                for (k, &(_, x, y)) in pixels[..n].iter().enumerate() {
+                    rays[k] = primary_ray(frame, x, y, s);
+                }
+                tracer.trace_packet(&rays, active, counts, &mut out);
+                for (&(at, _, _), &(c, info)) in pixels[..n].iter().zip(&out[..n]) {
+                    sums[at] += c;
+                    if s == 0
+                        && let Some(first) = first.as_mut()
+                    {
+                        first[base + at] = info;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// [`accumulate_tile`] with every ray traced alone: one pixel after another, each pixel's
+/// samples in index order.
+pub fn accumulate_tile_single(
     tracer: &Tracer,
     frame: &CameraFrame,
     rect: Rect,

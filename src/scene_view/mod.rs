@@ -201,7 +201,11 @@ pub fn tree_segments(tree: &RayTree, extent: f32) -> Vec<Segment> {
                     hit.point + hit.normal * extent * 0.04,
                     Style::Normal,
                 );
-                for s in node.shadow_rays.iter().filter(|s| !s.facing_away) {
+                for s in node
+                    .shadow_rays
+                    .iter()
+                    .filter(|s| !s.facing_away && !s.contributes_nothing)
+                {
                     let light = hit.point + s.to_light * s.distance;
                     match s.blocked_at {
                         Some(d) if s.blocked_by.is_some() => {

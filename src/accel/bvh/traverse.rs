@@ -143,6 +143,137 @@ impl Bvh {
     }
 }
 
+impl Bvh {
+    /// The traversal of a packet of up to 32 coherent rays (camera rays of neighbouring
+    /// pixels, shadow rays of neighbouring hits towards one light): one walk of the tree with
+    /// one shared stack, each node fetched once for the packet and tested by every ray still
+    /// in it (the same widened slab test as [`Bvh::walk`], against that ray's own
+    /// `(t_min, limit]`). A stack entry carries the rays that entered the child (a mask) and
+    /// the nearest of their entry `t`s, so a child is skipped when it is popped behind every
+    /// one of its rays' best hits (closest hit) and a ray leaves the packet at its first hit
+    /// (occlusion). Each ray visits every primitive its single walk would visit that can still
+    /// matter, so with the id tie-break its answer is the single walk's, bit for bit.
+    /// `active` selects the rays of `rays` (bit `i` for ray `i`).
+    pub(in crate::accel) fn walk_packet<V: Visitor, const K: usize>(
+        &self,
+        rays: &[Ray; K],
+        t_min: f32,
+        vs: &mut [V; K],
+        mut active: u32,
+    ) {
+        const { assert!(K <= 32) };
+        if self.nodes.is_empty() || active == 0 {
+            return;
+        }
+        let trs: [TravRay; K] = std::array::from_fn(|i| TravRay::new(&rays[i], t_min));
+        let mut stack = [(0u32, 0u32, 0f32); STACK_SIZE];
+        let mut sp = 0;
+        let (mut word, mut mask) = (0u32, active);
+        let slack = Vec4::splat(box_t_slack());
+        loop {
+            if word & LEAF != 0 {
+                let mut m = mask;
+                while m != 0 {
+                    let i = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    let v = &mut vs[i];
+                    let stop = if word & SPHERE != 0 {
+                        v.visit(&self.spheres[(word & !(LEAF | SPHERE)) as usize])
+                    } else {
+                        let packet = &self.packets[((word & !LEAF) >> 2) as usize];
+                        v.visit_triangles(&packet.tris, &packet.ids, (word & 3) as usize + 1)
+                    };
+                    if stop {
+                        active &= !(1 << i);
+                    }
+                }
+                if active == 0 {
+                    return;
+                }
+            } else {
+                let node = &self.nodes[word as usize];
+                let p = &node.planes;
+                // Per child slot, the rays that enter it, and the nearest of their entry ts.
+                let mut entered = [0u32; 4];
+                let mut key = Vec4::splat(f32::INFINITY);
+                let mut m = mask;
+                while m != 0 {
+                    let i = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    let r = &trs[i];
+                    let (nx, ny, nz) = (r.near[0], r.near[1], r.near[2]);
+                    let t_near = ((p[nx] - r.ox) * r.ix)
+                        .max((p[ny] - r.oy) * r.iy)
+                        .max((p[nz] - r.oz) * r.iz);
+                    let t_far = ((p[nx ^ 1] - r.ox) * r.ix)
+                        .min((p[ny ^ 1] - r.oy) * r.iy)
+                        .min((p[nz ^ 1] - r.oz) * r.iz);
+                    let t_near = (t_near - t_near.abs() * slack).max(r.t_min);
+                    let t_far = (t_far + t_far.abs() * slack).min(Vec4::splat(vs[i].limit()));
+                    let hit = t_near.cmple(t_far);
+                    let bits = hit.bitmask() & node.valid;
+                    key = key.min(Vec4::select(hit, t_near, Vec4::splat(f32::INFINITY)));
+                    for (slot, e) in entered.iter_mut().enumerate() {
+                        *e |= ((bits >> slot) & 1) << i;
+                    }
+                }
+                let key = key.to_array();
+                // The children entered, nearest first when ordered.
+                let mut hits = [(0u32, 0u32, 0f32); 4];
+                let mut k = 0;
+                for slot in 0..4 {
+                    if entered[slot] == 0 {
+                        continue;
+                    }
+                    let mut j = k;
+                    if V::ORDERED {
+                        while j > 0 && hits[j - 1].2 < key[slot] {
+                            hits[j] = hits[j - 1];
+                            j -= 1;
+                        }
+                    }
+                    hits[j] = (node.child[slot], entered[slot], key[slot]);
+                    k += 1;
+                }
+                if k > 0 {
+                    (word, mask) = (hits[k - 1].0, hits[k - 1].1);
+                    for h in &hits[..k - 1] {
+                        stack[sp] = *h;
+                        sp += 1;
+                    }
+                    continue;
+                }
+            }
+            // Pop the next child with a ray still looking whose best hit is not before it.
+            loop {
+                if sp == 0 {
+                    return;
+                }
+                sp -= 1;
+                let (w, m, t) = stack[sp];
+                let m = m & active;
+                if m == 0 {
+                    continue;
+                }
+                if V::ORDERED {
+                    let mut any = false;
+                    let mut r = m;
+                    while r != 0 {
+                        let i = r.trailing_zeros() as usize;
+                        r &= r - 1;
+                        any |= t <= vs[i].limit();
+                    }
+                    if !any {
+                        continue;
+                    }
+                }
+                (word, mask) = (w, m);
+                break;
+            }
+        }
+    }
+}
+
 /// A ray prepared for the node test.
 struct TravRay {
     ox: Vec4,

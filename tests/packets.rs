@@ -1,0 +1,279 @@
+//! Coherent rays: camera rays traced in packets (and their shadow rays towards each light) give
+//! the image of the single-ray path bit for bit, with the same ray counts and pixel facts, on
+//! every built-in scene (the stability scenes `acne` and `cracks` among them), with every
+//! accelerator and every intersection and offset method; and the packet queries of the
+//! accelerator answer what the single queries answer.
+
+use std::sync::Arc;
+
+use glam::Vec3;
+use raytree::accel::{Accel, AccelKind, PrimSet};
+use raytree::choice::Choice;
+use raytree::geometry::{Methods, OffsetMethod, Ray, SphereMethod, TriangleMethod};
+use raytree::render::{
+    Image, Rect, accumulate_tile, accumulate_tile_single, render, render_with, trace_tile_single,
+};
+use raytree::scene::builtin::{NAMES, load_builtin};
+use raytree::scene::{CameraFrame, Scene};
+use raytree::trace::{RayCounts, TraceSettings, Tracer};
+
+fn bits(image: &Image) -> Vec<[u32; 3]> {
+    image
+        .pixels
+        .iter()
+        .map(|p| p.to_array().map(f32::to_bits))
+        .collect()
+}
+
+/// Renders `scene` with packets and ray by ray and asserts the images and ray counts agree
+/// exactly; returns the rays traced.
+fn assert_same(scene: &Scene, settings: TraceSettings, samples: u32, what: &str) -> RayCounts {
+    let tracer = Tracer::new(Arc::new(scene.clone()), settings);
+    let (packets, ps) = render(&tracer, samples, 2, &|_, _| {}).expect("packet render");
+    let (single, ss) =
+        render_with(&tracer, samples, 2, &|_, _| {}, &trace_tile_single).expect("single render");
+    assert_eq!(ps.rays, ss.rays, "{what}: ray counts");
+    let (a, b) = (bits(&packets), bits(&single));
+    let differ = a.iter().zip(&b).filter(|(x, y)| x != y).count();
+    assert_eq!(differ, 0, "{what}: {differ} pixels differ");
+    ps.rays
+}
+
+fn sized(name: &str, width: u32, height: u32) -> Scene {
+    let mut s = load_builtin(name).unwrap_or_else(|e| panic!("built-in {name}: {e}"));
+    // Odd sizes: packets cut by the tile and image edges are partial.
+    s.render.width = width;
+    s.render.height = height;
+    s
+}
+
+#[test]
+fn every_builtin_scene_is_bit_identical_with_every_accelerator() {
+    for name in NAMES {
+        let scene = sized(name, 97, 71);
+        for accel in [AccelKind::None, AccelKind::Grid, AccelKind::Bvh] {
+            let settings = TraceSettings {
+                accel,
+                ..TraceSettings::default()
+            };
+            let rays = assert_same(&scene, settings, 2, &format!("{name} {accel:?}"));
+            assert!(rays.primary == 2 * 97 * 71, "{name}: {rays:?}");
+        }
+    }
+}
+
+#[test]
+fn every_method_and_the_cutoff_are_bit_identical() {
+    for name in NAMES {
+        let scene = sized(name, 61, 45);
+        let mut variants = Vec::new();
+        for &sphere in SphereMethod::ALL {
+            for &triangle in TriangleMethod::ALL {
+                for &offset in OffsetMethod::ALL {
+                    variants.push((
+                        Methods {
+                            sphere,
+                            triangle,
+                            offset,
+                        },
+                        0.0,
+                    ));
+                }
+            }
+        }
+        variants.push((Methods::default(), 0.3));
+        // Above 1 even the primary rays end untraced (cutoff), on both paths.
+        variants.push((Methods::default(), 1.5));
+        for (methods, cutoff) in variants {
+            let settings = TraceSettings {
+                accel: AccelKind::Bvh,
+                methods,
+                cutoff,
+            };
+            assert_same(
+                &scene,
+                settings,
+                1,
+                &format!("{name} {methods:?} cutoff {cutoff}"),
+            );
+        }
+    }
+}
+
+/// The issue-7 benchmark scene (a mesh, mirror and glass spheres, two lights), small.
+#[test]
+fn bench_scene_is_bit_identical() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = raytree::scene::procedural::write_bench_scene(dir.path(), 3000).expect("write");
+    let mut scene = raytree::scene::load_scene_file(&path).expect("load");
+    scene.render.width = 130;
+    scene.render.height = 98;
+    let rays = assert_same(&scene, TraceSettings::default(), 1, "bench scene");
+    assert!(rays.shadow > rays.primary && rays.reflected > 0 && rays.refracted > 0);
+}
+
+/// The pixel facts the viewer's image modes show come out row-major and equal, appended after
+/// what the list held.
+#[test]
+fn tile_facts_are_the_single_paths() {
+    let scene = sized("default", 40, 30);
+    let tracer = Tracer::new(Arc::new(scene.clone()), TraceSettings::default());
+    let frame = CameraFrame::new(&scene.camera, 40, 30);
+    let rect = Rect {
+        x: 3,
+        y: 5,
+        width: 31,
+        height: 23,
+    };
+    let n = (rect.width * rect.height) as usize;
+    let (mut sums_p, mut sums_s) = (vec![Vec3::ZERO; n], vec![Vec3::ZERO; n]);
+    let (mut counts_p, mut counts_s) = (RayCounts::default(), RayCounts::default());
+    let before = raytree::trace::SampleInfo {
+        rays: 77,
+        ..Default::default()
+    };
+    let (mut first_p, mut first_s) = (vec![before], vec![before]);
+    let samples = 0..3;
+    accumulate_tile(
+        &tracer,
+        &frame,
+        rect,
+        samples.clone(),
+        &mut sums_p,
+        &mut counts_p,
+        Some(&mut first_p),
+    );
+    accumulate_tile_single(
+        &tracer,
+        &frame,
+        rect,
+        samples,
+        &mut sums_s,
+        &mut counts_s,
+        Some(&mut first_s),
+    );
+    assert_eq!(first_p.len(), n + 1);
+    assert_eq!(first_p, first_s);
+    assert_eq!(counts_p, counts_s);
+    assert_eq!(sums_p, sums_s);
+    // A later pass (no sample 0) adds no facts.
+    let mut later = Vec::new();
+    accumulate_tile(
+        &tracer,
+        &frame,
+        rect,
+        3..4,
+        &mut sums_p,
+        &mut counts_p,
+        Some(&mut later),
+    );
+    assert!(later.is_empty());
+}
+
+/// A tiny xorshift generator: the packets' rays.
+struct Rng(u32);
+
+impl Rng {
+    fn next(&mut self) -> f32 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 17;
+        self.0 ^= self.0 << 5;
+        self.0 as f32 / u32::MAX as f32 * 2.0 - 1.0
+    }
+
+    fn vec(&mut self) -> Vec3 {
+        Vec3::new(self.next(), self.next(), self.next())
+    }
+}
+
+/// Packet queries against single ones on a triangle soup with spheres: neighbouring rays,
+/// scattered rays, unusable rays (NaN, zero direction, empty interval) and inactive lanes,
+/// which are left alone.
+#[test]
+fn packet_queries_answer_as_single_queries() {
+    let mut rng = Rng(12345);
+    let mut prims = PrimSet::default();
+    for _ in 0..40 {
+        prims
+            .spheres
+            .push((rng.vec() * 3.0, 0.05 + rng.next().abs() * 0.3));
+    }
+    for _ in 0..4000 {
+        let c = rng.vec() * 3.0;
+        prims
+            .triangles
+            .push([0, 1, 2].map(|_| c + rng.vec() * 0.25));
+    }
+    let m = Methods::default();
+    for kind in [AccelKind::Bvh, AccelKind::Grid, AccelKind::None] {
+        let accel = Accel::build(kind, &prims);
+        let (mut hits, mut blocked_count) = (0, 0);
+        for round in 0..300 {
+            let origin = rng.vec() * 6.0;
+            let aim = rng.vec() * 2.0;
+            let spread = if round % 3 == 0 { 2.0 } else { 0.02 };
+            let mut rays: [Ray; 8] = std::array::from_fn(|_| {
+                Ray::new(origin, (aim + rng.vec() * spread - origin).normalize())
+            });
+            let lengths: [f32; 8] = std::array::from_fn(|_| 1.0 + rng.next().abs() * 8.0);
+            if round % 7 == 0 {
+                rays[3].dir = Vec3::ZERO;
+                rays[5].origin.x = f32::NAN;
+            }
+            let active = if round % 5 == 0 { 0b1011_0111 } else { 0xff };
+            let sentinel = Some(raytree::accel::PrimHit {
+                t: -1.0,
+                prim: 7,
+                b1: 0.0,
+                b2: 0.0,
+            });
+            let mut out = [sentinel; 8];
+            accel.closest_hits(&m, &rays, active, &mut out);
+            let blocked = accel.occluded_packet(&m, &rays, &lengths, active);
+            for i in 0..8 {
+                if active & (1 << i) == 0 {
+                    assert_eq!(out[i], sentinel, "{kind:?} lane {i} touched");
+                    assert_eq!(blocked & (1 << i), 0);
+                    continue;
+                }
+                let single = accel.closest_hit(&m, &rays[i], 0.0, f32::INFINITY);
+                assert_eq!(out[i], single, "{kind:?} round {round} lane {i}");
+                let occluded = accel.occluded(&m, &rays[i], 0.0, lengths[i]);
+                assert_eq!(
+                    blocked & (1 << i) != 0,
+                    occluded,
+                    "{kind:?} round {round} lane {i}"
+                );
+                hits += usize::from(single.is_some());
+                blocked_count += usize::from(occluded);
+            }
+        }
+        assert!(
+            hits > 300 && blocked_count > 100,
+            "{kind:?}: {hits} hits, {blocked_count} blocked"
+        );
+    }
+}
+
+/// More lights than a packet's shadow answers hold (64, then one ray at a time), visible lights
+/// (balls that end rays) among them, and a light behind everything: still bit-identical.
+#[test]
+fn many_and_visible_lights_are_bit_identical() {
+    let mut scene = sized("glass", 53, 37);
+    let mut rng = Rng(99);
+    for k in 0..70 {
+        scene.lights.push(raytree::scene::Light {
+            name: format!("extra {k}"),
+            position: rng.vec() * 6.0 + Vec3::Y * 3.0,
+            color: Vec3::splat(0.01),
+            radius: if k % 9 == 0 { 0.2 } else { 0.0 },
+        });
+    }
+    let rays = assert_same(
+        &scene,
+        TraceSettings::default(),
+        1,
+        "glass with 70 more lights",
+    );
+    assert!(rays.shadow > 64 * rays.primary / 4, "{rays:?}");
+}
