@@ -1,0 +1,245 @@
+//! `raytree merge`: puts the parts of a render made on several machines (`raytree render
+//! --region` or `--tile`) back into one image. Every part's stamp must say the same scene,
+//! settings, samples and program; the parts must cover the image exactly once. Anything else
+//! is refused with one sentence naming the part, and nothing is written.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Result, bail};
+use clap::Args;
+use raytree::export::{self, KEY_REGION, KEY_SCENE_HASH, Pixels, StampedImage};
+use raytree::render::Image;
+
+#[derive(Args, Debug)]
+pub struct MergeArgs {
+    /// The parts: PNG or EXR images written by `raytree render --region/--tile`, all of one
+    /// kind.
+    #[arg(required = true, value_name = "PART")]
+    parts: Vec<PathBuf>,
+    /// The merged image: .png (from PNG or EXR parts) or .exr (from EXR parts).
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+/// The stamp entries that must agree between parts, and what each is called in a refusal.
+const MUST_AGREE: &[(&str, &str)] = &[
+    ("Software", "program version"),
+    ("raytree.samples", "samples"),
+    ("raytree.settings", "settings"),
+    (export::KEY_FRAME, "turntable frame"),
+    (KEY_SCENE_HASH, "scene"),
+];
+
+pub fn run_merge(args: &MergeArgs) -> Result<()> {
+    let out_ext = extension(&args.output);
+    if !matches!(out_ext.as_deref(), Some("png" | "exr")) {
+        bail!(
+            "cannot write {}: the file name must end in .png (8-bit sRGB) or .exr (linear float)",
+            args.output.display()
+        );
+    }
+    let mut parts = Vec::with_capacity(args.parts.len());
+    for path in &args.parts {
+        parts.push(export::read_stamped(path)?);
+    }
+    let (width, height) = check_parts(&args.parts, &parts)?;
+    let first = &parts[0];
+    let linear = matches!(first.pixels, Pixels::Linear(_));
+    if out_ext.as_deref() == Some("exr") && !linear {
+        bail!(
+            "cannot write {}: the parts are 8-bit PNGs, and an EXR needs the linear float pixels \
+             of EXR parts (render the parts as .exr, or merge to .png)",
+            args.output.display()
+        );
+    }
+    // The merged image's stamp: the first part's, with the whole image as its region, so it
+    // reads as the single-machine render's.
+    let text: Vec<(String, String)> = first
+        .text
+        .iter()
+        .map(|(k, v)| {
+            if k == KEY_REGION {
+                (k.clone(), format!("0,0,{width},{height}"))
+            } else {
+                (k.clone(), v.clone())
+            }
+        })
+        .collect();
+    if linear {
+        let mut image = Image::new(width, height);
+        for part in &parts {
+            let (r, Pixels::Linear(px)) = (region_of(part), &part.pixels) else {
+                continue;
+            };
+            for j in 0..r.height {
+                let src = (j * r.width) as usize..((j + 1) * r.width) as usize;
+                let at = ((r.y + j) * width + r.x) as usize;
+                image.pixels[at..at + r.width as usize].copy_from_slice(&px[src]);
+            }
+        }
+        export::write_image(&args.output, &image, &text)?;
+    } else {
+        let mut bytes = vec![0u8; width as usize * height as usize * 3];
+        for part in &parts {
+            let (r, Pixels::Srgb8(px)) = (region_of(part), &part.pixels) else {
+                continue;
+            };
+            let row = r.width as usize * 3;
+            for j in 0..r.height as usize {
+                let at = ((r.y as usize + j) * width as usize + r.x as usize) * 3;
+                bytes[at..at + row].copy_from_slice(&px[j * row..(j + 1) * row]);
+            }
+        }
+        export::write_png_rgb8(&args.output, width, height, &bytes, &text)?;
+    }
+    out!(
+        "wrote {} ({width}x{height}, from {} parts)",
+        args.output.display(),
+        parts.len()
+    );
+    Ok(())
+}
+
+fn extension(path: &Path) -> Option<String> {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+}
+
+fn region_of(part: &StampedImage) -> raytree::render::Rect {
+    part.get(KEY_REGION)
+        .and_then(export::parse_region)
+        .unwrap_or(raytree::render::Rect {
+            x: 0,
+            y: 0,
+            width: 0,
+            height: 0,
+        })
+}
+
+/// The full image's size from a part's settings stamp.
+fn full_size(part: &StampedImage) -> Option<(u32, u32)> {
+    let settings: serde_json::Value = serde_json::from_str(part.get("raytree.settings")?).ok()?;
+    let w = u32::try_from(settings.get("width")?.as_u64()?).ok()?;
+    let h = u32::try_from(settings.get("height")?.as_u64()?).ok()?;
+    Some((w, h))
+}
+
+/// Checks that the parts belong together and cover the image once; returns its size.
+fn check_parts(paths: &[PathBuf], parts: &[StampedImage]) -> Result<(u32, u32)> {
+    let name = |i: usize| paths[i].display().to_string();
+    let mut size = None;
+    for (i, part) in parts.iter().enumerate() {
+        let Some((w, h)) = full_size(part) else {
+            bail!(
+                "{} has no raytree stamp of its image size (raytree.settings); only images \
+                 written by `raytree render` can be merged",
+                name(i)
+            );
+        };
+        let Some(r) = part.get(KEY_REGION).and_then(export::parse_region) else {
+            bail!(
+                "{} has no raytree region stamp (raytree.region); render parts with `raytree \
+                 render --region` or `--tile`",
+                name(i)
+            );
+        };
+        if part.get(KEY_SCENE_HASH).is_none() {
+            bail!(
+                "{} has no raytree scene stamp (raytree.scene_hash)",
+                name(i)
+            );
+        }
+        if (r.width, r.height) != (part.width, part.height)
+            || u64::from(r.x) + u64::from(r.width) > u64::from(w)
+            || u64::from(r.y) + u64::from(r.height) > u64::from(h)
+            || r.width == 0
+            || r.height == 0
+        {
+            bail!(
+                "{} is {}x{} pixels but its stamp says region {} of a {w}x{h} image; the part is \
+                 damaged or edited",
+                name(i),
+                part.width,
+                part.height,
+                export::format_region(r)
+            );
+        }
+        if i > 0 {
+            let first = &parts[0];
+            let (fw, fh) = size.unwrap_or((w, h));
+            if (w, h) != (fw, fh) {
+                bail!(
+                    "{} is part of a {w}x{h} image but {} of a {fw}x{fh} one: parts of different \
+                     renders cannot be merged",
+                    name(i),
+                    name(0)
+                );
+            }
+            if std::mem::discriminant(&part.pixels) != std::mem::discriminant(&first.pixels) {
+                bail!(
+                    "{} is not of the same kind (PNG or EXR) as {}: merge parts of one kind",
+                    name(i),
+                    name(0)
+                );
+            }
+            for (key, what) in MUST_AGREE {
+                if part.get(key) != first.get(key) {
+                    bail!(
+                        "{} was rendered with a different {what} than {} ({key} `{}` vs `{}`): \
+                         parts of different renders cannot be merged",
+                        name(i),
+                        name(0),
+                        part.get(key).unwrap_or("none"),
+                        first.get(key).unwrap_or("none")
+                    );
+                }
+            }
+        }
+        size = Some((w, h));
+    }
+    let (w, h) = size.unwrap_or((0, 0));
+    // Which part holds each pixel: a second claim is an overlap.
+    let mut owner: Vec<u32> = vec![u32::MAX; w as usize * h as usize];
+    for (i, part) in parts.iter().enumerate() {
+        let r = region_of(part);
+        for y in r.y..r.y + r.height {
+            for x in r.x..r.x + r.width {
+                let slot = &mut owner[(y * w + x) as usize];
+                if *slot != u32::MAX {
+                    let other = *slot as usize;
+                    if paths[other] == paths[i] {
+                        bail!("{} is given twice", name(i));
+                    }
+                    bail!(
+                        "{} overlaps {} at pixel ({x}, {y}): each pixel must come from exactly \
+                         one part",
+                        name(i),
+                        name(other)
+                    );
+                }
+                *slot = i as u32;
+            }
+        }
+    }
+    let missing: Vec<usize> = (0..owner.len()).filter(|&p| owner[p] == u32::MAX).collect();
+    if let (Some(&a), Some(&b)) = (missing.first(), missing.last()) {
+        let ys = (a as u32 / w, b as u32 / w);
+        let xs = missing
+            .iter()
+            .map(|&p| p as u32 % w)
+            .fold((u32::MAX, 0), |(lo, hi), x| (lo.min(x), hi.max(x)));
+        bail!(
+            "the parts leave {} of the {w}x{h} image's pixels uncovered, within x {}..{} and y \
+             {}..{} (the first at ({}, {})): a part is missing",
+            missing.len(),
+            xs.0,
+            xs.1 + 1,
+            ys.0,
+            ys.1 + 1,
+            a as u32 % w,
+            ys.0
+        );
+    }
+    Ok((w, h))
+}
