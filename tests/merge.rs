@@ -186,7 +186,11 @@ fn parts_that_do_not_make_one_image_are_refused() {
         .map(|i| render(d, &format!("t{i}.exr"), &["--tile", &format!("{i}/3")]))
         .collect();
     // A missing part.
-    refused(d, &[&t[0], &t[2]], "uncovered");
+    refused(
+        d,
+        &[&t[0], &t[2]],
+        "the parts leave 1940 of the 97x61 image's pixels uncovered, the first at (0, 20)",
+    );
     // A part given twice.
     refused(d, &[&t[0], &t[1], &t[1], &t[2]], "t1.exr is given twice");
     // Overlapping parts.
@@ -384,4 +388,26 @@ fn turntable_frames_are_numbered_and_turn_the_camera() {
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(!output.status.success());
     assert!(stderr.contains("--frame 4 does not exist"), "{stderr}");
+}
+
+#[test]
+fn a_grid_of_regions_merges_and_a_missing_corner_is_found() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let full = render(d, "full.exr", &[]);
+    let grid = ["0,0,50,30", "50,0,47,30", "0,30,50,31", "50,30,47,31"];
+    let parts: Vec<PathBuf> = grid
+        .iter()
+        .enumerate()
+        .map(|(i, r)| render(d, &format!("g{i}.exr"), &["--region", r]))
+        .collect();
+    let all: Vec<&Path> = parts.iter().map(PathBuf::as_path).collect();
+    let merged = merge(d, &all, "grid.exr");
+    assert!(linear(&read(&merged)) == linear(&read(&full)));
+    std::fs::remove_file(&merged).expect("remove");
+    refused(
+        d,
+        &all[..3],
+        "the parts leave 1457 of the 97x61 image's pixels uncovered, the first at (50, 30)",
+    );
 }

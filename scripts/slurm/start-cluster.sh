@@ -52,8 +52,8 @@ if [ -e "$dir/slurm.conf" ]; then
   echo "start-cluster: $dir already holds a cluster (slurm.conf); stop it with stop-cluster.sh or use a new folder" >&2
   exit 1
 fi
-# munged refuses folders that others may write to.
-chmod 0700 "$dir"
+# munged refuses folders that others may write to; others may pass through (the socket).
+chmod 0711 "$dir"
 mkdir -p "$dir/state" "$dir/spool"
 
 # A port nobody listens on (bash's /dev/tcp connect fails on a free port).

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Result, bail};
 use clap::Args;
 use raytree::export::{self, KEY_REGION, KEY_SCENE_HASH, Pixels, StampedImage};
-use raytree::render::Image;
+use raytree::render::{Image, Rect};
 
 #[derive(Args, Debug)]
 pub struct MergeArgs {
@@ -106,10 +106,10 @@ fn extension(path: &Path) -> Option<String> {
         .map(str::to_ascii_lowercase)
 }
 
-fn region_of(part: &StampedImage) -> raytree::render::Rect {
+fn region_of(part: &StampedImage) -> Rect {
     part.get(KEY_REGION)
         .and_then(export::parse_region)
-        .unwrap_or(raytree::render::Rect {
+        .unwrap_or(Rect {
             x: 0,
             y: 0,
             width: 0,
@@ -199,46 +199,66 @@ fn check_parts(paths: &[PathBuf], parts: &[StampedImage]) -> Result<(u32, u32)> 
         size = Some((w, h));
     }
     let (w, h) = size.unwrap_or((0, 0));
-    // Which part holds each pixel: a second claim is an overlap.
-    let mut owner: Vec<u32> = vec![u32::MAX; w as usize * h as usize];
-    for (i, part) in parts.iter().enumerate() {
-        let r = region_of(part);
-        for y in r.y..r.y + r.height {
-            for x in r.x..r.x + r.width {
-                let slot = &mut owner[(y * w + x) as usize];
-                if *slot != u32::MAX {
-                    let other = *slot as usize;
-                    if paths[other] == paths[i] {
-                        bail!("{} is given twice", name(i));
-                    }
+    // Rectangles, not pixels (a poster's pixel map would take gigabytes): no two may share a
+    // pixel, and then they cover the image once exactly when their areas add up to it.
+    let rects: Vec<Rect> = parts.iter().map(region_of).collect();
+    for (i, a) in rects.iter().enumerate() {
+        for (j, b) in rects.iter().enumerate().take(i) {
+            let (x0, y0) = (a.x.max(b.x), a.y.max(b.y));
+            let (x1, y1) = (
+                (a.x + a.width).min(b.x + b.width),
+                (a.y + a.height).min(b.y + b.height),
+            );
+            if x0 < x1 && y0 < y1 {
+                if paths[i] == paths[j] || a == b {
                     bail!(
-                        "{} overlaps {} at pixel ({x}, {y}): each pixel must come from exactly \
-                         one part",
+                        "{} is given twice (or is the same part as {})",
                         name(i),
-                        name(other)
+                        name(j)
                     );
                 }
-                *slot = i as u32;
+                bail!(
+                    "{} overlaps {} at pixel ({x0}, {y0}): each pixel must come from exactly \
+                     one part",
+                    name(i),
+                    name(j)
+                );
             }
         }
     }
-    let missing: Vec<usize> = (0..owner.len()).filter(|&p| owner[p] == u32::MAX).collect();
-    if let (Some(&a), Some(&b)) = (missing.first(), missing.last()) {
-        let ys = (a as u32 / w, b as u32 / w);
-        let xs = missing
-            .iter()
-            .map(|&p| p as u32 % w)
-            .fold((u32::MAX, 0), |(lo, hi), x| (lo.min(x), hi.max(x)));
+    let covered: u64 = rects
+        .iter()
+        .map(|r| u64::from(r.width) * u64::from(r.height))
+        .sum();
+    let total = u64::from(w) * u64::from(h);
+    if covered < total {
+        // The first uncovered pixel, row by row: the parts' spans on that row leave a gap.
+        let mut first = (0, 0);
+        'rows: for y in 0..h {
+            let mut spans: Vec<(u32, u32)> = rects
+                .iter()
+                .filter(|r| r.y <= y && y < r.y + r.height)
+                .map(|r| (r.x, r.x + r.width))
+                .collect();
+            spans.sort_unstable();
+            let mut x = 0;
+            for (lo, hi) in spans {
+                if lo > x {
+                    break;
+                }
+                x = x.max(hi);
+            }
+            if x < w {
+                first = (x, y);
+                break 'rows;
+            }
+        }
         bail!(
-            "the parts leave {} of the {w}x{h} image's pixels uncovered, within x {}..{} and y \
-             {}..{} (the first at ({}, {})): a part is missing",
-            missing.len(),
-            xs.0,
-            xs.1 + 1,
-            ys.0,
-            ys.1 + 1,
-            a as u32 % w,
-            ys.0
+            "the parts leave {} of the {w}x{h} image's pixels uncovered, the first at ({}, {}): \
+             a part is missing",
+            total - covered,
+            first.0,
+            first.1
         );
     }
     Ok((w, h))
