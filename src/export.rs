@@ -255,6 +255,89 @@ pub fn read_stamped(path: &Path) -> Result<StampedImage, ReadError> {
     }
 }
 
+/// An image's size, kind and stamp without its pixels (the file's header only): what
+/// `raytree merge` checks before it reads any part's pixels.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StampHeader {
+    pub width: u32,
+    pub height: u32,
+    /// True for an EXR (linear floats), false for a PNG (8-bit sRGB).
+    pub linear: bool,
+    pub text: Vec<(String, String)>,
+}
+
+impl StampHeader {
+    /// The stamp's value for `key`.
+    pub fn get(&self, key: &str) -> Option<&str> {
+        self.text
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.as_str())
+    }
+}
+
+/// Reads the header of a PNG or EXR: size, kind and stamp, not the pixels.
+pub fn read_stamp_header(path: &Path) -> Result<StampHeader, ReadError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("png") => {
+            let file = std::fs::File::open(path).map_err(|e| read_error(path, e))?;
+            let reader = png::Decoder::new(std::io::BufReader::new(file))
+                .read_info()
+                .map_err(|e| read_error(path, e))?;
+            let info = reader.info();
+            Ok(StampHeader {
+                width: info.width,
+                height: info.height,
+                linear: false,
+                text: info
+                    .uncompressed_latin1_text
+                    .iter()
+                    .map(|c| (c.keyword.clone(), c.text.clone()))
+                    .collect(),
+            })
+        }
+        Some("exr") => {
+            let meta = exr::meta::MetaData::read_from_file(path, false)
+                .map_err(|e| read_error(path, e))?;
+            let header = meta
+                .headers
+                .first()
+                .ok_or_else(|| read_error(path, "it has no layer"))?;
+            Ok(StampHeader {
+                width: header.layer_size.width() as u32,
+                height: header.layer_size.height() as u32,
+                linear: true,
+                text: exr_stamp(path, &header.own_attributes)?,
+            })
+        }
+        _ => Err(read_error(path, "the file name must end in .png or .exr")),
+    }
+}
+
+/// The stamp in an EXR layer's attributes (empty when it has none).
+fn exr_stamp(
+    path: &Path,
+    attributes: &exr::meta::header::LayerAttributes,
+) -> Result<Vec<(String, String)>, ReadError> {
+    match attributes
+        .other
+        .get(&exr::meta::attribute::Text::from(EXR_STAMP_ATTRIBUTE))
+    {
+        Some(exr::meta::attribute::AttributeValue::Text(t)) => serde_json::from_str(&t.to_string())
+            .map_err(|e| {
+                read_error(
+                    path,
+                    format!("its {EXR_STAMP_ATTRIBUTE} attribute is not a stamp: {e}"),
+                )
+            }),
+        _ => Ok(Vec::new()),
+    }
+}
+
 fn read_png(path: &Path) -> Result<StampedImage, ReadError> {
     let file = std::fs::File::open(path).map_err(|e| read_error(path, e))?;
     let decoder = png::Decoder::new(std::io::BufReader::new(file));
@@ -307,20 +390,7 @@ fn read_exr(path: &Path) -> Result<StampedImage, ReadError> {
         .map_err(|e| read_error(path, e))?;
     let layer = &image.layer_data;
     let (w, h) = (layer.size.width(), layer.size.height());
-    let text = match layer
-        .attributes
-        .other
-        .get(&exr::meta::attribute::Text::from(EXR_STAMP_ATTRIBUTE))
-    {
-        Some(exr::meta::attribute::AttributeValue::Text(t)) => serde_json::from_str(&t.to_string())
-            .map_err(|e| {
-                read_error(
-                    path,
-                    format!("its {EXR_STAMP_ATTRIBUTE} attribute is not a stamp: {e}"),
-                )
-            })?,
-        _ => Vec::new(),
-    };
+    let text = exr_stamp(path, &layer.attributes)?;
     Ok(StampedImage {
         width: w as u32,
         height: h as u32,

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 use clap::Args;
-use raytree::export::{self, KEY_REGION, KEY_SCENE_HASH, Pixels, StampedImage};
+use raytree::export::{self, KEY_REGION, KEY_SCENE_HASH, Pixels, StampHeader};
 use raytree::render::{Image, Rect};
 
 #[derive(Args, Debug)]
@@ -38,13 +38,14 @@ pub fn run_merge(args: &MergeArgs) -> Result<()> {
             args.output.display()
         );
     }
+    // Headers first: nothing is decoded until every part is known to fit.
     let mut parts = Vec::with_capacity(args.parts.len());
     for path in &args.parts {
-        parts.push(export::read_stamped(path)?);
+        parts.push(export::read_stamp_header(path)?);
     }
     let (width, height) = check_parts(&args.parts, &parts)?;
     let first = &parts[0];
-    let linear = matches!(first.pixels, Pixels::Linear(_));
+    let linear = first.linear;
     if out_ext.as_deref() == Some("exr") && !linear {
         bail!(
             "cannot write {}: the parts are 8-bit PNGs, and an EXR needs the linear float pixels \
@@ -65,31 +66,44 @@ pub fn run_merge(args: &MergeArgs) -> Result<()> {
             }
         })
         .collect();
-    if linear {
-        let mut image = Image::new(width, height);
-        for part in &parts {
-            let (r, Pixels::Linear(px)) = (region_of(part), &part.pixels) else {
-                continue;
-            };
-            for j in 0..r.height {
-                let src = (j * r.width) as usize..((j + 1) * r.width) as usize;
-                let at = ((r.y + j) * width + r.x) as usize;
-                image.pixels[at..at + r.width as usize].copy_from_slice(&px[src]);
-            }
+    // Then each part's pixels in turn, copied into place and dropped.
+    let (iw, ih) = if linear { (width, height) } else { (0, 0) };
+    let mut image = Image::new(iw, ih);
+    let mut bytes = vec![
+        0u8;
+        if linear {
+            0
+        } else {
+            width as usize * height as usize * 3
         }
+    ];
+    for (path, header) in args.parts.iter().zip(&parts) {
+        let part = export::read_stamped(path)?;
+        let r = region_of(header);
+        if (part.width, part.height) != (r.width, r.height) {
+            bail!("{} changed while it was being merged", path.display());
+        }
+        match &part.pixels {
+            Pixels::Linear(px) => {
+                let w = r.width as usize;
+                for j in 0..r.height as usize {
+                    let at = (r.y as usize + j) * width as usize + r.x as usize;
+                    image.pixels[at..at + w].copy_from_slice(&px[j * w..(j + 1) * w]);
+                }
+            }
+            Pixels::Srgb8(px) if !linear => {
+                let row = r.width as usize * 3;
+                for j in 0..r.height as usize {
+                    let at = ((r.y as usize + j) * width as usize + r.x as usize) * 3;
+                    bytes[at..at + row].copy_from_slice(&px[j * row..(j + 1) * row]);
+                }
+            }
+            Pixels::Srgb8(_) => bail!("{} changed while it was being merged", path.display()),
+        }
+    }
+    if linear {
         export::write_image(&args.output, &image, &text)?;
     } else {
-        let mut bytes = vec![0u8; width as usize * height as usize * 3];
-        for part in &parts {
-            let (r, Pixels::Srgb8(px)) = (region_of(part), &part.pixels) else {
-                continue;
-            };
-            let row = r.width as usize * 3;
-            for j in 0..r.height as usize {
-                let at = ((r.y as usize + j) * width as usize + r.x as usize) * 3;
-                bytes[at..at + row].copy_from_slice(&px[j * row..(j + 1) * row]);
-            }
-        }
         export::write_png_rgb8(&args.output, width, height, &bytes, &text)?;
     }
     out!(
@@ -106,7 +120,7 @@ fn extension(path: &Path) -> Option<String> {
         .map(str::to_ascii_lowercase)
 }
 
-fn region_of(part: &StampedImage) -> Rect {
+fn region_of(part: &StampHeader) -> Rect {
     part.get(KEY_REGION)
         .and_then(export::parse_region)
         .unwrap_or(Rect {
@@ -118,7 +132,7 @@ fn region_of(part: &StampedImage) -> Rect {
 }
 
 /// The full image's size from a part's settings stamp.
-fn full_size(part: &StampedImage) -> Option<(u32, u32)> {
+fn full_size(part: &StampHeader) -> Option<(u32, u32)> {
     let settings: serde_json::Value = serde_json::from_str(part.get("raytree.settings")?).ok()?;
     let w = u32::try_from(settings.get("width")?.as_u64()?).ok()?;
     let h = u32::try_from(settings.get("height")?.as_u64()?).ok()?;
@@ -126,7 +140,7 @@ fn full_size(part: &StampedImage) -> Option<(u32, u32)> {
 }
 
 /// Checks that the parts belong together and cover the image once; returns its size.
-fn check_parts(paths: &[PathBuf], parts: &[StampedImage]) -> Result<(u32, u32)> {
+fn check_parts(paths: &[PathBuf], parts: &[StampHeader]) -> Result<(u32, u32)> {
     let name = |i: usize| paths[i].display().to_string();
     let mut size = None;
     for (i, part) in parts.iter().enumerate() {
@@ -176,7 +190,7 @@ fn check_parts(paths: &[PathBuf], parts: &[StampedImage]) -> Result<(u32, u32)> 
                     name(0)
                 );
             }
-            if std::mem::discriminant(&part.pixels) != std::mem::discriminant(&first.pixels) {
+            if part.linear != first.linear {
                 bail!(
                     "{} is not of the same kind (PNG or EXR) as {}: merge parts of one kind",
                     name(i),
