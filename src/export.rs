@@ -487,21 +487,18 @@ pub fn write_exr_stamped(
     let mut exr_image = exr::image::Image::from_channels((w, image.height as usize), channels);
     if !text.is_empty() {
         let json = serde_json::to_string(text).map_err(|e| export_error(path, e))?;
-        // EXR text is Latin-1: anything beyond it is escaped, so the JSON is plain ASCII.
-        let ascii: String = json
-            .chars()
-            .flat_map(|c| {
-                if c.is_ascii() {
-                    vec![c]
-                } else {
-                    let mut units = [0u16; 2];
-                    c.encode_utf16(&mut units)
-                        .iter()
-                        .flat_map(|u| format!("\\u{u:04x}").chars().collect::<Vec<_>>())
-                        .collect()
+        // EXR text is Latin-1: every non-ASCII character (only ever inside a JSON string) is
+        // written as its JSON escape, so the attribute is plain ASCII.
+        let mut ascii = String::with_capacity(json.len());
+        for c in json.chars() {
+            if c.is_ascii() {
+                ascii.push(c);
+            } else {
+                for unit in c.encode_utf16(&mut [0u16; 2]) {
+                    ascii += &format!("\\u{unit:04x}");
                 }
-            })
-            .collect();
+            }
+        }
         let value = exr::meta::attribute::Text::new_or_none(&ascii)
             .ok_or_else(|| export_error(path, "the stamp is not plain text"))?;
         exr_image.layer_data.attributes.other.insert(
@@ -606,6 +603,49 @@ mod tests {
             "IO error: File too large"
         );
         assert_eq!(plain_reason("simulated failure"), "simulated failure");
+    }
+
+    #[test]
+    fn stamps_read_back_from_exr_and_png_even_beyond_latin1() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let mut image = Image::new(3, 2);
+        image.pixels[4] = Vec3::new(0.25, 1.5, -0.0);
+        let text = vec![
+            (
+                "raytree.scene".to_string(),
+                "scènes/☃ \"q\".toml".to_string(),
+            ),
+            (KEY_REGION.to_string(), "1,2,3,2".to_string()),
+        ];
+        let exr = dir.path().join("a.exr");
+        write_exr_stamped(&exr, &image, &text).expect("write exr");
+        let header = read_stamp_header(&exr).expect("exr header");
+        assert_eq!((header.width, header.height, header.linear), (3, 2, true));
+        assert_eq!(header.text, text);
+        let full = read_stamped(&exr).expect("exr");
+        assert_eq!(full.text, text);
+        assert_eq!(full.pixels, Pixels::Linear(image.pixels.clone()));
+        assert_eq!(
+            parse_region(full.get(KEY_REGION).expect("region")),
+            Some(Rect {
+                x: 1,
+                y: 2,
+                width: 3,
+                height: 2
+            })
+        );
+        // PNG text is Latin-1: the label's Latin-1 part survives.
+        let png = dir.path().join("a.png");
+        let latin = vec![("raytree.scene".to_string(), "scène".to_string())];
+        write_png(&png, &image, &latin).expect("write png");
+        let header = read_stamp_header(&png).expect("png header");
+        assert_eq!((header.width, header.height, header.linear), (3, 2, false));
+        assert_eq!(header.text, latin);
+        assert_eq!(
+            read_stamped(&png).expect("png").pixels,
+            Pixels::Srgb8(srgb8_bytes(&image))
+        );
+        assert!(read_stamp_header(&dir.path().join("a.jpg")).is_err());
     }
 
     #[test]
