@@ -8,8 +8,8 @@ use std::path::Path;
 use glam::Vec3;
 
 use crate::accel::AccelKind;
-use crate::render::Image;
-use crate::scene::RenderParams;
+use crate::render::{Image, Rect};
+use crate::scene::{RenderParams, Scene};
 use crate::trace::TraceSettings;
 
 /// A write that failed: one sentence naming the file.
@@ -128,6 +128,277 @@ pub fn stamp(
     ]
 }
 
+/// The stamp key of the scene's fingerprint ([`scene_hash`]).
+pub const KEY_SCENE_HASH: &str = "raytree.scene_hash";
+/// The stamp key of the pixels an image holds of the full image: `X,Y,W,H`.
+pub const KEY_REGION: &str = "raytree.region";
+/// The stamp key of a turntable frame: `I/N`.
+pub const KEY_FRAME: &str = "raytree.frame";
+
+/// A fingerprint of everything in the scene that shapes its pixels (render parameters, camera,
+/// lights, materials, objects, spheres, triangles; not the file's path nor its warnings): 16
+/// hex digits of a 64-bit FNV-1a hash. Parts of one render made on different machines from the
+/// same scene carry the same fingerprint.
+pub fn scene_hash(scene: &Scene) -> String {
+    struct Fnv(u64);
+    impl std::fmt::Write for Fnv {
+        fn write_str(&mut self, s: &str) -> std::fmt::Result {
+            for b in s.bytes() {
+                self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+            }
+            Ok(())
+        }
+    }
+    let mut h = Fnv(0xcbf2_9ce4_8422_2325);
+    // Debug prints floats exactly (the shortest text that reads back to the same value).
+    let _ = std::fmt::Write::write_fmt(
+        &mut h,
+        format_args!(
+            "{:?}{:?}{:?}{:?}{:?}{:?}{:?}",
+            scene.render,
+            scene.camera,
+            scene.lights,
+            scene.materials,
+            scene.objects,
+            scene.spheres,
+            scene.triangles
+        ),
+    );
+    format!("{:016x}", h.0)
+}
+
+/// `X,Y,W,H`, as `--region` takes it and [`KEY_REGION`] holds it.
+pub fn format_region(r: Rect) -> String {
+    format!("{},{},{},{}", r.x, r.y, r.width, r.height)
+}
+
+/// Reads `X,Y,W,H` (whole numbers); `None` when it is not that.
+pub fn parse_region(text: &str) -> Option<Rect> {
+    let v: Vec<u32> = text
+        .split(',')
+        .map(|p| p.trim().parse::<u32>())
+        .collect::<Result<_, _>>()
+        .ok()?;
+    match v[..] {
+        [x, y, width, height] => Some(Rect {
+            x,
+            y,
+            width,
+            height,
+        }),
+        _ => None,
+    }
+}
+
+/// The stamp entries that make an image a part of a larger render: the scene's fingerprint and
+/// the region it holds (the whole image for a single-machine render), after [`stamp`]'s.
+pub fn part_stamp(scene: &Scene, region: Rect) -> Vec<(String, String)> {
+    vec![
+        (KEY_SCENE_HASH.to_string(), scene_hash(scene)),
+        (KEY_REGION.to_string(), format_region(region)),
+    ]
+}
+
+/// The pixels of an image read back: 8-bit sRGB RGB bytes (PNG) or linear floats (EXR).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Pixels {
+    Srgb8(Vec<u8>),
+    Linear(Vec<Vec3>),
+}
+
+/// An image raytree wrote, read back with its stamp.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StampedImage {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Pixels,
+    /// The stamp, in the order written (empty when the file has none).
+    pub text: Vec<(String, String)>,
+}
+
+impl StampedImage {
+    /// The stamp's value for `key`.
+    pub fn get(&self, key: &str) -> Option<&str> {
+        self.text
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.as_str())
+    }
+}
+
+/// A read that failed: one sentence naming the file.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot read {path}: {reason}")]
+pub struct ReadError {
+    pub path: String,
+    pub reason: String,
+}
+
+fn read_error(path: &Path, reason: impl std::fmt::Display) -> ReadError {
+    ReadError {
+        path: path.display().to_string(),
+        reason: plain_reason(&reason.to_string()),
+    }
+}
+
+/// Reads a PNG (8-bit RGB, as raytree writes) or an EXR (RGB) with its stamp, by the
+/// extension of `path`.
+pub fn read_stamped(path: &Path) -> Result<StampedImage, ReadError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("png") => read_png(path),
+        Some("exr") => read_exr(path),
+        _ => Err(read_error(path, "the file name must end in .png or .exr")),
+    }
+}
+
+/// An image's size, kind and stamp without its pixels (the file's header only): what
+/// `raytree merge` checks before it reads any part's pixels.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StampHeader {
+    pub width: u32,
+    pub height: u32,
+    /// True for an EXR (linear floats), false for a PNG (8-bit sRGB).
+    pub linear: bool,
+    pub text: Vec<(String, String)>,
+}
+
+impl StampHeader {
+    /// The stamp's value for `key`.
+    pub fn get(&self, key: &str) -> Option<&str> {
+        self.text
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.as_str())
+    }
+}
+
+/// Reads the header of a PNG or EXR: size, kind and stamp, not the pixels.
+pub fn read_stamp_header(path: &Path) -> Result<StampHeader, ReadError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("png") => {
+            let file = std::fs::File::open(path).map_err(|e| read_error(path, e))?;
+            let reader = png::Decoder::new(std::io::BufReader::new(file))
+                .read_info()
+                .map_err(|e| read_error(path, e))?;
+            let info = reader.info();
+            Ok(StampHeader {
+                width: info.width,
+                height: info.height,
+                linear: false,
+                text: info
+                    .uncompressed_latin1_text
+                    .iter()
+                    .map(|c| (c.keyword.clone(), c.text.clone()))
+                    .collect(),
+            })
+        }
+        Some("exr") => {
+            let meta = exr::meta::MetaData::read_from_file(path, false)
+                .map_err(|e| read_error(path, e))?;
+            let header = meta
+                .headers
+                .first()
+                .ok_or_else(|| read_error(path, "it has no layer"))?;
+            Ok(StampHeader {
+                width: header.layer_size.width() as u32,
+                height: header.layer_size.height() as u32,
+                linear: true,
+                text: exr_stamp(path, &header.own_attributes)?,
+            })
+        }
+        _ => Err(read_error(path, "the file name must end in .png or .exr")),
+    }
+}
+
+/// The stamp in an EXR layer's attributes (empty when it has none).
+fn exr_stamp(
+    path: &Path,
+    attributes: &exr::meta::header::LayerAttributes,
+) -> Result<Vec<(String, String)>, ReadError> {
+    match attributes
+        .other
+        .get(&exr::meta::attribute::Text::from(EXR_STAMP_ATTRIBUTE))
+    {
+        Some(exr::meta::attribute::AttributeValue::Text(t)) => serde_json::from_str(&t.to_string())
+            .map_err(|e| {
+                read_error(
+                    path,
+                    format!("its {EXR_STAMP_ATTRIBUTE} attribute is not a stamp: {e}"),
+                )
+            }),
+        _ => Ok(Vec::new()),
+    }
+}
+
+fn read_png(path: &Path) -> Result<StampedImage, ReadError> {
+    let file = std::fs::File::open(path).map_err(|e| read_error(path, e))?;
+    let decoder = png::Decoder::new(std::io::BufReader::new(file));
+    let mut reader = decoder.read_info().map_err(|e| read_error(path, e))?;
+    let size = reader
+        .output_buffer_size()
+        .ok_or_else(|| read_error(path, "the image is too large"))?;
+    let mut buf = vec![0; size];
+    let info = reader
+        .next_frame(&mut buf)
+        .map_err(|e| read_error(path, e))?;
+    if info.color_type != png::ColorType::Rgb || info.bit_depth != png::BitDepth::Eight {
+        return Err(read_error(
+            path,
+            format!(
+                "it is {:?} at {:?} bits, not the 8-bit RGB raytree writes",
+                info.color_type, info.bit_depth
+            ),
+        ));
+    }
+    buf.truncate(info.line_size * info.height as usize);
+    let text = reader
+        .info()
+        .uncompressed_latin1_text
+        .iter()
+        .map(|c| (c.keyword.clone(), c.text.clone()))
+        .collect();
+    Ok(StampedImage {
+        width: info.width,
+        height: info.height,
+        pixels: Pixels::Srgb8(buf),
+        text,
+    })
+}
+
+fn read_exr(path: &Path) -> Result<StampedImage, ReadError> {
+    use exr::prelude::*;
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .rgb_channels(
+            |size, _| (size.width(), vec![Vec3::ZERO; size.width() * size.height()]),
+            |(w, px): &mut (usize, Vec<Vec3>), Vec2(x, y), (r, g, b): (f32, f32, f32)| {
+                px[y * *w + x] = Vec3::new(r, g, b);
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| read_error(path, e))?;
+    let layer = &image.layer_data;
+    let (w, h) = (layer.size.width(), layer.size.height());
+    let text = exr_stamp(path, &layer.attributes)?;
+    Ok(StampedImage {
+        width: w as u32,
+        height: h as u32,
+        pixels: Pixels::Linear(layer.channel_data.pixels.1.clone()),
+        text,
+    })
+}
+
 /// Writes an 8-bit sRGB PNG with `text` as `tEXt` chunks (keyword, value).
 pub fn write_png(path: &Path, image: &Image, text: &[(String, String)]) -> Result<(), ExportError> {
     let bytes = srgb8_bytes(image);
@@ -139,6 +410,18 @@ pub fn write_png(path: &Path, image: &Image, text: &[(String, String)]) -> Resul
         &bytes,
         text,
     )
+}
+
+/// Writes 8-bit sRGB RGB bytes (row-major) as a PNG with `text`, exactly as [`write_png`]
+/// writes an image: `raytree merge` assembles PNG parts through here.
+pub fn write_png_rgb8(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[u8],
+    text: &[(String, String)],
+) -> Result<(), ExportError> {
+    encode_png(path, width, height, png::ColorType::Rgb, rgb, text)
 }
 
 /// Writes 8-bit sRGB RGBA pixels (row-major, straight alpha) as a PNG with `text`, like
@@ -179,15 +462,50 @@ fn encode_png(
     })
 }
 
+/// The EXR header attribute that holds the stamp: the same (key, value) pairs as a PNG's text
+/// chunks, as a JSON array of pairs (one attribute, so the header's order never varies).
+pub const EXR_STAMP_ATTRIBUTE: &str = "raytree.stamp";
+
 /// Writes a linear 32-bit float RGB OpenEXR file.
 pub fn write_exr(path: &Path, image: &Image) -> Result<(), ExportError> {
+    write_exr_stamped(path, image, &[])
+}
+
+/// [`write_exr`] with `text` in the header attribute [`EXR_STAMP_ATTRIBUTE`] (none when
+/// `text` is empty).
+pub fn write_exr_stamped(
+    path: &Path,
+    image: &Image,
+    text: &[(String, String)],
+) -> Result<(), ExportError> {
     use exr::prelude::*;
     let w = image.width as usize;
     let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
         let c = image.pixels[y * w + x];
         (c.x, c.y, c.z)
     });
-    let exr_image = exr::image::Image::from_channels((w, image.height as usize), channels);
+    let mut exr_image = exr::image::Image::from_channels((w, image.height as usize), channels);
+    if !text.is_empty() {
+        let json = serde_json::to_string(text).map_err(|e| export_error(path, e))?;
+        // EXR text is Latin-1: every non-ASCII character (only ever inside a JSON string) is
+        // written as its JSON escape, so the attribute is plain ASCII.
+        let mut ascii = String::with_capacity(json.len());
+        for c in json.chars() {
+            if c.is_ascii() {
+                ascii.push(c);
+            } else {
+                for unit in c.encode_utf16(&mut [0u16; 2]) {
+                    ascii += &format!("\\u{unit:04x}");
+                }
+            }
+        }
+        let value = exr::meta::attribute::Text::new_or_none(&ascii)
+            .ok_or_else(|| export_error(path, "the stamp is not plain text"))?;
+        exr_image.layer_data.attributes.other.insert(
+            exr::meta::attribute::Text::from(EXR_STAMP_ATTRIBUTE),
+            exr::meta::attribute::AttributeValue::Text(value),
+        );
+    }
     write_atomically(path, |out| {
         let mut cursor = std::io::Cursor::new(Vec::new());
         exr_image
@@ -210,7 +528,7 @@ pub fn write_image(
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
         Some("png") => write_png(path, image, text),
-        Some("exr") => write_exr(path, image),
+        Some("exr") => write_exr_stamped(path, image, text),
         _ => Err(export_error(
             path,
             "the file name must end in .png (8-bit sRGB) or .exr (linear float)",
@@ -285,6 +603,49 @@ mod tests {
             "IO error: File too large"
         );
         assert_eq!(plain_reason("simulated failure"), "simulated failure");
+    }
+
+    #[test]
+    fn stamps_read_back_from_exr_and_png_even_beyond_latin1() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let mut image = Image::new(3, 2);
+        image.pixels[4] = Vec3::new(0.25, 1.5, -0.0);
+        let text = vec![
+            (
+                "raytree.scene".to_string(),
+                "scènes/☃ \"q\".toml".to_string(),
+            ),
+            (KEY_REGION.to_string(), "1,2,3,2".to_string()),
+        ];
+        let exr = dir.path().join("a.exr");
+        write_exr_stamped(&exr, &image, &text).expect("write exr");
+        let header = read_stamp_header(&exr).expect("exr header");
+        assert_eq!((header.width, header.height, header.linear), (3, 2, true));
+        assert_eq!(header.text, text);
+        let full = read_stamped(&exr).expect("exr");
+        assert_eq!(full.text, text);
+        assert_eq!(full.pixels, Pixels::Linear(image.pixels.clone()));
+        assert_eq!(
+            parse_region(full.get(KEY_REGION).expect("region")),
+            Some(Rect {
+                x: 1,
+                y: 2,
+                width: 3,
+                height: 2
+            })
+        );
+        // PNG text is Latin-1: the label's Latin-1 part survives.
+        let png = dir.path().join("a.png");
+        let latin = vec![("raytree.scene".to_string(), "scène".to_string())];
+        write_png(&png, &image, &latin).expect("write png");
+        let header = read_stamp_header(&png).expect("png header");
+        assert_eq!((header.width, header.height, header.linear), (3, 2, false));
+        assert_eq!(header.text, latin);
+        assert_eq!(
+            read_stamped(&png).expect("png").pixels,
+            Pixels::Srgb8(srgb8_bytes(&image))
+        );
+        assert!(read_stamp_header(&dir.path().join("a.jpg")).is_err());
     }
 
     #[test]

@@ -1,5 +1,5 @@
 //! The `raytree` command: parse, call the library, print one-line errors, set the exit code.
-//! The subcommands live in [`cli`]: `render`, `tree`, `scenes`, and with the `lab` feature
+//! The subcommands live in [`cli`]: `render`, `merge`, `tree`, `scenes`, and with the `lab` feature
 //! `bench` and `stability`; without a subcommand, the viewer (feature `viewer`).
 
 #[macro_use]
@@ -13,6 +13,7 @@ use anyhow::bail;
 use clap::{Parser, Subcommand};
 #[cfg(feature = "lab")]
 use cli::lab::{BenchArgs, StabilityArgs, run_bench, run_stability};
+use cli::merge::{MergeArgs, run_merge};
 use cli::render::{RenderArgs, run_render};
 use cli::tree::{TreeArgs, run_tree};
 use raytree::scene;
@@ -34,6 +35,9 @@ struct Cli {
 enum Command {
     /// Render a scene to an image file, with a progress bar and statistics.
     Render(RenderArgs),
+    /// Put the parts of a render spread over machines (`render --region` or `--tile`) back
+    /// into one image, after checking they are of one render and cover it exactly once.
+    Merge(MergeArgs),
     /// Print the ray tracing tree of one pixel's centre sample.
     Tree(TreeArgs),
     #[cfg(feature = "lab")]
@@ -52,6 +56,7 @@ enum Command {
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Some(Command::Render(args)) => run_render(&args),
+        Some(Command::Merge(args)) => run_merge(&args),
         Some(Command::Tree(args)) => run_tree(&args),
         #[cfg(feature = "lab")]
         Some(Command::Bench(args)) => run_bench(&args),

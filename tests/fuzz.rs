@@ -727,6 +727,15 @@ fn flag() -> impl Strategy<Value = Vec<String>> {
         with("--shading", &["phong", "blinn-phong"], &["gouraud"]),
         with("--stats-json", &["OUT/s.json"], &["OUT/no/s.json", "OUT"]),
         with("--frames", &["1", "2"], &["0", "1001", "x"]),
+        with(
+            "--region",
+            &["0,0,1,1", "0,1,2,2"],
+            &["0,0,0,1", "99999,0,1,1", "1,2,3"]
+        ),
+        with("--tile", &["0/1", "0/2", "1/2"], &["2/2", "0/0", "x", "1"]),
+        with("--turntable", &["1", "3"], &["0", "x"]),
+        with("--frame", &["0", "1"], &["-1", "x"]),
+        with("--frame-range", &["0..1", "1..3"], &["1..1", "2..1", "x"]),
         pick(&["--bogus", "-", "--", "-x", "--help"]).prop_map(|f| vec![f]),
     ]
 }

@@ -2,6 +2,7 @@
 //! that accumulates samples in a fixed order per pixel (so the result never depends on the
 //! thread count or the tile order), and statistics.
 
+pub mod region;
 pub mod session;
 pub mod stats;
 
