@@ -735,9 +735,12 @@ impl eframe::App for ViewerApp {
         panels::help_window(&ctx, &mut self.show_help);
         panels::export_window(self, &ctx);
         if self.sweep.open
-            && let Some(point) = self.sweep.show(&ctx, &self.scene)
+            && let Some(point) = self.sweep.show(&ctx, &self.scene, &self.settings.trace)
         {
-            // A clicked point: its settings become the viewer's.
+            // A clicked point: its settings become the viewer's; say what changed.
+            if let Some(text) = self.sweep.applied.clone() {
+                self.messages.push((false, text));
+            }
             self.edit.render.max_depth = point.max_depth;
             self.edit.render.samples = point.samples;
             self.settings.trace = point.trace;
