@@ -15,8 +15,8 @@ use crate::scene::CameraFrame;
 use crate::scene_view::Filter;
 
 impl ViewerApp {
-    /// Export (Ctrl+S), open (Ctrl+O), help (F1), stop (Escape) and a file dropped on the
-    /// window.
+    /// Export (Ctrl+S), open (Ctrl+O), help (F1), stop (Escape), undo (Ctrl+Z), redo
+    /// (Ctrl+Shift+Z, Ctrl+Y), reset the camera (Home) and a file dropped on the window.
     pub(super) fn shortcuts(&mut self, ctx: &egui::Context) {
         use egui::{Key, KeyboardShortcut, Modifiers};
         let save = KeyboardShortcut::new(Modifiers::COMMAND, Key::S);
@@ -29,6 +29,30 @@ impl ViewerApp {
                 i.consume_key(Modifiers::NONE, Key::Escape),
             )
         });
+        // A text field being typed in keeps its own Ctrl+Z and Home.
+        if !ctx.egui_wants_keyboard_input() {
+            let redo_shift = KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+            let redo_y = KeyboardShortcut::new(Modifiers::COMMAND, Key::Y);
+            let undo = KeyboardShortcut::new(Modifiers::COMMAND, Key::Z);
+            // Ctrl+Shift+Z first: the plain Ctrl+Z pattern would match it too.
+            let (redo, undo, home) = ctx.input_mut(|i| {
+                let redo = i.consume_shortcut(&redo_shift) | i.consume_shortcut(&redo_y);
+                (
+                    redo,
+                    i.consume_shortcut(&undo),
+                    i.consume_key(Modifiers::NONE, Key::Home),
+                )
+            });
+            if redo {
+                self.redo();
+            }
+            if undo {
+                self.undo();
+            }
+            if home {
+                self.reset_camera();
+            }
+        }
         if do_save {
             self.export_choice = true;
         }
@@ -144,7 +168,8 @@ impl ViewerApp {
         let delta = response.drag_delta();
         if delta != egui::Vec2::ZERO {
             if response.dragged_by(egui::PointerButton::Primary) {
-                self.edit.camera.orbit(delta.x * 0.01, delta.y * 0.01);
+                let (yaw, pitch) = orbit_angles(delta, size.x, self.prefs.orbit_degrees);
+                self.edit.camera.orbit(yaw, pitch);
                 self.pending.push(Command::MoveCamera);
             } else if response.dragged_by(egui::PointerButton::Secondary)
                 || response.dragged_by(egui::PointerButton::Middle)
@@ -160,5 +185,30 @@ impl ViewerApp {
                 self.pending.push(Command::MoveCamera);
             }
         }
+    }
+}
+
+/// The orbit (yaw, pitch in radians) of a drag by `delta` points over a view `width` points wide,
+/// turning `degrees` for a drag across the whole width (the same rate up and down), so the
+/// speed follows the view's size on screen.
+pub fn orbit_angles(delta: egui::Vec2, width: f32, degrees: f32) -> (f32, f32) {
+    let per_point = degrees.to_radians() / width.max(1.0);
+    (delta.x * per_point, delta.y * per_point)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_drag_across_the_width_turns_the_set_angle() {
+        let (yaw, pitch) = orbit_angles(egui::vec2(640.0, 0.0), 640.0, 180.0);
+        assert!((yaw - std::f32::consts::PI).abs() < 1e-6);
+        assert_eq!(pitch, 0.0);
+        // A quarter of the width: a quarter of 180°.
+        let (yaw, _) = orbit_angles(egui::vec2(320.0, 0.0), 1280.0, 180.0);
+        assert!((yaw.to_degrees() - 45.0).abs() < 1e-4);
+        let (_, pitch) = orbit_angles(egui::vec2(0.0, -100.0), 400.0, 90.0);
+        assert!((pitch.to_degrees() + 22.5).abs() < 1e-4);
     }
 }

@@ -14,6 +14,7 @@ mod panels;
 pub mod scene_pane;
 pub mod sweep;
 pub mod tree_view;
+pub mod undo;
 pub mod viewport;
 pub mod workspace;
 
@@ -47,6 +48,8 @@ pub struct Prefs {
     pub last_dir: Option<PathBuf>,
     /// The panes' arrangement (replaced by the default when unusable).
     pub layout: workspace::Layout,
+    /// Degrees the camera orbits for a drag across the whole image width.
+    pub orbit_degrees: f32,
 }
 
 impl Default for Prefs {
@@ -57,6 +60,7 @@ impl Default for Prefs {
             mode: ImageMode::Render,
             last_dir: None,
             layout: workspace::default_layout(),
+            orbit_degrees: 180.0,
         }
     }
 }
@@ -147,6 +151,8 @@ pub struct ViewerApp {
     max_side: u32,
     last_mode: ImageMode,
     pending: Vec<Command>,
+    /// Undo and redo of the edits ([`undo`]).
+    pub history: undo::History,
 }
 
 /// The most trees shown at once (the current one and the extra ones).
@@ -245,6 +251,7 @@ impl ViewerApp {
             max_side: max_side.max(1),
             last_mode: ImageMode::Render,
             pending: Vec::new(),
+            history: undo::History::default(),
         };
         for w in app.scene.warnings.clone() {
             app.messages.push((false, w));
@@ -589,6 +596,7 @@ impl ViewerApp {
         self.extra_trees.clear();
         self.tree_state = tree_view::TreeState::default();
         self.scene_view.unframe();
+        self.history = undo::History::default();
     }
 
     /// Writes the film at full resolution (never a window grab), stamped with its progress.
@@ -747,6 +755,7 @@ impl eframe::App for ViewerApp {
             self.pending.push(Command::Rebuild);
         }
         self.apply();
+        self.track_edits(&ctx);
         self.refresh_if_mode_changed();
         if !self.is_finished() || !self.scene_view.is_finished() {
             ctx.request_repaint();

@@ -383,7 +383,9 @@ pub fn scene_view_ui(app: &mut ViewerApp, ui: &mut Ui) {
     let delta = response.drag_delta();
     if delta != egui::Vec2::ZERO {
         if response.dragged_by(egui::PointerButton::Primary) {
-            app.scene_view.camera.orbit(delta.x * 0.01, delta.y * 0.01);
+            let (yaw, pitch) =
+                super::input::orbit_angles(delta, rect.width(), app.prefs.orbit_degrees);
+            app.scene_view.camera.orbit(yaw, pitch);
             restart = true;
         } else if response.dragged_by(egui::PointerButton::Secondary)
             || response.dragged_by(egui::PointerButton::Middle)
