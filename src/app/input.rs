@@ -10,7 +10,7 @@ use eframe::egui;
 use super::file_browser::{BrowseFor, FileBrowser};
 use super::paint3d::ScreenView;
 use super::viewport::{DisplayCallback, DisplayId};
-use super::{Command, ViewerApp, scene_pane};
+use super::{Command, ViewerApp, legend, scene_pane};
 use crate::scene::CameraFrame;
 use crate::scene_view::Filter;
 
@@ -83,9 +83,25 @@ impl ViewerApp {
             self.scene.render.width as f32,
             self.scene.render.height as f32,
         );
-        let avail = ui.available_rect_before_wrap();
+        let mut avail = ui.available_rect_before_wrap();
         if avail.width() < 1.0 || avail.height() < 1.0 {
             return; // a zero-area window: nothing to draw
+        }
+        // A mode that maps values to colours gets its scale in a strip beside the image.
+        let scale = super::modes::colour_scale(self.prefs.mode, self.scene.render.max_depth);
+        if let Some(scale) = &scale
+            && avail.width() > 3.0 * legend::SCALE_WIDTH
+        {
+            let strip = egui::Rect::from_min_max(
+                egui::pos2(avail.max.x - legend::SCALE_WIDTH, avail.min.y),
+                avail.max,
+            );
+            avail.max.x = strip.min.x;
+            let height = strip.height() * 0.6;
+            ui.scope_builder(
+                egui::UiBuilder::new().max_rect(strip.shrink2(egui::vec2(4.0, 8.0))),
+                |ui| legend::colour_scale_ui(ui, scale, height),
+            );
         }
         let scale = (avail.width() / w).min(avail.height() / h);
         let size = egui::vec2(w * scale, h * scale);
@@ -120,6 +136,7 @@ impl ViewerApp {
             };
             let depth = self.film.depth();
             let drawn = scene_pane::draw_trees(self, &ui.painter_at(rect), &view, &depth, &filter);
+            legend::ray_key(&ui.painter_at(rect), rect);
             scene_pane::pick_and_hover_only(self, &response, &drawn);
         }
         let to_pixel = |p: egui::Pos2| {

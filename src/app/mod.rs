@@ -8,6 +8,7 @@
 mod file_browser;
 mod film;
 mod input;
+mod legend;
 pub mod modes;
 mod paint3d;
 mod panels;

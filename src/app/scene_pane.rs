@@ -462,6 +462,9 @@ pub fn scene_view_ui(app: &mut ViewerApp, ui: &mut Ui) {
         ..app.scene_view.filter.clone()
     };
     let drawn = draw_trees(app, &painter, &view, &depth, &filter);
+    if app.tree.is_some() {
+        super::legend::ray_key(&painter, rect);
+    }
     pick_and_hover(app, &response, &drawn);
     app.scene_view.drawn = drawn;
     if app.tree.is_none() {
