@@ -41,7 +41,8 @@ pub fn colour_scale_ui(ui: &mut Ui, scale: &ColourScale, height: f32) {
                     format!("colour scale: {title} from {lo} to {hi}"),
                 )
             });
-            let bar = Rect::from_min_size(rect.min + Vec2::new(2.0, 6.0), Vec2::new(18.0, h - 12.0));
+            let bar =
+                Rect::from_min_size(rect.min + Vec2::new(2.0, 6.0), Vec2::new(18.0, h - 12.0));
             let painter = ui.painter_at(rect);
             // The ramp from the bottom (low) to the top (high), in thin bands.
             let bands = 64;
@@ -96,7 +97,10 @@ pub fn colour_scale_ui(ui: &mut Ui, scale: &ColourScale, height: f32) {
                         Stroke::new(1.0, Color32::from_gray(120)),
                         egui::StrokeKind::Outside,
                     );
-                    ui.add(egui::Label::new(egui::RichText::new(label).text_style(small.clone())).wrap());
+                    ui.add(
+                        egui::Label::new(egui::RichText::new(label).text_style(small.clone()))
+                            .wrap(),
+                    );
                 });
             }
             ui.add(egui::Label::new(egui::RichText::new(*note).text_style(small)).wrap());
@@ -153,10 +157,7 @@ pub fn ray_key(painter: &egui::Painter, rect: Rect) {
     if rect.width() < size.x * 2.0 || rect.height() < size.y * 2.0 {
         return; // too small a view: the key would hide it
     }
-    let area = Rect::from_min_size(
-        Pos2::new(rect.min.x + 6.0, rect.max.y - size.y - 6.0),
-        size,
-    );
+    let area = Rect::from_min_size(Pos2::new(rect.min.x + 6.0, rect.max.y - size.y - 6.0), size);
     painter.rect_filled(area, 4.0, Color32::from_rgba_unmultiplied(25, 25, 25, 200));
     let font = egui::FontId::proportional(11.0);
     for (i, e) in entries.iter().enumerate() {
@@ -179,7 +180,13 @@ mod tests {
     #[test]
     fn the_key_has_the_three_rays_and_both_shadow_outcomes() {
         let labels: Vec<&str> = key_entries().iter().map(key_label).collect();
-        for want in ["primary", "reflected", "refracted", "shadow: lit", "shadow: blocked"] {
+        for want in [
+            "primary",
+            "reflected",
+            "refracted",
+            "shadow: lit",
+            "shadow: blocked",
+        ] {
             assert!(labels.contains(&want), "{want} missing from {labels:?}");
         }
         // The colours are the scene view's own.

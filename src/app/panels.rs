@@ -21,20 +21,24 @@ pub mod tips {
     pub const SHADING: &str = "The local illumination model at each hit: I = ka·Ia + Σ over lights (kd·(N·L) + ks·(specular)^n)·light colour. Phong: R·V; Blinn-Phong: N·H with the halfway vector H = normalize(L + V).";
     pub const BACKGROUND: &str = "The colour a ray gets when it meets nothing (termination condition: no intersection), including the primary ray of an empty pixel.";
     pub const AMBIENT_LIGHT: &str = "Ia: light that reaches every point from everywhere; multiplied by each material's ka. A point whose shadow rays are all blocked gets only this: I = ka·Ia.";
-    pub const SPHERE: &str = "How a ray is intersected with a sphere (solving the quadratic for t).";
-    pub const TRIANGLE: &str = "How a ray is intersected with a triangle (plane, then inside test).";
+    pub const SPHERE: &str =
+        "How a ray is intersected with a sphere (solving the quadratic for t).";
+    pub const TRIANGLE: &str =
+        "How a ray is intersected with a triangle (plane, then inside test).";
     pub const OFFSET: &str = "Secondary rays (shadow, reflected, refracted) start a little off the surface they leave, so they do not hit it again at t ≈ 0 (\"shadow acne\"). This picks how far.";
     pub const ACCEL: &str = "The structure that finds which objects a ray can hit without testing them all. Changes the speed, never the image.";
     pub const CUTOFF: &str = "Adaptive depth: a ray whose weight (the product of kr and kt down the tree) is below this is not traced, as it could barely change the pixel. 0 traces every ray down to max depth.";
     pub const THREADS: &str = "CPU threads rendering the image (0: all cores).";
     pub const EXPOSURE: &str = "Multiplies the image's colours before display (a display setting: the render does not change).";
-    pub const TONEMAP: &str = "How colours above 1 are shown: clamp cuts them, Reinhard and ACES roll them off smoothly.";
+    pub const TONEMAP: &str =
+        "How colours above 1 are shown: clamp cuts them, Reinhard and ACES roll them off smoothly.";
     pub const IMAGE_MODE: &str = "What the picture shows: the render, or per pixel what its ray tracing tree did (depth reached, how its rays ended, rays traced, the normal). A colour scale beside the image says what each colour means.";
     pub const POSITION: &str = "The eye: where primary rays start.";
     pub const LOOK_AT: &str = "The point at the centre of the image; the camera orbits about it.";
     pub const UP: &str = "Which way is up in the image.";
     pub const FOV: &str = "Vertical field of view: the angle the image spans from top to bottom.";
-    pub const ORBIT: &str = "How far a drag across the whole image turns the camera (the same rate up and down).";
+    pub const ORBIT: &str =
+        "How far a drag across the whole image turns the camera (the same rate up and down).";
     pub const LIGHT_POSITION: &str = "Where the point light is: shadow rays are shot from each hit towards it. Drag the light's marker in the scene view to move it.";
     pub const LIGHT_COLOUR: &str = "The light's colour and intensity: multiplies the diffuse and specular terms of every point it lights.";
     pub const LIGHT_RADIUS: &str = "0: a point light with hard shadows; larger: an area light whose shadow rays go to random points on it (soft shadows, needs more samples).";
@@ -43,7 +47,8 @@ pub mod tips {
     pub const KS: &str = "ks, specular coefficient: the strength of the highlight, ks·(R·V)^n or ks·(N·H)^n; only where the shadow ray reaches the light.";
     pub const KR: &str = "kr, reflectivity: how much of the reflected ray R's colour is added (local + kr·R). 0: no reflected ray is traced.";
     pub const KT: &str = "kt, transparency: how much of the refracted (transmitted) ray T's colour is added (local + kt·T). 0: no refracted ray is traced.";
-    pub const SHININESS: &str = "n, the specular exponent: larger makes a smaller, sharper highlight.";
+    pub const SHININESS: &str =
+        "n, the specular exponent: larger makes a smaller, sharper highlight.";
     pub const IOR: &str = "Index of refraction η of the material (air 1, water 1.33, glass 1.5): bends the refracted ray T by Snell's law, η_i·sin θ_i = η_r·sin θ_r.";
     pub const SCALAR: &str = "One number for all three channels (a grey coefficient): an edit changes R, G and B together. Off: R, G and B apart.";
 }
@@ -203,10 +208,7 @@ pub fn top_bar(app: &mut ViewerApp, ui: &mut Ui) {
                     app.redo();
                 }
                 ui.separator();
-                if ui
-                    .button("Reset camera to the scene's (Home)")
-                    .clicked()
-                {
+                if ui.button("Reset camera to the scene's (Home)").clicked() {
                     app.reset_camera();
                 }
             });
@@ -332,7 +334,12 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
             });
             restart |= combo(ui, "shading", &mut r.shading, tips::SHADING);
             restart |= color_edit(ui, "background", &mut r.background, tips::BACKGROUND);
-            restart |= color_edit(ui, "ambient light", &mut r.ambient_light, tips::AMBIENT_LIGHT);
+            restart |= color_edit(
+                ui,
+                "ambient light",
+                &mut r.ambient_light,
+                tips::AMBIENT_LIGHT,
+            );
             let t = &mut app.settings.trace;
             restart |= combo(ui, "sphere", &mut t.methods.sphere, tips::SPHERE);
             restart |= combo(ui, "triangle", &mut t.methods.triangle, tips::TRIANGLE);
@@ -405,7 +412,9 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                 }
                 if ui
                     .button("Reset to the scene's")
-                    .on_hover_text("the camera as the scene file placed it (Home); undo with Ctrl+Z")
+                    .on_hover_text(
+                        "the camera as the scene file placed it (Home); undo with Ctrl+Z",
+                    )
                     .clicked()
                 {
                     app.reset_camera();
