@@ -366,7 +366,7 @@ impl SweepWindow {
             ui.label("Renders the scene once per setting of each knob and plots error (mean FLIP against a converged reference) against time. Click a point to use its settings.");
             return None;
         };
-        ui.label("Error against time per image, both on log scales; the white staircase is the Pareto front (no other setting is both faster and more accurate). Hover a point for its setting, click it to apply it.");
+        ui.label("Error against time per image, both on log scales; the white staircase is the Pareto front (no other setting is both faster and more accurate). Settings that show the scene's own image count once, at the median of their times (the diamond). Hover a point for its setting, click it to apply it.");
         let mut chosen = None;
         let label = |pos: &HoverPosition<'_>| -> Option<String> {
             match pos {
@@ -375,6 +375,18 @@ impl SweepWindow {
                     position,
                     ..
                 } => {
+                    if *plot_name == BASELINE_MARK {
+                        return Some(format!(
+                            "{} settings show the scene's own image;\nthey count once, at the median of their times:\ntime {}\nmean FLIP {}",
+                            report
+                                .points
+                                .iter()
+                                .filter(|p| crate::experiments::pareto::same_image(*p))
+                                .count(),
+                            format_secs(10f64.powf(position.x)),
+                            format_flip(10f64.powf(position.y))
+                        ));
+                    }
                     let hit = report.points.iter().find(|p| {
                         (plot_name == &p.knob.name() || *plot_name == "Pareto front")
                             && (log(p.secs) - position.x).abs() < 1e-9
@@ -422,10 +434,24 @@ impl SweepWindow {
                     }
                 }
                 let front: Vec<[f64; 2]> = front_points(report);
+                // No bands: egui_plot merges points of equal x (the staircase's risers) into a
+                // filled band, which drew the front as a wedge.
                 plot.line(
                     Line::new("Pareto front", PlotPoints::from(staircase(&front)))
-                        .color(Color32::WHITE),
+                        .color(Color32::WHITE)
+                        .allow_band(false),
                 );
+                // The settings that show the baseline's image stand on the front as one point at
+                // the median of their times: mark where.
+                if let Some(at) = baseline_mark(report) {
+                    plot.points(
+                        Points::new(BASELINE_MARK, PlotPoints::from(vec![at]))
+                            .shape(egui_plot::MarkerShape::Diamond)
+                            .filled(false)
+                            .radius(7.0)
+                            .color(Color32::WHITE),
+                    );
+                }
                 if plot.response().clicked()
                     && let Some(at) = plot.pointer_coordinate()
                 {
@@ -435,6 +461,23 @@ impl SweepWindow {
             });
         chosen
     }
+}
+
+/// The series of the baseline image's place on the front.
+const BASELINE_MARK: &str = "baseline image (median time)";
+
+/// Where the front places the settings that show the baseline's image, if they are on it.
+fn baseline_mark(report: &BenchReport) -> Option<[f64; 2]> {
+    report
+        .pareto_front()
+        .into_iter()
+        .find(|&i| crate::experiments::pareto::same_image(&report.points[i]))
+        .map(|i| {
+            [
+                log(report.front_secs(i)),
+                log(report.points[i].error.mean_flip),
+            ]
+        })
 }
 
 /// The front's points in plot coordinates, fastest first, each at the time the front ranks it by
