@@ -238,3 +238,35 @@ fn f1_lists_ray_colours_glyphs_and_the_built_in_scenes() {
     h.get_by_label_contains(&names);
     h.get_by_label_contains("Ctrl+Shift+Z");
 }
+
+#[test]
+fn dragging_a_light_in_the_scene_view_moves_it_as_one_undoable_step() {
+    let scene = small("default");
+    let mut h = harness(scene.clone());
+    settle(&mut h);
+    let rect = h.get_by_label("scene view").rect();
+    let view_camera = h.state().scene_view.camera.clone();
+    let frame =
+        raytree::scene::CameraFrame::new(&view_camera, rect.width() as u32, rect.height() as u32);
+    let at = |p: Vec3| {
+        frame
+            .project(p)
+            .map(|(x, y)| rect.min + egui::vec2(x, y))
+            .expect("the light is in view")
+    };
+    let light = scene.lights[0].position;
+    let from = at(light);
+    drag(&mut h, from, egui::vec2(60.0, 0.0));
+    let moved = h.state().scene().lights[0].position;
+    assert!(moved != light, "the light did not move");
+    // It followed the pointer: about 60 points to the right on screen.
+    let now = at(moved);
+    assert!(
+        (now.x - from.x - 60.0).abs() < 8.0 && (now.y - from.y).abs() < 8.0,
+        "the light went from {from:?} to {now:?}"
+    );
+    assert_eq!(h.state().scene_view.camera, view_camera, "the view orbited");
+    assert_eq!(h.state().history.undo_steps(), 1);
+    keys(&mut h, egui::Modifiers::COMMAND, egui::Key::Z);
+    assert!(*h.state().scene() == scene);
+}

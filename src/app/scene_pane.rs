@@ -381,7 +381,10 @@ pub fn scene_view_ui(app: &mut ViewerApp, ui: &mut Ui) {
     app.scene_view.size = size;
     // Camera moves: only this view's render restarts.
     let delta = response.drag_delta();
-    if delta != egui::Vec2::ZERO {
+    // A drag that starts on a light moves the light instead.
+    let camera = app.scene_view.camera.clone();
+    let light_drag = super::input::drag_light(app, ui, &response, &camera, rect);
+    if delta != egui::Vec2::ZERO && !light_drag {
         if response.dragged_by(egui::PointerButton::Primary) {
             let (yaw, pitch) =
                 super::input::orbit_angles(delta, rect.width(), app.prefs.orbit_degrees);
