@@ -383,11 +383,11 @@ pub fn scene_view_ui(app: &mut ViewerApp, ui: &mut Ui) {
     let delta = response.drag_delta();
     // A drag that starts on a light moves the light instead.
     let camera = app.scene_view.camera.clone();
-    let light_drag = super::input::drag_light(app, ui, &response, &camera, rect);
+    let light_drag = super::gesture::drag_light(app, ui, &response, &camera, rect);
     if delta != egui::Vec2::ZERO && !light_drag {
         if response.dragged_by(egui::PointerButton::Primary) {
             let (yaw, pitch) =
-                super::input::orbit_angles(delta, rect.width(), app.prefs.orbit_degrees);
+                super::gesture::orbit_angles(delta, rect.width(), app.prefs.orbit_degrees);
             app.scene_view.camera.orbit(yaw, pitch);
             restart = true;
         } else if response.dragged_by(egui::PointerButton::Secondary)
