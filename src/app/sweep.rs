@@ -76,7 +76,7 @@ pub fn format_flip(e: f64) -> String {
     } else if e < 1e-3 {
         format!("{e:.1e}")
     } else {
-        format!("{}", round3(e))
+        round3(e)
     }
 }
 
