@@ -90,17 +90,19 @@ impl ViewerApp {
         // A mode that maps values to colours gets its scale in a strip beside the image.
         let scale = super::modes::colour_scale(self.prefs.mode, self.scene.render.max_depth);
         if let Some(scale) = &scale
-            && avail.width() > 3.0 * legend::SCALE_WIDTH
+            && avail.width() > 2.0 * legend::SCALE_WIDTH
+            && avail.height() > 2.0 * legend::SCALE_HEIGHT
         {
-            let strip = egui::Rect::from_min_max(
-                egui::pos2(avail.max.x - legend::SCALE_WIDTH, avail.min.y),
-                avail.max,
-            );
-            avail.max.x = strip.min.x;
-            let height = strip.height() * 0.6;
+            let (image, strip, below) = legend::place_scale(avail, w, h);
+            avail = image;
+            let length = if below {
+                strip.width() * 0.8
+            } else {
+                strip.height() * 0.6
+            };
             ui.scope_builder(
-                egui::UiBuilder::new().max_rect(strip.shrink2(egui::vec2(4.0, 8.0))),
-                |ui| legend::colour_scale_ui(ui, scale, height),
+                egui::UiBuilder::new().max_rect(strip.shrink2(egui::vec2(4.0, 6.0))),
+                |ui| legend::colour_scale_ui(ui, scale, length, below),
             );
         }
         let scale = (avail.width() / w).min(avail.height() / h);
