@@ -58,13 +58,24 @@ fn keys(h: &mut Harness<'static, ViewerApp>, modifiers: egui::Modifiers, key: eg
 
 /// Drags from `from` by `by` with the primary button, in five moves.
 fn drag(h: &mut Harness<'static, ViewerApp>, from: egui::Pos2, by: egui::Vec2) {
+    drag_with(h, from, by, egui::Modifiers::NONE);
+}
+
+/// [`drag`] with `modifiers` held.
+fn drag_with(
+    h: &mut Harness<'static, ViewerApp>,
+    from: egui::Pos2,
+    by: egui::Vec2,
+    modifiers: egui::Modifiers,
+) {
+    h.event(egui::Event::ModifiersChanged(modifiers));
     h.hover_at(from);
     h.step();
     h.event(egui::Event::PointerButton {
         pos: from,
         button: egui::PointerButton::Primary,
         pressed: true,
-        modifiers: egui::Modifiers::NONE,
+        modifiers,
     });
     h.step();
     for i in 1..=5 {
@@ -75,9 +86,10 @@ fn drag(h: &mut Harness<'static, ViewerApp>, from: egui::Pos2, by: egui::Vec2) {
         pos: from + by,
         button: egui::PointerButton::Primary,
         pressed: false,
-        modifiers: egui::Modifiers::NONE,
+        modifiers,
     });
     h.step();
+    h.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
     h.step();
 }
 
@@ -288,6 +300,47 @@ fn dragging_a_light_in_the_scene_view_moves_it_as_one_undoable_step() {
     assert!(
         (now.x - from.x - 60.0).abs() < 8.0 && (now.y - from.y).abs() < 8.0,
         "the light went from {from:?} to {now:?}"
+    );
+    assert_eq!(h.state().scene_view.camera, view_camera, "the view orbited");
+    assert_eq!(h.state().history.undo_steps(), 1);
+    keys(&mut h, egui::Modifiers::COMMAND, egui::Key::Z);
+    assert!(*h.state().scene() == scene);
+}
+
+#[test]
+fn shift_dragging_a_sphere_in_the_scene_view_moves_it_as_one_undoable_step() {
+    let scene = small("default");
+    let mut h = harness(scene.clone());
+    settle(&mut h);
+    let rect = h.get_by_label("scene view").rect();
+    let view_camera = h.state().scene_view.camera.clone();
+    let frame =
+        raytree::scene::CameraFrame::new(&view_camera, rect.width() as u32, rect.height() as u32);
+    // The sphere nearest the view's camera whose centre is in view.
+    let (i, from) = scene
+        .spheres
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| {
+            frame
+                .project(s.center)
+                .map(|(x, y)| (i, rect.min + egui::vec2(x, y)))
+        })
+        .filter(|(_, p)| rect.shrink(40.0).contains(*p))
+        .min_by(|a, b| {
+            let d = |i: usize| (scene.spheres[i].center - view_camera.position).length();
+            d(a.0).total_cmp(&d(b.0))
+        })
+        .expect("a sphere in the scene view");
+    let found = raytree::app::gesture::sphere_at(&scene.spheres, &view_camera, rect, from);
+    assert_eq!(found, Some(i), "the ray through its centre meets it first");
+    drag_with(&mut h, from, egui::vec2(0.0, -40.0), egui::Modifiers::SHIFT);
+    let moved = h.state().scene().spheres[i].center;
+    assert!(moved != scene.spheres[i].center, "the sphere did not move");
+    let (_, y) = frame.project(moved).expect("in view");
+    assert!(
+        (rect.min.y + y - (from.y - 40.0)).abs() < 8.0,
+        "the sphere did not follow the pointer"
     );
     assert_eq!(h.state().scene_view.camera, view_camera, "the view orbited");
     assert_eq!(h.state().history.undo_steps(), 1);

@@ -64,6 +64,78 @@ pub fn drag_light(
     true
 }
 
+/// The sphere of `spheres` the ray through screen point `at` of a view seen through `camera`
+/// over `rect` meets first, if any.
+pub fn sphere_at(
+    spheres: &[crate::scene::Sphere],
+    camera: &crate::scene::Camera,
+    rect: egui::Rect,
+    at: egui::Pos2,
+) -> Option<usize> {
+    let (w, h) = (rect.width().max(1.0), rect.height().max(1.0));
+    let frame = CameraFrame::new(camera, w as u32, h as u32);
+    let ray = frame.ray(at.x - rect.min.x, at.y - rect.min.y);
+    let d = ray.dir.normalize_or(glam::Vec3::NEG_Z);
+    spheres
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| {
+            let oc = ray.origin - s.center;
+            let b = oc.dot(d);
+            let c = oc.length_squared() - s.radius * s.radius;
+            let disc = b * b - c;
+            if disc < 0.0 {
+                return None;
+            }
+            let t = -b - disc.sqrt();
+            let t = if t > 0.0 { t } else { -b + disc.sqrt() };
+            (t > 0.0).then_some((i, t))
+        })
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(i, _)| i)
+}
+
+/// Shift and a drag that starts on a sphere in a view seen through `camera` over `rect` moves
+/// the sphere in the plane facing the camera (the accelerator is rebuilt as it moves); returns
+/// whether the drag is the sphere's.
+pub fn drag_sphere(
+    app: &mut ViewerApp,
+    ui: &egui::Ui,
+    response: &egui::Response,
+    camera: &crate::scene::Camera,
+    rect: egui::Rect,
+) -> bool {
+    let key = response.id.with("dragged sphere");
+    if response.drag_started_by(egui::PointerButton::Primary) {
+        let shift = ui.input(|i| i.modifiers.shift);
+        let grabbed = ui
+            .input(|i| i.pointer.press_origin())
+            .filter(|_| shift)
+            .and_then(|origin| sphere_at(&app.edit.spheres, camera, rect, origin));
+        ui.data_mut(|d| match grabbed {
+            Some(i) => {
+                d.insert_temp(key, i);
+            }
+            None => d.remove::<usize>(key),
+        });
+    }
+    let Some(i) = ui.data(|d| d.get_temp::<usize>(key)) else {
+        return false;
+    };
+    if !response.dragged_by(egui::PointerButton::Primary) {
+        ui.data_mut(|d| d.remove::<usize>(key));
+        return response.drag_stopped();
+    }
+    let delta = response.drag_delta();
+    if let Some(sphere) = app.edit.spheres.get_mut(i)
+        && delta != egui::Vec2::ZERO
+    {
+        sphere.center += plane_move(camera, sphere.center, delta, rect.height());
+        app.pending.push(Command::Rebuild);
+    }
+    true
+}
+
 /// The world move of a point at `p` dragged by `delta` points in a view `height` points tall
 /// seen through `camera`: in the plane through `p` facing the camera, so the point stays under
 /// the pointer.

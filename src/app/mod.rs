@@ -7,7 +7,7 @@
 
 mod file_browser;
 mod film;
-mod gesture;
+pub mod gesture;
 mod input;
 mod legend;
 pub mod modes;

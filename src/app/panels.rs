@@ -680,6 +680,8 @@ pub fn help_window(ctx: &egui::Context, open: &mut bool) {
                         ("Click", "ray tree of that pixel; selects its material"),
                         ("Shift+click", "add that pixel's tree to the trees shown"),
                         ("Ctrl+drag", "trees of a grid of pixels in the rectangle"),
+                        ("Drag a light (scene view)", "move the light, facing the view"),
+                        ("Shift+drag a sphere (scene view)", "move the sphere, facing the view"),
                         ("Ctrl+Z", "undo the last edit (a whole drag is one edit)"),
                         ("Ctrl+Shift+Z, Ctrl+Y", "redo"),
                         ("Home", "reset the camera to the scene's"),

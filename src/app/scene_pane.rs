@@ -383,7 +383,8 @@ pub fn scene_view_ui(app: &mut ViewerApp, ui: &mut Ui) {
     let delta = response.drag_delta();
     // A drag that starts on a light moves the light instead.
     let camera = app.scene_view.camera.clone();
-    let light_drag = super::gesture::drag_light(app, ui, &response, &camera, rect);
+    let light_drag = super::gesture::drag_light(app, ui, &response, &camera, rect)
+        || super::gesture::drag_sphere(app, ui, &response, &camera, rect);
     if delta != egui::Vec2::ZERO && !light_drag {
         if response.dragged_by(egui::PointerButton::Primary) {
             let (yaw, pitch) =

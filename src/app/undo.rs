@@ -2,8 +2,8 @@
 //! "reset the camera to the scene's" (Home).
 //!
 //! The history keeps what the viewer can edit ([`Edits`]: render parameters, camera, lights,
-//! materials and trace settings), not the geometry, so a step costs a few hundred bytes even
-//! for a mesh of millions of triangles. It is watched once a frame, after the commands are
+//! materials, spheres (they can be dragged) and trace settings), not the triangles, so a step
+//! stays small even for a mesh of millions of triangles. It is watched once a frame, after the commands are
 //! applied: a change that the loader's rules refused never becomes a step, and a change made
 //! while a gesture is under way (a button held: a drag of a value, an orbit, the colour
 //! picker; the wheel still turning) becomes one step when the gesture ends.
@@ -11,7 +11,7 @@
 use eframe::egui;
 
 use super::{Command, ViewerApp};
-use crate::scene::{Camera, Light, Material, RenderParams, Scene};
+use crate::scene::{Camera, Light, Material, RenderParams, Scene, Sphere};
 use crate::trace::TraceSettings;
 
 /// The most steps kept; older ones are dropped.
@@ -24,6 +24,7 @@ pub struct Edits {
     pub camera: Camera,
     pub lights: Vec<Light>,
     pub materials: Vec<Material>,
+    pub spheres: Vec<Sphere>,
     pub trace: TraceSettings,
 }
 
@@ -34,6 +35,7 @@ impl Edits {
             camera: scene.camera.clone(),
             lights: scene.lights.clone(),
             materials: scene.materials.clone(),
+            spheres: scene.spheres.clone(),
             trace,
         }
     }
@@ -44,6 +46,7 @@ impl Edits {
         scene.camera = self.camera;
         scene.lights = self.lights;
         scene.materials = self.materials;
+        scene.spheres = self.spheres;
         *trace = self.trace;
     }
 }
@@ -136,8 +139,14 @@ impl ViewerApp {
     }
 
     fn restore(&mut self, to: Edits) {
+        // Moved spheres need the accelerator rebuilt.
+        let rebuild = to.spheres != self.edit.spheres;
         to.put(&mut self.edit, &mut self.settings.trace);
-        self.pending.push(Command::Restart);
+        self.pending.push(if rebuild {
+            Command::Rebuild
+        } else {
+            Command::Restart
+        });
     }
 
     /// Undoes the last edit; false when there is none.
