@@ -10,13 +10,13 @@ use eframe::egui;
 use super::file_browser::{BrowseFor, FileBrowser};
 use super::paint3d::ScreenView;
 use super::viewport::{DisplayCallback, DisplayId};
-use super::{Command, ViewerApp, scene_pane};
+use super::{Command, ViewerApp, gesture, legend, scene_pane};
 use crate::scene::CameraFrame;
 use crate::scene_view::Filter;
 
 impl ViewerApp {
-    /// Export (Ctrl+S), open (Ctrl+O), help (F1), stop (Escape) and a file dropped on the
-    /// window.
+    /// Export (Ctrl+S), open (Ctrl+O), help (F1), stop (Escape), undo (Ctrl+Z), redo
+    /// (Ctrl+Shift+Z, Ctrl+Y), reset the camera (Home) and a file dropped on the window.
     pub(super) fn shortcuts(&mut self, ctx: &egui::Context) {
         use egui::{Key, KeyboardShortcut, Modifiers};
         let save = KeyboardShortcut::new(Modifiers::COMMAND, Key::S);
@@ -29,6 +29,30 @@ impl ViewerApp {
                 i.consume_key(Modifiers::NONE, Key::Escape),
             )
         });
+        // A text field being typed in keeps its own Ctrl+Z and Home.
+        if !ctx.egui_wants_keyboard_input() {
+            let redo_shift = KeyboardShortcut::new(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+            let redo_y = KeyboardShortcut::new(Modifiers::COMMAND, Key::Y);
+            let undo = KeyboardShortcut::new(Modifiers::COMMAND, Key::Z);
+            // Ctrl+Shift+Z first: the plain Ctrl+Z pattern would match it too.
+            let (redo, undo, home) = ctx.input_mut(|i| {
+                let redo = i.consume_shortcut(&redo_shift) | i.consume_shortcut(&redo_y);
+                (
+                    redo,
+                    i.consume_shortcut(&undo),
+                    i.consume_key(Modifiers::NONE, Key::Home),
+                )
+            });
+            if redo {
+                self.redo();
+            }
+            if undo {
+                self.undo();
+            }
+            if home {
+                self.reset_camera();
+            }
+        }
         if do_save {
             self.export_choice = true;
         }
@@ -59,9 +83,27 @@ impl ViewerApp {
             self.scene.render.width as f32,
             self.scene.render.height as f32,
         );
-        let avail = ui.available_rect_before_wrap();
+        let mut avail = ui.available_rect_before_wrap();
         if avail.width() < 1.0 || avail.height() < 1.0 {
             return; // a zero-area window: nothing to draw
+        }
+        // A mode that maps values to colours gets its scale in a strip beside the image.
+        let scale = super::modes::colour_scale(self.prefs.mode, self.scene.render.max_depth);
+        if let Some(scale) = &scale
+            && avail.width() > 2.0 * legend::SCALE_WIDTH
+            && avail.height() > 2.0 * legend::SCALE_HEIGHT
+        {
+            let (image, strip, below) = legend::place_scale(avail, w, h);
+            avail = image;
+            let length = if below {
+                strip.width() * 0.8
+            } else {
+                strip.height() * 0.6
+            };
+            ui.scope_builder(
+                egui::UiBuilder::new().max_rect(strip.shrink2(egui::vec2(4.0, 6.0))),
+                |ui| legend::colour_scale_ui(ui, scale, length, below),
+            );
         }
         let scale = (avail.width() / w).min(avail.height() / h);
         let size = egui::vec2(w * scale, h * scale);
@@ -96,6 +138,7 @@ impl ViewerApp {
             };
             let depth = self.film.depth();
             let drawn = scene_pane::draw_trees(self, &ui.painter_at(rect), &view, &depth, &filter);
+            legend::ray_key(&ui.painter_at(rect), rect);
             scene_pane::pick_and_hover_only(self, &response, &drawn);
         }
         let to_pixel = |p: egui::Pos2| {
@@ -144,7 +187,8 @@ impl ViewerApp {
         let delta = response.drag_delta();
         if delta != egui::Vec2::ZERO {
             if response.dragged_by(egui::PointerButton::Primary) {
-                self.edit.camera.orbit(delta.x * 0.01, delta.y * 0.01);
+                let (yaw, pitch) = gesture::orbit_angles(delta, size.x, self.prefs.orbit_degrees);
+                self.edit.camera.orbit(yaw, pitch);
                 self.pending.push(Command::MoveCamera);
             } else if response.dragged_by(egui::PointerButton::Secondary)
                 || response.dragged_by(egui::PointerButton::Middle)

@@ -7,13 +7,16 @@
 
 mod file_browser;
 mod film;
+pub mod gesture;
 mod input;
+mod legend;
 pub mod modes;
 mod paint3d;
 mod panels;
 pub mod scene_pane;
 pub mod sweep;
 pub mod tree_view;
+pub mod undo;
 pub mod viewport;
 pub mod workspace;
 
@@ -47,6 +50,8 @@ pub struct Prefs {
     pub last_dir: Option<PathBuf>,
     /// The panes' arrangement (replaced by the default when unusable).
     pub layout: workspace::Layout,
+    /// Degrees the camera orbits for a drag across the whole image width.
+    pub orbit_degrees: f32,
 }
 
 impl Default for Prefs {
@@ -57,6 +62,7 @@ impl Default for Prefs {
             mode: ImageMode::Render,
             last_dir: None,
             layout: workspace::default_layout(),
+            orbit_degrees: 180.0,
         }
     }
 }
@@ -147,6 +153,8 @@ pub struct ViewerApp {
     max_side: u32,
     last_mode: ImageMode,
     pending: Vec<Command>,
+    /// Undo and redo of the edits ([`undo`]).
+    pub history: undo::History,
 }
 
 /// The most trees shown at once (the current one and the extra ones).
@@ -245,6 +253,7 @@ impl ViewerApp {
             max_side: max_side.max(1),
             last_mode: ImageMode::Render,
             pending: Vec::new(),
+            history: undo::History::default(),
         };
         for w in app.scene.warnings.clone() {
             app.messages.push((false, w));
@@ -589,6 +598,7 @@ impl ViewerApp {
         self.extra_trees.clear();
         self.tree_state = tree_view::TreeState::default();
         self.scene_view.unframe();
+        self.history = undo::History::default();
     }
 
     /// Writes the film at full resolution (never a window grab), stamped with its progress.
@@ -735,15 +745,19 @@ impl eframe::App for ViewerApp {
         panels::help_window(&ctx, &mut self.show_help);
         panels::export_window(self, &ctx);
         if self.sweep.open
-            && let Some(point) = self.sweep.show(&ctx, &self.scene)
+            && let Some(point) = self.sweep.show(&ctx, &self.scene, &self.settings.trace)
         {
-            // A clicked point: its settings become the viewer's.
+            // A clicked point: its settings become the viewer's; say what changed.
+            if let Some(text) = self.sweep.applied.clone() {
+                self.messages.push((false, text));
+            }
             self.edit.render.max_depth = point.max_depth;
             self.edit.render.samples = point.samples;
             self.settings.trace = point.trace;
             self.pending.push(Command::Rebuild);
         }
         self.apply();
+        self.track_edits(&ctx);
         self.refresh_if_mode_changed();
         if !self.is_finished() || !self.scene_view.is_finished() {
             ctx.request_repaint();

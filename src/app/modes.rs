@@ -54,7 +54,7 @@ fn srgb(r: u8, g: u8, b: u8) -> Vec3 {
 }
 
 /// A perceptual ramp (viridis stops) at `t` in [0, 1].
-fn ramp(t: f32) -> Vec3 {
+pub fn ramp(t: f32) -> Vec3 {
     const STOPS: [(u8, u8, u8); 5] = [
         (68, 1, 84),
         (59, 82, 139),
@@ -105,7 +105,7 @@ pub fn mode_color(mode: ImageMode, aux: &SampleInfo, max_depth: u32) -> Vec3 {
             let (r, g, b) = TERMINATION_LEGEND[pick].1;
             srgb(r, g, b)
         }
-        ImageMode::Cost => ramp((aux.rays.max(1) as f32).log2() / 8.0),
+        ImageMode::Cost => ramp((aux.rays.max(1) as f32).log2() / COST_OCTAVES as f32),
         ImageMode::Normals => {
             if aux.normal == Vec3::ZERO {
                 Vec3::ZERO
@@ -117,6 +117,95 @@ pub fn mode_color(mode: ImageMode, aux: &SampleInfo, max_depth: u32) -> Vec3 {
                     (c.z * 255.0) as u8,
                 )
             }
+        }
+    }
+}
+
+/// What a mode's colours mean, for the scale drawn beside the image: the one description
+/// the viewer's legend reads, made from the same functions that paint the pixels.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ColourScale {
+    /// A value mapped along [`ramp`]: `ticks` are (position in 0..=1, value as text), lowest
+    /// first; `units` says what the value counts.
+    Ramp {
+        title: &'static str,
+        units: &'static str,
+        ticks: Vec<(f32, String)>,
+    },
+    /// Named classes with their colours (linear).
+    Classes {
+        title: &'static str,
+        note: &'static str,
+        entries: Vec<(String, Vec3)>,
+    },
+}
+
+/// The most rays the cost ramp tells apart: 2^COST_OCTAVES (more are drawn at its top).
+pub const COST_OCTAVES: u32 = 8;
+
+/// The colour scale of `mode` at `max_depth`; `None` for the render itself.
+pub fn colour_scale(mode: ImageMode, max_depth: u32) -> Option<ColourScale> {
+    match mode {
+        ImageMode::Render => None,
+        ImageMode::Depth => {
+            let max = max_depth.max(1);
+            let step = max.div_ceil(8);
+            let mut ticks: Vec<(f32, String)> = (0..=max)
+                .step_by(step as usize)
+                .map(|d| (d as f32 / max as f32, d.to_string()))
+                .collect();
+            if ticks.last().map(|t| t.0) != Some(1.0) {
+                ticks.push((1.0, max.to_string()));
+            }
+            Some(ColourScale::Ramp {
+                title: "Depth reached",
+                units: "generations of rays below the primary (0: no reflected or refracted ray)",
+                ticks,
+            })
+        }
+        ImageMode::Cost => Some(ColourScale::Ramp {
+            title: "Cost",
+            units: "rays traced for the pixel's first sample, shadow rays included (log scale)",
+            ticks: (0..=COST_OCTAVES)
+                .map(|k| {
+                    let label = if k == COST_OCTAVES {
+                        format!("{}+", 1u32 << k)
+                    } else {
+                        (1u32 << k).to_string()
+                    };
+                    (k as f32 / COST_OCTAVES as f32, label)
+                })
+                .collect(),
+        }),
+        ImageMode::Termination => Some(ColourScale::Classes {
+            title: "Termination",
+            note: "how the pixel's rays ended; the first reason listed wins",
+            entries: TERMINATION_LEGEND
+                .iter()
+                .map(|(label, (r, g, b))| (label.to_string(), srgb(*r, *g, *b)))
+                .collect(),
+        }),
+        ImageMode::Normals => {
+            let at = |n: Vec3| {
+                let aux = SampleInfo {
+                    normal: n,
+                    ..SampleInfo::default()
+                };
+                mode_color(ImageMode::Normals, &aux, max_depth)
+            };
+            Some(ColourScale::Classes {
+                title: "Normals",
+                note: "colour = 0.5·N + 0.5 of the surface normal N at the primary hit (world axes)",
+                entries: vec![
+                    ("+x".to_string(), at(Vec3::X)),
+                    ("−x".to_string(), at(Vec3::NEG_X)),
+                    ("+y".to_string(), at(Vec3::Y)),
+                    ("−y".to_string(), at(Vec3::NEG_Y)),
+                    ("+z".to_string(), at(Vec3::Z)),
+                    ("−z".to_string(), at(Vec3::NEG_Z)),
+                    ("no hit".to_string(), Vec3::ZERO),
+                ],
+            })
         }
     }
 }
@@ -164,6 +253,40 @@ mod tests {
             TERMINATION_LEGEND.len(),
             "two reasons share a colour"
         );
+    }
+
+    /// The scale's ticks sit where the pixels of those values are painted.
+    #[test]
+    fn scales_match_the_painted_colours() {
+        for mode in ImageMode::ALL {
+            assert_eq!(colour_scale(mode, 5).is_none(), mode == ImageMode::Render);
+        }
+        let Some(ColourScale::Ramp { ticks, .. }) = colour_scale(ImageMode::Depth, 5) else {
+            panic!("depth has a ramp");
+        };
+        assert_eq!(ticks.len(), 6);
+        for (t, label) in ticks {
+            let aux = SampleInfo {
+                depth_reached: label.parse().expect("a number"),
+                ..SampleInfo::default()
+            };
+            assert_eq!(ramp(t), mode_color(ImageMode::Depth, &aux, 5), "{label}");
+        }
+        let Some(ColourScale::Ramp { ticks, .. }) = colour_scale(ImageMode::Cost, 5) else {
+            panic!("cost has a ramp");
+        };
+        let (t, label) = &ticks[4];
+        assert_eq!(label, "16");
+        let aux = SampleInfo {
+            rays: 16,
+            ..SampleInfo::default()
+        };
+        assert_eq!(ramp(*t), mode_color(ImageMode::Cost, &aux, 5));
+        // Deep trees: at most about nine ticks, the maximum always labelled.
+        let Some(ColourScale::Ramp { ticks, .. }) = colour_scale(ImageMode::Depth, 50) else {
+            panic!("depth has a ramp");
+        };
+        assert!(ticks.len() <= 10 && ticks.last().map(|t| t.1.as_str()) == Some("50"));
     }
 
     #[test]

@@ -5,64 +5,148 @@ use eframe::egui::{self, Color32, DragValue, RichText, Ui};
 use glam::Vec3;
 
 use super::file_browser::{BrowseFor, FileBrowser};
-use super::modes::{ImageMode, TERMINATION_LEGEND};
+use super::modes::ImageMode;
 use super::tree_view;
 use super::{Command, ViewerApp};
 use crate::choice::Choice;
 use crate::scene::{Light, Material, builtin, rules};
 
-// ---- small widgets ------------------------------------------------------------------------
+// ---- what each setting does, in the lecture's words ---------------------------------------
 
-/// A label and a drag value named by it (for screen readers and UI tests).
-fn drag(ui: &mut Ui, label: &str, value: DragValue<'_>) -> bool {
-    let l = ui.label(label);
-    ui.add(value).labelled_by(l.id).changed()
+/// Tooltips: what each setting does to the ray tracing tree and the illumination model.
+pub mod tips {
+    pub const MAX_DEPTH: &str = "Termination condition: the deepest ray traced. The primary ray from the eye is depth 0; every reflected (R) or refracted (T) ray is one deeper. A ray at max depth gets no children: its reflected and refracted parts are left out.";
+    pub const SAMPLES: &str = "Rays per pixel, spread over the pixel and averaged: more samples smooth the edges (anti-aliasing) and soft shadows, and cost that many times the work.";
+    pub const SIZE: &str = "Image size in pixels: one primary ray per pixel and sample (1024x768 shoots 786 432 primary rays per sample).";
+    pub const SHADING: &str = "The local illumination model at each hit: I = ka·Ia + Σ over lights (kd·(N·L) + ks·(specular)^n)·light colour. Phong: R·V; Blinn-Phong: N·H with the halfway vector H = normalize(L + V).";
+    pub const BACKGROUND: &str = "The colour a ray gets when it meets nothing (termination condition: no intersection), including the primary ray of an empty pixel.";
+    pub const AMBIENT_LIGHT: &str = "Ia: light that reaches every point from everywhere; multiplied by each material's ka. A point whose shadow rays are all blocked gets only this: I = ka·Ia.";
+    pub const SPHERE: &str =
+        "How a ray is intersected with a sphere (solving the quadratic for t).";
+    pub const TRIANGLE: &str =
+        "How a ray is intersected with a triangle (plane, then inside test).";
+    pub const OFFSET: &str = "Secondary rays (shadow, reflected, refracted) start a little off the surface they leave, so they do not hit it again at t ≈ 0 (\"shadow acne\"). This picks how far.";
+    pub const ACCEL: &str = "The structure that finds which objects a ray can hit without testing them all. Changes the speed, never the image.";
+    pub const CUTOFF: &str = "Adaptive depth: a ray whose weight (the product of kr and kt down the tree) is below this is not traced, as it could barely change the pixel. 0 traces every ray down to max depth.";
+    pub const THREADS: &str = "CPU threads rendering the image (0: all cores).";
+    pub const EXPOSURE: &str = "Multiplies the image's colours before display (a display setting: the render does not change).";
+    pub const TONEMAP: &str =
+        "How colours above 1 are shown: clamp cuts them, Reinhard and ACES roll them off smoothly.";
+    pub const IMAGE_MODE: &str = "What the picture shows: the render, or per pixel what its ray tracing tree did (depth reached, how its rays ended, rays traced, the normal). A colour scale beside the image says what each colour means.";
+    pub const POSITION: &str = "The eye: where primary rays start.";
+    pub const LOOK_AT: &str = "The point at the centre of the image; the camera orbits about it.";
+    pub const UP: &str = "Which way is up in the image.";
+    pub const FOV: &str = "Vertical field of view: the angle the image spans from top to bottom.";
+    pub const ORBIT: &str =
+        "How far a drag across the whole image turns the camera (the same rate up and down).";
+    pub const LIGHT_POSITION: &str = "Where the point light is: shadow rays are shot from each hit towards it. Drag the light's marker in the scene view to move it.";
+    pub const LIGHT_COLOUR: &str = "The light's colour and intensity: multiplies the diffuse and specular terms of every point it lights.";
+    pub const LIGHT_RADIUS: &str = "0: a point light with hard shadows; larger: an area light whose shadow rays go to random points on it (soft shadows, needs more samples).";
+    pub const KA: &str = "ka, ambient coefficient: the share of the ambient light Ia the surface returns (I_ambient = ka·Ia), shown even in shadow.";
+    pub const KD: &str = "kd, diffuse coefficient: the surface's own colour under a light, kd·(N·L); only where the shadow ray reaches the light.";
+    pub const KS: &str = "ks, specular coefficient: the strength of the highlight, ks·(R·V)^n or ks·(N·H)^n; only where the shadow ray reaches the light.";
+    pub const KR: &str = "kr, reflectivity: how much of the reflected ray R's colour is added (local + kr·R). 0: no reflected ray is traced.";
+    pub const KT: &str = "kt, transparency: how much of the refracted (transmitted) ray T's colour is added (local + kt·T). 0: no refracted ray is traced.";
+    pub const SHININESS: &str =
+        "n, the specular exponent: larger makes a smaller, sharper highlight.";
+    pub const IOR: &str = "Index of refraction η of the material (air 1, water 1.33, glass 1.5): bends the refracted ray T by Snell's law, η_i·sin θ_i = η_r·sin θ_r.";
+    pub const SCALAR: &str = "One number for all three channels (a grey coefficient): an edit changes R, G and B together. Off: R, G and B apart.";
 }
 
-fn vec3_edit(ui: &mut Ui, label: &str, v: &mut Vec3, speed: f32) -> bool {
+// ---- small widgets ------------------------------------------------------------------------
+
+/// A label and a drag value named by it (for screen readers and UI tests), both with `tip`.
+fn drag(ui: &mut Ui, label: &str, value: DragValue<'_>, tip: &str) -> bool {
+    let l = ui.label(label).on_hover_text(tip);
+    ui.add(value).labelled_by(l.id).on_hover_text(tip).changed()
+}
+
+fn vec3_edit(ui: &mut Ui, label: &str, v: &mut Vec3, speed: f32, tip: &str) -> bool {
     let mut changed = false;
     ui.horizontal(|ui| {
-        let l = ui.label(label);
+        let l = ui.label(label).on_hover_text(tip);
         for c in [&mut v.x, &mut v.y, &mut v.z] {
             changed |= ui
                 .add(DragValue::new(c).speed(speed).max_decimals(4))
                 .labelled_by(l.id)
+                .on_hover_text(tip)
                 .changed();
         }
     });
     changed
 }
 
-fn color_edit(ui: &mut Ui, label: &str, v: &mut Vec3) -> bool {
+/// The colour a picker shows for `v`: `v` itself, or scaled into 0..=1 by its largest channel
+/// (a light of colour (5, 4, 3) shows as (1, 0.8, 0.6)); and that scale.
+pub fn picker_rgb(v: Vec3) -> ([f32; 3], f32) {
+    let k = v.max_element().max(1.0);
+    let c = v / k;
+    ([c.x, c.y, c.z], k)
+}
+
+/// An RGB coefficient: a colour picker (its pick keeps the intensity of colours above 1) and
+/// either one number for all three channels (scalar mode, the default when they are equal) or
+/// R, G and B; the "=" toggle switches. Every edit is one change of the whole colour.
+fn color_edit(ui: &mut Ui, label: &str, v: &mut Vec3, tip: &str) -> bool {
     let mut changed = false;
+    let id = ui.scope_id().with(("rgb mode", label));
+    let mut scalar = ui
+        .data(|d| d.get_temp::<bool>(id))
+        .unwrap_or(v.x == v.y && v.y == v.z);
     ui.horizontal(|ui| {
-        let l = ui.label(label);
-        for c in [&mut v.x, &mut v.y, &mut v.z] {
-            changed |= ui
+        let l = ui.label(label).on_hover_text(tip);
+        let (mut rgb, k) = picker_rgb(*v);
+        if ui
+            .color_edit_button_rgb(&mut rgb)
+            .labelled_by(l.id)
+            .on_hover_text(tip)
+            .changed()
+        {
+            *v = Vec3::from(rgb) * k;
+            changed = true;
+            if v.x != v.y || v.y != v.z {
+                scalar = false;
+            }
+        }
+        if scalar {
+            let mut x = v.max_element();
+            if ui
                 .add(
-                    DragValue::new(c)
+                    DragValue::new(&mut x)
                         .speed(0.01)
                         .range(0.0..=100.0)
                         .max_decimals(3),
                 )
                 .labelled_by(l.id)
-                .changed();
+                .on_hover_text(tip)
+                .changed()
+            {
+                *v = Vec3::splat(x);
+                changed = true;
+            }
+        } else {
+            for c in [&mut v.x, &mut v.y, &mut v.z] {
+                changed |= ui
+                    .add(
+                        DragValue::new(c)
+                            .speed(0.01)
+                            .range(0.0..=100.0)
+                            .max_decimals(3),
+                    )
+                    .labelled_by(l.id)
+                    .on_hover_text(tip)
+                    .changed();
+            }
         }
-        let mut rgb = [v.x.min(1.0), v.y.min(1.0), v.z.min(1.0)];
-        if ui
-            .color_edit_button_rgb(&mut rgb)
-            .labelled_by(l.id)
-            .changed()
-        {
-            *v = Vec3::from(rgb);
-            changed = true;
-        }
+        ui.toggle_value(&mut scalar, "=")
+            .on_hover_text(tips::SCALAR);
     });
+    ui.data_mut(|d| d.insert_temp(id, scalar));
     changed
 }
 
 /// A menu of every variant of a [`Choice`], each with its help line as a tooltip.
-fn combo<T: Choice>(ui: &mut Ui, label: &str, value: &mut T) -> bool {
+fn combo<T: Choice>(ui: &mut Ui, label: &str, value: &mut T, tip: &str) -> bool {
     let mut changed = false;
     egui::ComboBox::from_label(label)
         .selected_text(format!("{value:?}"))
@@ -73,7 +157,9 @@ fn combo<T: Choice>(ui: &mut Ui, label: &str, value: &mut T) -> bool {
                     .on_hover_text(o.help())
                     .changed();
             }
-        });
+        })
+        .response
+        .on_hover_text(format!("{tip}\n{:?}: {}", value, value.help()));
     changed
 }
 
@@ -103,6 +189,27 @@ pub fn top_bar(app: &mut ViewerApp, ui: &mut Ui) {
                 }
                 if ui.button("Export... (Ctrl+S)").clicked() {
                     app.export_choice = true;
+                }
+            });
+            ui.menu_button("Edit", |ui| {
+                if ui
+                    .add_enabled(app.history.can_undo(), egui::Button::new("Undo (Ctrl+Z)"))
+                    .clicked()
+                {
+                    app.undo();
+                }
+                if ui
+                    .add_enabled(
+                        app.history.can_redo(),
+                        egui::Button::new("Redo (Ctrl+Shift+Z, Ctrl+Y)"),
+                    )
+                    .clicked()
+                {
+                    app.redo();
+                }
+                ui.separator();
+                if ui.button("Reset camera to the scene's (Home)").clicked() {
+                    app.reset_camera();
                 }
             });
             ui.menu_button("View", |ui| {
@@ -201,6 +308,7 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
             let r = &mut app.edit.render;
             restart |= ui
                 .add(egui::Slider::new(&mut r.max_depth, rules::DEPTH).text("max depth"))
+                .on_hover_text(tips::MAX_DEPTH)
                 .changed();
             restart |= ui
                 .add(
@@ -208,27 +316,35 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                         .logarithmic(true)
                         .text("samples"),
                 )
+                .on_hover_text(tips::SAMPLES)
                 .changed();
             ui.horizontal(|ui| {
                 restart |= drag(
                     ui,
                     "width",
                     DragValue::new(&mut r.width).range(rules::IMAGE_SIZE),
+                    tips::SIZE,
                 );
                 restart |= drag(
                     ui,
                     "height",
                     DragValue::new(&mut r.height).range(rules::IMAGE_SIZE),
+                    tips::SIZE,
                 );
             });
-            restart |= combo(ui, "shading", &mut r.shading);
-            restart |= color_edit(ui, "background", &mut r.background);
-            restart |= color_edit(ui, "ambient light", &mut r.ambient_light);
+            restart |= combo(ui, "shading", &mut r.shading, tips::SHADING);
+            restart |= color_edit(ui, "background", &mut r.background, tips::BACKGROUND);
+            restart |= color_edit(
+                ui,
+                "ambient light",
+                &mut r.ambient_light,
+                tips::AMBIENT_LIGHT,
+            );
             let t = &mut app.settings.trace;
-            restart |= combo(ui, "sphere", &mut t.methods.sphere);
-            restart |= combo(ui, "triangle", &mut t.methods.triangle);
-            restart |= combo(ui, "offset", &mut t.methods.offset);
-            rebuild |= combo(ui, "accelerator", &mut t.accel);
+            restart |= combo(ui, "sphere", &mut t.methods.sphere, tips::SPHERE);
+            restart |= combo(ui, "triangle", &mut t.methods.triangle, tips::TRIANGLE);
+            restart |= combo(ui, "offset", &mut t.methods.offset, tips::OFFSET);
+            rebuild |= combo(ui, "accelerator", &mut t.accel, tips::ACCEL);
             ui.horizontal(|ui| {
                 restart |= drag(
                     ui,
@@ -237,6 +353,7 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                         .speed(0.001)
                         // rules::CUTOFF: at least 0, below 1.
                         .range(0.0..=0.999),
+                    tips::CUTOFF,
                 );
             });
             ui.horizontal(|ui| {
@@ -244,6 +361,7 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                     ui,
                     "threads (0 = all)",
                     DragValue::new(&mut app.settings.threads).range(0..=rules::MAX_THREADS),
+                    tips::THREADS,
                 );
             });
             ui.label(format!("accelerator in use: {:?}", app.tracer.accel.kind()));
@@ -257,38 +375,58 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                     for m in ImageMode::ALL {
                         ui.selectable_value(&mut app.prefs.mode, m, m.label());
                     }
-                });
+                })
+                .response
+                .on_hover_text(tips::IMAGE_MODE);
             ui.add(
                 egui::Slider::new(&mut app.prefs.exposure, 0.01..=16.0)
                     .logarithmic(true)
                     .text("exposure"),
-            );
+            )
+            .on_hover_text(tips::EXPOSURE);
             ui.horizontal(|ui| {
-                ui.label("tonemap");
+                ui.label("tonemap").on_hover_text(tips::TONEMAP);
                 ui.radio_value(&mut app.prefs.tonemap, 0, "clamp");
                 ui.radio_value(&mut app.prefs.tonemap, 1, "Reinhard");
                 ui.radio_value(&mut app.prefs.tonemap, 2, "ACES");
             });
-            if app.prefs.mode == ImageMode::Termination {
-                for (label, (r, g, b)) in TERMINATION_LEGEND {
-                    ui.colored_label(Color32::from_rgb(r, g, b), format!("# {label}"));
-                }
-            }
         });
     egui::CollapsingHeader::new("Camera")
         .default_open(true)
         .show(ui, |ui| {
             let c = &mut app.edit.camera;
-            restart |= vec3_edit(ui, "position", &mut c.position, 0.05);
-            restart |= vec3_edit(ui, "look at ", &mut c.look_at, 0.05);
-            restart |= vec3_edit(ui, "up      ", &mut c.up, 0.01);
+            restart |= vec3_edit(ui, "position", &mut c.position, 0.05, tips::POSITION);
+            restart |= vec3_edit(ui, "look at ", &mut c.look_at, 0.05, tips::LOOK_AT);
+            restart |= vec3_edit(ui, "up      ", &mut c.up, 0.01, tips::UP);
             restart |= ui
                 .add(egui::Slider::new(&mut c.fov_y_deg, 1.0..=170.0).text("fov y (°)"))
+                .on_hover_text(tips::FOV)
                 .changed();
-            if ui.button("Frame all").clicked() {
-                app.pending.push(Command::FrameAll);
-            }
-            ui.small("drag: orbit · right/middle drag: pan · wheel: zoom");
+            ui.horizontal(|ui| {
+                if ui
+                    .button("Frame all")
+                    .on_hover_text("move the camera back until every object is in view")
+                    .clicked()
+                {
+                    app.pending.push(Command::FrameAll);
+                }
+                if ui
+                    .button("Reset to the scene's")
+                    .on_hover_text(
+                        "the camera as the scene file placed it (Home); undo with Ctrl+Z",
+                    )
+                    .clicked()
+                {
+                    app.reset_camera();
+                }
+            });
+            ui.add(
+                egui::Slider::new(&mut app.prefs.orbit_degrees, 30.0..=720.0)
+                    .text("orbit (° per width)")
+                    .max_decimals(0),
+            )
+            .on_hover_text(tips::ORBIT);
+            ui.small("drag: orbit · right/middle drag: pan · wheel: zoom · Home: reset");
         });
     egui::CollapsingHeader::new(format!("Lights ({})", app.edit.lights.len()))
         .default_open(true)
@@ -300,13 +438,15 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                     .id_salt(("light", i))
                     .default_open(selected)
                     .show(ui, |ui| {
-                        restart |= vec3_edit(ui, "position", &mut l.position, 0.05);
-                        restart |= color_edit(ui, "colour", &mut l.color);
+                        restart |=
+                            vec3_edit(ui, "position", &mut l.position, 0.05, tips::LIGHT_POSITION);
+                        restart |= color_edit(ui, "colour", &mut l.color, tips::LIGHT_COLOUR);
                         ui.horizontal(|ui| {
                             restart |= drag(
                                 ui,
                                 "radius",
                                 DragValue::new(&mut l.radius).speed(0.01).range(0.0..=1e6),
+                                tips::LIGHT_RADIUS,
                             );
                         });
                         if ui.button("Remove").clicked() {
@@ -376,11 +516,11 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
 
 fn material_editor(ui: &mut Ui, m: &mut Material) -> bool {
     let mut changed = false;
-    changed |= color_edit(ui, "ambient ka ", &mut m.ambient);
-    changed |= color_edit(ui, "diffuse kd ", &mut m.diffuse);
-    changed |= color_edit(ui, "specular ks", &mut m.specular);
-    changed |= color_edit(ui, "reflect kr ", &mut m.reflectivity);
-    changed |= color_edit(ui, "transmit kt", &mut m.transparency);
+    changed |= color_edit(ui, "ambient ka", &mut m.ambient, tips::KA);
+    changed |= color_edit(ui, "diffuse kd", &mut m.diffuse, tips::KD);
+    changed |= color_edit(ui, "specular ks", &mut m.specular, tips::KS);
+    changed |= color_edit(ui, "reflect kr", &mut m.reflectivity, tips::KR);
+    changed |= color_edit(ui, "transmit kt", &mut m.transparency, tips::KT);
     ui.horizontal(|ui| {
         changed |= drag(
             ui,
@@ -388,11 +528,13 @@ fn material_editor(ui: &mut Ui, m: &mut Material) -> bool {
             DragValue::new(&mut m.shininess)
                 .speed(0.5)
                 .range(0.0..=10000.0),
+            tips::SHININESS,
         );
         changed |= drag(
             ui,
             "ior",
             DragValue::new(&mut m.ior).speed(0.01).range(0.01..=10.0),
+            tips::IOR,
         );
     });
     changed
@@ -524,25 +666,51 @@ pub fn export_window(app: &mut ViewerApp, ctx: &egui::Context) {
 }
 
 pub fn help_window(ctx: &egui::Context, open: &mut bool) {
-    egui::Window::new("Help").open(open).show(ctx, |ui| {
-        egui::Grid::new("keys").striped(true).show(ui, |ui| {
-            for (k, v) in [
-                ("Left drag", "orbit the camera about its target"),
-                ("Right or middle drag", "pan"),
-                ("Wheel", "zoom"),
-                ("Click", "ray tree of that pixel; selects its material"),
-                ("Ctrl+S", "export the render (PNG or EXR, full resolution)"),
-                (
-                    "Ctrl+O",
-                    "open a scene or OBJ (or drop the file on the window)",
-                ),
-                ("Esc", "stop rendering"),
-                ("F1", "this help"),
-            ] {
-                ui.strong(k);
-                ui.label(v);
-                ui.end_row();
-            }
+    egui::Window::new("Help")
+        .open(open)
+        .default_height(560.0)
+        .show(ctx, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                ui.heading("Controls");
+                egui::Grid::new("keys").striped(true).show(ui, |ui| {
+                    for (k, v) in [
+                        ("Left drag", "orbit the camera about its target (180° across the image; see Camera)"),
+                        ("Right or middle drag", "pan"),
+                        ("Wheel", "zoom"),
+                        ("Click", "ray tree of that pixel; selects its material"),
+                        ("Shift+click", "add that pixel's tree to the trees shown"),
+                        ("Ctrl+drag", "trees of a grid of pixels in the rectangle"),
+                        ("Drag a light (scene view)", "move the light, facing the view"),
+                        ("Shift+drag a sphere (scene view)", "move the sphere, facing the view"),
+                        ("Ctrl+Z", "undo the last edit (a whole drag is one edit)"),
+                        ("Ctrl+Shift+Z, Ctrl+Y", "redo"),
+                        ("Home", "reset the camera to the scene's"),
+                        ("Ctrl+S", "export the render (PNG or EXR, full resolution)"),
+                        (
+                            "Ctrl+O",
+                            "open a scene or OBJ (or drop the file on the window)",
+                        ),
+                        ("Esc", "stop rendering"),
+                        ("F1", "this help"),
+                    ] {
+                        ui.strong(k);
+                        ui.label(v);
+                        ui.end_row();
+                    }
+                });
+                ui.add_space(6.0);
+                ui.label("Colour fields: the swatch opens a colour picker; \"=\" edits one number for all three channels.");
+                ui.label("Hover any setting for what it does.");
+                ui.separator();
+                ui.heading("Rays and diagram glyphs");
+                ui.label("The same colours in the render view's overlay, the scene view, the tree list and the diagram:");
+                super::legend::ray_legend_ui(ui);
+                ui.separator();
+                ui.heading("Built-in scenes");
+                ui.label(format!(
+                    "Scene > Built-in opens: {}.",
+                    builtin::NAMES.join(", ")
+                ));
+            });
         });
-    });
 }

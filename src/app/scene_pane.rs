@@ -381,9 +381,15 @@ pub fn scene_view_ui(app: &mut ViewerApp, ui: &mut Ui) {
     app.scene_view.size = size;
     // Camera moves: only this view's render restarts.
     let delta = response.drag_delta();
-    if delta != egui::Vec2::ZERO {
+    // A drag that starts on a light moves the light instead.
+    let camera = app.scene_view.camera.clone();
+    let light_drag = super::gesture::drag_light(app, ui, &response, &camera, rect)
+        || super::gesture::drag_sphere(app, ui, &response, &camera, rect);
+    if delta != egui::Vec2::ZERO && !light_drag {
         if response.dragged_by(egui::PointerButton::Primary) {
-            app.scene_view.camera.orbit(delta.x * 0.01, delta.y * 0.01);
+            let (yaw, pitch) =
+                super::gesture::orbit_angles(delta, rect.width(), app.prefs.orbit_degrees);
+            app.scene_view.camera.orbit(yaw, pitch);
             restart = true;
         } else if response.dragged_by(egui::PointerButton::Secondary)
             || response.dragged_by(egui::PointerButton::Middle)
@@ -460,6 +466,9 @@ pub fn scene_view_ui(app: &mut ViewerApp, ui: &mut Ui) {
         ..app.scene_view.filter.clone()
     };
     let drawn = draw_trees(app, &painter, &view, &depth, &filter);
+    if app.tree.is_some() {
+        super::legend::ray_key(&painter, rect);
+    }
     pick_and_hover(app, &response, &drawn);
     app.scene_view.drawn = drawn;
     if app.tree.is_none() {

@@ -253,55 +253,7 @@ fn paint_legend(painter: &egui::Painter, rect: Rect, rows: usize) {
         let column = rect.min.x + (i / rows.max(1)) as f32 * LEGEND_COLUMN;
         let y = rect.min.y + LEGEND_TOP + 8.0 + (i % rows.max(1)) as f32 * LEGEND_ROW;
         let at = Pos2::new(column + 22.0, y);
-        let c = rgba32(e.rgba);
-        match e.mark {
-            Mark::Ray(kind) => {
-                painter.line_segment(
-                    [at - Vec2::new(12.0, 0.0), at + Vec2::new(12.0, 0.0)],
-                    Stroke::new(2.0, c),
-                );
-                painter.text(
-                    at - Vec2::new(0.0, 6.0),
-                    egui::Align2::CENTER_CENTER,
-                    diagram::edge_label(kind),
-                    egui::FontId::proportional(10.0),
-                    c,
-                );
-            }
-            Mark::Glyph(g) => paint_glyph(painter, g, at, 8.0),
-            Mark::Swatch => {
-                painter.rect_filled(
-                    Rect::from_center_size(at, Vec2::splat(diagram::SWATCH)),
-                    0.0,
-                    Color32::from_rgb(192, 128, 64),
-                );
-            }
-            Mark::NotTraced => {
-                painter.add(egui::Shape::dashed_line(
-                    &rect_loop(Rect::from_center_size(at, Vec2::new(24.0, 12.0))),
-                    Stroke::new(1.5, c),
-                    4.0,
-                    3.0,
-                ));
-            }
-            Mark::Tir => {
-                painter.text(
-                    at,
-                    egui::Align2::CENTER_CENTER,
-                    "TIR",
-                    egui::FontId::proportional(10.0),
-                    c,
-                );
-            }
-            Mark::Highlight => {
-                painter.rect_stroke(
-                    Rect::from_center_size(at, Vec2::new(24.0, 12.0)),
-                    3.0,
-                    Stroke::new(3.0, c),
-                    egui::StrokeKind::Middle,
-                );
-            }
-        }
+        paint_mark(painter, e, at);
         painter.text(
             Pos2::new(column + 44.0, y),
             egui::Align2::LEFT_CENTER,
@@ -309,6 +261,60 @@ fn paint_legend(painter: &egui::Painter, rect: Rect, rows: usize) {
             font.clone(),
             text,
         );
+    }
+}
+
+/// The mark of legend entry `e` (a ray's line and letter, a glyph, a swatch...) centred at
+/// `at`, about 24 × 12 points: the diagram's legend, the help's and the views' use it.
+pub fn paint_mark(painter: &egui::Painter, e: &diagram::LegendEntry, at: Pos2) {
+    let c = rgba32(e.rgba);
+    match e.mark {
+        Mark::Ray(kind) => {
+            painter.line_segment(
+                [at - Vec2::new(12.0, 0.0), at + Vec2::new(12.0, 0.0)],
+                Stroke::new(2.0, c),
+            );
+            painter.text(
+                at - Vec2::new(0.0, 6.0),
+                egui::Align2::CENTER_CENTER,
+                diagram::edge_label(kind),
+                egui::FontId::proportional(10.0),
+                c,
+            );
+        }
+        Mark::Glyph(g) => paint_glyph(painter, g, at, 8.0),
+        Mark::Swatch => {
+            painter.rect_filled(
+                Rect::from_center_size(at, Vec2::splat(diagram::SWATCH)),
+                0.0,
+                Color32::from_rgb(192, 128, 64),
+            );
+        }
+        Mark::NotTraced => {
+            painter.add(egui::Shape::dashed_line(
+                &rect_loop(Rect::from_center_size(at, Vec2::new(24.0, 12.0))),
+                Stroke::new(1.5, c),
+                4.0,
+                3.0,
+            ));
+        }
+        Mark::Tir => {
+            painter.text(
+                at,
+                egui::Align2::CENTER_CENTER,
+                "TIR",
+                egui::FontId::proportional(10.0),
+                c,
+            );
+        }
+        Mark::Highlight => {
+            painter.rect_stroke(
+                Rect::from_center_size(at, Vec2::new(24.0, 12.0)),
+                3.0,
+                Stroke::new(3.0, c),
+                egui::StrokeKind::Middle,
+            );
+        }
     }
 }
 

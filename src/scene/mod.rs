@@ -177,7 +177,7 @@ pub struct Object {
 
 /// A whole scene, ready to be traced. Invariants (checked at load time, never in the hot loop):
 /// every number finite, radii > 0, triangles of non-zero area, ids in range.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Scene {
     pub render: RenderParams,
     pub camera: Camera,
