@@ -19,6 +19,8 @@ struct Options {
     runs: usize,
     threads: usize,
     keep: Option<PathBuf>,
+    /// Only the build-memory measurement.
+    memory: bool,
 }
 
 fn options() -> Options {
@@ -27,6 +29,7 @@ fn options() -> Options {
         runs: 5,
         threads: 2,
         keep: None,
+        memory: false,
     };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -39,6 +42,7 @@ fn options() -> Options {
             "--runs" => o.runs = value("--runs").parse().expect("a number"),
             "--threads" => o.threads = value("--threads").parse().expect("a number"),
             "--keep" => o.keep = Some(PathBuf::from(value("--keep"))),
+            "--memory" => o.memory = true,
             "--bench" => {}
             other => panic!("unknown option {other}"),
         }
@@ -126,12 +130,72 @@ fn stats(mut v: Vec<f64>) -> String {
     )
 }
 
+/// A `/proc/self/status` value in bytes (`VmRSS`, `VmHWM`), 0 where there is none.
+fn status_bytes(key: &str) -> u64 {
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix(key))
+        .and_then(|rest| {
+            rest.trim()
+                .trim_end_matches("kB")
+                .trim()
+                .parse::<u64>()
+                .ok()
+        })
+        .map_or(0, |kb| kb * 1024)
+}
+
+/// The BVH build's memory on the benchmark torus of `triangles` triangles loaded as a bare
+/// OBJ: the resident set before the build, the peak during it (the kernel's peak is reset
+/// first through `/proc/self/clear_refs`), and what the scene and accelerator keep.
+fn build_memory(triangles: usize, root: &std::path::Path) {
+    let file = root.join("build_memory.obj");
+    std::fs::write(&file, bumpy_torus_obj(triangles)).expect("the OBJ is written");
+    let scene = std::sync::Arc::new(raytree::scene::load_scene_file(&file).expect("it loads"));
+    let before = status_bytes("VmRSS:");
+    let reset = std::fs::write("/proc/self/clear_refs", "5").is_ok();
+    let t = Instant::now();
+    let tracer = raytree::trace::Tracer::new(scene.clone(), Default::default());
+    let secs = t.elapsed().as_secs_f64();
+    let peak = status_bytes("VmHWM:");
+    let after = status_bytes("VmRSS:");
+    let accel = tracer.accel.memory_bytes() as u64;
+    let records = (scene.triangles.capacity() * size_of::<raytree::scene::Triangle>()) as u64;
+    let mb = |b: u64| b as f64 / 1e6;
+    println!(
+        "BVH build of {} triangles: {secs:.2} s; resident before {:.0} MB, after {:.0} MB, peak during {:.0} MB{}",
+        scene.triangles.len(),
+        mb(before),
+        mb(after),
+        mb(peak),
+        if reset {
+            ""
+        } else {
+            " (peak not reset: whole process)"
+        }
+    );
+    println!(
+        "  kept: accelerator {:.0} MB + scene triangles {:.0} MB = {:.0} MB; build peak above the loaded scene {:.0} MB; peak / kept {:.2}",
+        mb(accel),
+        mb(records),
+        mb(accel + records),
+        mb(peak.saturating_sub(before)),
+        peak as f64 / (accel + records) as f64
+    );
+}
+
 fn main() {
     let o = options();
     rayon::ThreadPoolBuilder::new()
         .num_threads(o.threads)
         .build_global()
         .expect("the thread pool");
+    if o.memory {
+        let tmp = tempfile::tempdir().expect("a temporary folder");
+        build_memory(o.triangles, tmp.path());
+        return;
+    }
     let tmp = tempfile::tempdir().expect("a temporary folder");
     let root = o.keep.clone().unwrap_or_else(|| tmp.path().to_path_buf());
     std::fs::create_dir_all(&root).expect("the output folder");
