@@ -115,6 +115,10 @@ pub struct ViewerApp {
     scene_label: String,
     tracer: Arc<Tracer>,
     session: Session,
+    /// A build asked of the session and not yet installed (`Some(restart the scene view)`);
+    /// while it is, the current tracer's accelerator does not fit the working copy, so every
+    /// restart builds (a stop in the middle of a build drops it).
+    pending_build: Option<bool>,
     generation: u64,
     progress: Progress,
     /// The film as the latest tiles left it: linear colour and sample-0 facts per pixel.
@@ -224,6 +228,7 @@ impl ViewerApp {
             scene_label: label,
             tracer,
             session,
+            pending_build: None,
             generation: 0,
             progress: Progress::default(),
             film: Film::new(w, h),
@@ -326,31 +331,51 @@ impl ViewerApp {
             self.edit.render.height = nh;
         }
         let scene = Arc::new(self.edit.clone());
-        let (w, h) = (scene.render.width, scene.render.height);
-        let tracer = if rebuild || self.tracer.settings.accel != self.settings.trace.accel {
-            Tracer::new(scene.clone(), self.settings.trace)
-        } else {
-            Tracer::with_accel(
-                scene.clone(),
-                self.settings.trace,
-                self.tracer.accel.clone(),
-            )
+        let target = scene.render.samples;
+        let focus = self.hover.map(|(x, y)| (x as f32, y as f32));
+        if rebuild
+            || self.pending_build.is_some()
+            || self.tracer.settings.accel != self.settings.trace.accel
+        {
+            // Built on the session's coordinator thread: the previous image stays up, with
+            // "building BVH…", until the new tracer is handed out by `poll_session`.
+            self.generation = self
+                .session
+                .start_build(scene, self.settings.trace, target, focus);
+            self.progress = Progress {
+                started: Some(Instant::now()),
+                pass_label: "building BVH…".into(),
+                ..Progress::default()
+            };
+            self.pending_build = Some(self.pending_build.unwrap_or(false) || scene_view);
+            return;
+        }
+        let tracer = Arc::new(Tracer::with_accel(
+            scene,
+            self.settings.trace,
+            self.tracer.accel.clone(),
+        ));
+        self.generation = self.session.start(tracer.clone(), target, focus);
+        self.progress = Progress {
+            started: Some(Instant::now()),
+            pass_label: "preview".into(),
+            ..Progress::default()
         };
-        self.tracer = Arc::new(tracer);
+        self.install_tracer(tracer, scene_view);
+    }
+
+    /// Makes the tracer of the generation just started (`start`ed, or built and handed out)
+    /// the current one: film and display at its size, trees re-traced, scene view restarted.
+    fn install_tracer(&mut self, tracer: Arc<Tracer>, scene_view: bool) {
+        self.tracer = tracer;
+        let scene = self.tracer.scene.clone();
+        let (w, h) = (scene.render.width, scene.render.height);
         self.film.resize(w, h);
         self.scene = scene;
         self.display
             .lock()
             .unwrap_or_else(|p| p.into_inner())
             .resize(w, h);
-        let target = self.scene.render.samples;
-        let focus = self.hover.map(|(x, y)| (x as f32, y as f32));
-        self.generation = self.session.start(self.tracer.clone(), target, focus);
-        self.progress = Progress {
-            started: Some(Instant::now()),
-            pass_label: "preview".into(),
-            ..Progress::default()
-        };
         // The tree follows the scene: re-trace the clicked pixel with the new settings.
         if let Some(tree) = &self.tree {
             let [x, y] = tree.pixel;
@@ -416,6 +441,14 @@ impl ViewerApp {
 
     /// Takes the tiles that arrived, within a time budget so the UI stays responsive.
     pub fn poll_session(&mut self) {
+        // A tracer built off the UI thread comes before its generation's first tile.
+        if let Some(tracer) = self.session.take_built() {
+            let scene_view = self.pending_build.take().unwrap_or(true);
+            self.install_tracer(tracer, scene_view);
+            self.progress.pass_label = "preview".into();
+        } else if let Some(t) = self.session.building_for() {
+            self.progress.pass_label = format!("building BVH… {:.1} s", t.as_secs_f64());
+        }
         self.scene_view.poll();
         let budget = Instant::now();
         let mut display = self.display.lock().unwrap_or_else(|p| p.into_inner());
