@@ -15,6 +15,7 @@ pub mod scene_pane;
 pub mod sweep;
 pub mod tree_view;
 pub mod viewport;
+pub mod watch;
 pub mod workspace;
 
 use std::path::{Path, PathBuf};
@@ -115,6 +116,8 @@ pub struct ViewerApp {
     scene_label: String,
     tracer: Arc<Tracer>,
     session: Session,
+    /// The open scene's files, watched for saves (`None` for built-in scenes).
+    watch: Option<watch::SceneWatch>,
     /// A build asked of the session and not yet installed (`Some(restart the scene view)`);
     /// while it is, the current tracer's accelerator does not fit the working copy, so every
     /// restart builds (a stop in the middle of a build drops it).
@@ -229,6 +232,7 @@ impl ViewerApp {
             tracer,
             session,
             pending_build: None,
+            watch: None,
             generation: 0,
             progress: Progress::default(),
             film: Film::new(w, h),
@@ -254,6 +258,7 @@ impl ViewerApp {
         for w in app.scene.warnings.clone() {
             app.messages.push((false, w));
         }
+        app.watch_scene();
         app.restart(false);
         Ok(app)
     }
@@ -439,8 +444,61 @@ impl ViewerApp {
         true
     }
 
+    /// Watches the open scene's files (see [`watch`]), or nothing for a built-in scene.
+    fn watch_scene(&mut self) {
+        self.watch = None;
+        let Some(source) = self.edit.source.clone() else {
+            return;
+        };
+        match watch::SceneWatch::new(&watch::scene_files(&self.edit, &source)) {
+            Ok(w) => self.watch = Some(w),
+            Err(e) => self.messages.push((false, e)),
+        }
+    }
+
+    /// True while a saved change waits for its reload (the UI keeps polling).
+    pub fn reload_pending(&self) -> bool {
+        self.watch.as_ref().is_some_and(watch::SceneWatch::pending)
+    }
+
+    /// Reloads the open scene after a save. Same geometry: the camera (as moved in the viewer)
+    /// and the clicked trees stay, and the accelerator is kept. A broken save: its error, and
+    /// the last good scene stays.
+    fn reload(&mut self) {
+        let Some(path) = self.edit.source.clone() else {
+            return;
+        };
+        match scene::load_scene_file(&path) {
+            Ok(mut s) => {
+                let same_geometry =
+                    s.triangles == self.edit.triangles && s.spheres == self.edit.spheres;
+                for w in &s.warnings {
+                    self.messages.push((false, w.clone()));
+                }
+                self.messages
+                    .push((false, format!("reloaded {} after a save", path.display())));
+                if same_geometry {
+                    s.camera = self.edit.camera.clone();
+                    self.edit = s;
+                    self.watch_scene();
+                    self.restart(false);
+                } else {
+                    self.replace_scene(s, path.display().to_string());
+                    self.watch_scene();
+                    self.restart(true);
+                }
+            }
+            Err(e) => self.error(format!(
+                "{e} (after a save; the last good scene stays until the file loads again)"
+            )),
+        }
+    }
+
     /// Takes the tiles that arrived, within a time budget so the UI stays responsive.
     pub fn poll_session(&mut self) {
+        if self.watch.as_mut().is_some_and(watch::SceneWatch::poll) {
+            self.reload();
+        }
         // A tracer built off the UI thread comes before its generation's first tile.
         if let Some(tracer) = self.session.take_built() {
             let scene_view = self.pending_build.take().unwrap_or(true);
@@ -517,6 +575,7 @@ impl ViewerApp {
                 Command::OpenFile(path) => match scene::load_scene_file(&path) {
                     Ok(s) => {
                         self.replace_scene(s, path.display().to_string());
+                        self.watch_scene();
                         rebuild = true;
                         restart = true;
                     }
@@ -526,6 +585,7 @@ impl ViewerApp {
                 Command::OpenBuiltin(name) => match scene::builtin::load_builtin(&name) {
                     Ok(s) => {
                         self.replace_scene(s, name);
+                        self.watch = None;
                         rebuild = true;
                         restart = true;
                     }
@@ -780,6 +840,9 @@ impl eframe::App for ViewerApp {
         self.refresh_if_mode_changed();
         if !self.is_finished() || !self.scene_view.is_finished() {
             ctx.request_repaint();
+        } else if self.watch.is_some() {
+            // Idle: wake up now and then to see whether the scene was saved.
+            ctx.request_repaint_after(watch::DEBOUNCE);
         }
     }
 
