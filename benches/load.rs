@@ -21,6 +21,8 @@ struct Options {
     keep: Option<PathBuf>,
     /// Only the build-memory measurement.
     memory: bool,
+    /// Only the viewer's open of a big OBJ: its load, build and longest frame.
+    viewer: bool,
 }
 
 fn options() -> Options {
@@ -30,6 +32,7 @@ fn options() -> Options {
         threads: 2,
         keep: None,
         memory: false,
+        viewer: false,
     };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -43,6 +46,7 @@ fn options() -> Options {
             "--threads" => o.threads = value("--threads").parse().expect("a number"),
             "--keep" => o.keep = Some(PathBuf::from(value("--keep"))),
             "--memory" => o.memory = true,
+            "--viewer" => o.viewer = true,
             "--bench" => {}
             other => panic!("unknown option {other}"),
         }
@@ -185,12 +189,69 @@ fn build_memory(triangles: usize, root: &std::path::Path) {
     );
 }
 
+/// The headless viewer opens the benchmark torus as a bare OBJ: the time `apply` takes (the
+/// UI thread reads and parses the file), then frames (`poll_session` + `apply`, as the window's
+/// frame does) until the new tracer is in and its first pass is done; the longest such frame.
+#[cfg(feature = "viewer")]
+fn viewer_open(triangles: usize, root: &std::path::Path) {
+    use raytree::app::{Command, ViewerApp};
+    let file = root.join("viewer_open.obj");
+    std::fs::write(&file, bumpy_torus_obj(triangles)).expect("the OBJ is written");
+    let mut app = ViewerApp::headless(
+        raytree::scene::builtin::load_builtin("default").expect("a built-in scene"),
+        "default".into(),
+    )
+    .expect("the viewer");
+    while !app.is_finished() {
+        app.poll_session();
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    }
+    let t = Instant::now();
+    app.command(Command::OpenFile(file.clone()));
+    app.apply();
+    let open = t.elapsed().as_secs_f64();
+    let mut longest: f64 = 0.0;
+    let mut frames = 0;
+    while app.scene().source.as_deref() != Some(file.as_path()) || app.samples_done() == 0 {
+        let f = Instant::now();
+        let before = app.scene().triangles.len();
+        app.poll_session();
+        app.apply();
+        let dt = f.elapsed().as_secs_f64();
+        if app.scene().triangles.len() != before {
+            println!(
+                "  the frame that installs the built tracer: {:.1} ms",
+                dt * 1e3
+            );
+        }
+        longest = longest.max(dt);
+        frames += 1;
+        std::thread::sleep(std::time::Duration::from_millis(16));
+    }
+    println!(
+        "viewer opens {} triangles: open (read + parse on the UI thread) {open:.2} s; built and first pass after {:.2} s; {frames} frames meanwhile, the longest {:.1} ms",
+        app.scene().triangles.len(),
+        t.elapsed().as_secs_f64(),
+        longest * 1e3
+    );
+}
+
+#[cfg(not(feature = "viewer"))]
+fn viewer_open(_: usize, _: &std::path::Path) {
+    println!("--viewer needs the `viewer` feature");
+}
+
 fn main() {
     let o = options();
     rayon::ThreadPoolBuilder::new()
         .num_threads(o.threads)
         .build_global()
         .expect("the thread pool");
+    if o.viewer {
+        let tmp = tempfile::tempdir().expect("a temporary folder");
+        viewer_open(o.triangles, tmp.path());
+        return;
+    }
     if o.memory {
         let tmp = tempfile::tempdir().expect("a temporary folder");
         build_memory(o.triangles, tmp.path());
