@@ -31,7 +31,7 @@ fn objs(folder: &Path, out: &mut Vec<PathBuf>) {
     };
     for e in entries.flatten() {
         let p = e.path();
-        if p.is_dir() && !p.extension().is_some_and(|x| x == "obj") {
+        if p.is_dir() && p.extension().is_none_or(|x| x != "obj") {
             objs(&p, out);
         } else if p.extension().is_some_and(|x| x.eq_ignore_ascii_case("obj")) && p.is_file() {
             out.push(p);

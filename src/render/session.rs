@@ -152,7 +152,7 @@ pub struct Session {
     /// worker exists to send it.
     start_failure: Cell<Option<SessionEvent>>,
     /// The tracer a [`Self::start_build`] made, with its generation, until taken.
-    built: Arc<Mutex<Option<(u64, Arc<Tracer>)>>>,
+    built: Arc<BuiltSlot>,
     /// The generation whose accelerator is being built and since when, until it is taken.
     building: Cell<Option<(u64, Instant)>>,
 }
@@ -372,6 +372,9 @@ impl Session {
         }
     }
 }
+
+/// Where the coordinator leaves a built tracer, with its generation.
+type BuiltSlot = Mutex<Option<(u64, Arc<Tracer>)>>;
 
 /// What a generation renders: a tracer, or a scene whose tracer is built first.
 enum Source {
