@@ -21,6 +21,7 @@
 //! `tests/fixtures/hostile/` (every input that ever crashed is a fixture there).
 
 mod hostile_support;
+mod obj_compare;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -680,6 +681,81 @@ fn fuzz_obj_and_mtl() {
         "  {} loaded with triangles as a mesh, {} as a bare OBJ",
         as_mesh.into_inner(),
         bare.into_inner()
+    );
+}
+
+/// raytree's parallel OBJ reader against tobj on the same random OBJs (well-formed meshes with
+/// hostile lines mixed in, and hostile lines alone): where it reads a file, tobj reads the same
+/// models bit for bit; where tobj fails, it leaves the file to tobj. (Through the loader, the
+/// target above runs it too.)
+#[test]
+fn fuzz_fast_obj_reader_equals_tobj() {
+    let taken = AtomicU32::new(0);
+    // Well-formed files of every kind of corner, group and material change.
+    let clean_line = |n: u32| {
+        let i = move || (1..=n).prop_map(|i| i.to_string());
+        let corner = (i(), i(), i(), 0..4u8).prop_map(|(v, t, m, form)| match form {
+            0 => v,
+            1 => format!("{v}/{t}"),
+            2 => format!("{v}//{m}"),
+            _ => format!("{v}/{t}/{m}"),
+        });
+        prop_oneof![
+            4 => proptest::collection::vec(corner, 1..7).prop_map(|c| format!("f {}", c.join(" "))),
+            1 => proptest::sample::select(&[
+                "o a", "g b", "g", "usemtl red", "usemtl none", "s 1", "# c", "", "mtllib m.mtl",
+            ][..]).prop_map(str::to_string),
+        ]
+    };
+    let clean = (1u32..8).prop_flat_map(move |n| {
+        let numbers = |k: usize| {
+            proptest::collection::vec(-3.0f32..3.0, k)
+                .prop_map(|v| v.iter().map(f32::to_string).collect::<Vec<_>>().join(" "))
+        };
+        (
+            proptest::collection::vec(numbers(3).prop_map(|v| format!("v {v}")), n as usize),
+            proptest::collection::vec(numbers(2).prop_map(|v| format!("vt {v}")), n as usize),
+            proptest::collection::vec(numbers(3).prop_map(|v| format!("vn {v}")), n as usize),
+            proptest::collection::vec(clean_line(n), 0..20),
+            any::<bool>(),
+        )
+            .prop_map(|(v, t, m, faces, crlf)| {
+                let text = [v, t, m, faces].concat().join("\n") + "\n";
+                if crlf {
+                    text.replace('\n', "\r\n")
+                } else {
+                    text
+                }
+            })
+    });
+    let case = prop_oneof![
+        2 => clean,
+        2 => mesh_case().prop_map(|c| c.obj),
+        1 => proptest::collection::vec(obj_line(), 0..24).prop_map(|l| l.join("\n")),
+    ];
+    run(
+        "fast OBJ reader",
+        cases(SHORT_OBJ_CASES / 2, 1),
+        4,
+        case,
+        |obj| {
+            let load_mtl = |p: &Path| -> tobj::MTLLoadResult {
+                if p == Path::new("m.mtl") {
+                    tobj::load_mtl_buf(&mut "newmtl red\nKd 1 0 0\n".as_bytes())
+                } else {
+                    Err(tobj::LoadError::OpenFileFailed)
+                }
+            };
+            if obj_compare::check(&obj, &load_mtl) {
+                taken.fetch_add(1, Ordering::Relaxed);
+            }
+        },
+    );
+    let taken = taken.into_inner();
+    eprintln!("  {taken} read by the fast reader");
+    assert!(
+        taken > cases(SHORT_OBJ_CASES / 2, 1) / 4,
+        "the fast path is exercised"
     );
 }
 

@@ -469,7 +469,14 @@ fn bare_obj_is_framed_and_lit() {
     let path = Path::new("tests/fixtures/models/materials.obj");
     let scene = load_scene_file(path).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(scene.source.as_deref(), Some(path));
-    assert_eq!(scene.render, RenderParams::default());
+    // A low ambient light, so that `Ka 1` does not wash the model out (issue 14.4).
+    assert_eq!(
+        scene.render,
+        RenderParams {
+            ambient_light: Vec3::splat(0.1),
+            ..RenderParams::default()
+        }
+    );
     assert_eq!(scene.objects.len(), 1);
     assert_eq!(scene.objects[0].name, "materials");
     assert_eq!(scene.triangles.len(), 6);
@@ -497,13 +504,18 @@ fn bare_obj_is_framed_and_lit() {
         "not absurdly far"
     );
 
-    assert_eq!(scene.lights.len(), 1);
+    assert_eq!(scene.lights.len(), 2);
     let key = &scene.lights[0];
     assert_eq!(
         (key.name.as_str(), key.color, key.radius),
-        ("key", Vec3::ONE, 0.0)
+        ("key", Vec3::splat(0.8), 0.0)
     );
     assert!(key.position.y > c.position.y, "above the camera");
+    let head = &scene.lights[1];
+    assert_eq!(
+        (head.name.as_str(), head.position),
+        ("headlight", c.position)
+    );
 }
 
 #[test]

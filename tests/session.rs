@@ -212,3 +212,97 @@ fn a_failed_thread_spawn_is_reported_and_the_next_start_renders() {
     let (batch, _) = render(&t, 2, 1, &|_, _| {}).expect("render");
     assert!(img == batch, "the render after the failure differs");
 }
+
+/// A scene with a big mesh (its BVH build takes a good fraction of a second) at `w`×`h`.
+fn big_scene(w: u32, h: u32) -> Arc<raytree::scene::Scene> {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = raytree::scene::procedural::write_bench_scene(dir.path(), 300_000).expect("write");
+    let mut s = raytree::scene::load_scene_file(&path).expect("loads");
+    s.render.width = w;
+    s.render.height = h;
+    Arc::new(s)
+}
+
+/// `start_build` returns at once and builds on the coordinator: the tracer is handed out once,
+/// before the generation's first event, and the render equals the batch render of a tracer
+/// built on the caller's thread.
+#[test]
+fn a_build_off_the_caller_thread_is_handed_out_before_its_first_tile() {
+    let scene = big_scene(48, 32);
+    let mut session = Session::new(2).expect("pool");
+    let t = Instant::now();
+    let generation = session.start_build(scene.clone(), TraceSettings::default(), 1, None);
+    let returned = t.elapsed();
+    assert!(session.building_for().is_some(), "building is reported");
+    let deadline = Instant::now() + Duration::from_secs(120);
+    let built = loop {
+        assert!(Instant::now() < deadline, "the build never ended");
+        if let Some(t) = session.take_built() {
+            break t;
+        }
+        assert!(
+            session.try_next().is_none(),
+            "an event before the tracer was handed out"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    };
+    // The build took longer than the call: the call did not wait for it.
+    assert!(built.build_secs > returned.as_secs_f64(), "{returned:?}");
+    assert!(session.take_built().is_none(), "handed out once");
+    assert!(session.building_for().is_none());
+    assert!(Arc::ptr_eq(&built.scene, &scene));
+    let (img, _) = collect(&session, generation, 48, 32);
+    let direct = Tracer::new(scene, TraceSettings::default());
+    let (batch, _) = render(&direct, 1, 1, &|_, _| {}).expect("render");
+    assert!(
+        img == batch,
+        "the built tracer renders as one built directly"
+    );
+}
+
+/// A second build (or a plain start, or a stop) while one is in flight supersedes it: the older
+/// tracer is never handed out and none of its events arrive; the newer one is.
+#[test]
+fn a_build_in_flight_is_superseded_and_its_result_never_appears() {
+    let big = big_scene(48, 32);
+    let small = tracer("default", 48, 32, 3);
+    let mut session = Session::new(2).expect("pool");
+    let first = session.start_build(big.clone(), TraceSettings::default(), 1, None);
+    let second = session.start_build(small.scene.clone(), TraceSettings::default(), 1, None);
+    assert!(second > first);
+    let deadline = Instant::now() + Duration::from_secs(120);
+    let built = loop {
+        assert!(Instant::now() < deadline, "the second build never ended");
+        if let Some(t) = session.take_built() {
+            break t;
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    };
+    assert!(
+        Arc::ptr_eq(&built.scene, &small.scene),
+        "the newer scene's tracer"
+    );
+    collect(&session, second, 48, 32);
+    // Let the superseded build run out: it hands nothing out and sends nothing that arrives.
+    let quiet = Instant::now() + Duration::from_secs(3);
+    while Instant::now() < quiet {
+        assert!(
+            session.take_built().is_none(),
+            "a superseded tracer appeared"
+        );
+        assert!(session.try_next().is_none(), "an event after the finish");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    // A plain start and a stop supersede a build too.
+    session.start_build(big.clone(), TraceSettings::default(), 1, None);
+    let plain = session.start(small.clone(), 1, None);
+    collect(&session, plain, 48, 32);
+    session.start_build(big, TraceSettings::default(), 1, None);
+    session.stop();
+    let quiet = Instant::now() + Duration::from_secs(3);
+    while Instant::now() < quiet {
+        assert!(session.take_built().is_none(), "a stopped build appeared");
+        assert!(session.try_next().is_none(), "an event of a stopped build");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}

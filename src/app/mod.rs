@@ -18,6 +18,7 @@ pub mod sweep;
 pub mod tree_view;
 pub mod undo;
 pub mod viewport;
+pub mod watch;
 pub mod workspace;
 
 use std::path::{Path, PathBuf};
@@ -121,6 +122,12 @@ pub struct ViewerApp {
     scene_label: String,
     tracer: Arc<Tracer>,
     session: Session,
+    /// The open scene's files, watched for saves (`None` for built-in scenes).
+    watch: Option<watch::SceneWatch>,
+    /// A build asked of the session and not yet installed (`Some(restart the scene view)`);
+    /// while it is, the current tracer's accelerator does not fit the working copy, so every
+    /// restart builds (a stop in the middle of a build drops it).
+    pending_build: Option<bool>,
     generation: u64,
     progress: Progress,
     /// The film as the latest tiles left it: linear colour and sample-0 facts per pixel.
@@ -232,6 +239,8 @@ impl ViewerApp {
             scene_label: label,
             tracer,
             session,
+            pending_build: None,
+            watch: None,
             generation: 0,
             progress: Progress::default(),
             film: Film::new(w, h),
@@ -258,6 +267,7 @@ impl ViewerApp {
         for w in app.scene.warnings.clone() {
             app.messages.push((false, w));
         }
+        app.watch_scene();
         app.restart(false);
         Ok(app)
     }
@@ -335,31 +345,51 @@ impl ViewerApp {
             self.edit.render.height = nh;
         }
         let scene = Arc::new(self.edit.clone());
-        let (w, h) = (scene.render.width, scene.render.height);
-        let tracer = if rebuild || self.tracer.settings.accel != self.settings.trace.accel {
-            Tracer::new(scene.clone(), self.settings.trace)
-        } else {
-            Tracer::with_accel(
-                scene.clone(),
-                self.settings.trace,
-                self.tracer.accel.clone(),
-            )
+        let target = scene.render.samples;
+        let focus = self.hover.map(|(x, y)| (x as f32, y as f32));
+        if rebuild
+            || self.pending_build.is_some()
+            || self.tracer.settings.accel != self.settings.trace.accel
+        {
+            // Built on the session's coordinator thread: the previous image stays up, with
+            // "building BVH…", until the new tracer is handed out by `poll_session`.
+            self.generation = self
+                .session
+                .start_build(scene, self.settings.trace, target, focus);
+            self.progress = Progress {
+                started: Some(Instant::now()),
+                pass_label: "building BVH…".into(),
+                ..Progress::default()
+            };
+            self.pending_build = Some(self.pending_build.unwrap_or(false) || scene_view);
+            return;
+        }
+        let tracer = Arc::new(Tracer::with_accel(
+            scene,
+            self.settings.trace,
+            self.tracer.accel.clone(),
+        ));
+        self.generation = self.session.start(tracer.clone(), target, focus);
+        self.progress = Progress {
+            started: Some(Instant::now()),
+            pass_label: "preview".into(),
+            ..Progress::default()
         };
-        self.tracer = Arc::new(tracer);
+        self.install_tracer(tracer, scene_view);
+    }
+
+    /// Makes the tracer of the generation just started (`start`ed, or built and handed out)
+    /// the current one: film and display at its size, trees re-traced, scene view restarted.
+    fn install_tracer(&mut self, tracer: Arc<Tracer>, scene_view: bool) {
+        self.tracer = tracer;
+        let scene = self.tracer.scene.clone();
+        let (w, h) = (scene.render.width, scene.render.height);
         self.film.resize(w, h);
         self.scene = scene;
         self.display
             .lock()
             .unwrap_or_else(|p| p.into_inner())
             .resize(w, h);
-        let target = self.scene.render.samples;
-        let focus = self.hover.map(|(x, y)| (x as f32, y as f32));
-        self.generation = self.session.start(self.tracer.clone(), target, focus);
-        self.progress = Progress {
-            started: Some(Instant::now()),
-            pass_label: "preview".into(),
-            ..Progress::default()
-        };
         // The tree follows the scene: re-trace the clicked pixel with the new settings.
         if let Some(tree) = &self.tree {
             let [x, y] = tree.pixel;
@@ -423,8 +453,69 @@ impl ViewerApp {
         true
     }
 
+    /// Watches the open scene's files (see [`watch`]), or nothing for a built-in scene.
+    fn watch_scene(&mut self) {
+        self.watch = None;
+        let Some(source) = self.edit.source.clone() else {
+            return;
+        };
+        match watch::SceneWatch::new(&watch::scene_files(&self.edit, &source)) {
+            Ok(w) => self.watch = Some(w),
+            Err(e) => self.messages.push((false, e)),
+        }
+    }
+
+    /// True while a saved change waits for its reload (the UI keeps polling).
+    pub fn reload_pending(&self) -> bool {
+        self.watch.as_ref().is_some_and(watch::SceneWatch::pending)
+    }
+
+    /// Reloads the open scene after a save. Same geometry: the camera (as moved in the viewer)
+    /// and the clicked trees stay, and the accelerator is kept. A broken save: its error, and
+    /// the last good scene stays.
+    fn reload(&mut self) {
+        let Some(path) = self.edit.source.clone() else {
+            return;
+        };
+        match scene::load_scene_file(&path) {
+            Ok(mut s) => {
+                let same_geometry =
+                    s.triangles == self.edit.triangles && s.spheres == self.edit.spheres;
+                for w in &s.warnings {
+                    self.messages.push((false, w.clone()));
+                }
+                self.messages
+                    .push((false, format!("reloaded {} after a save", path.display())));
+                if same_geometry {
+                    s.camera = self.edit.camera.clone();
+                    self.edit = s;
+                    self.watch_scene();
+                    self.restart(false);
+                } else {
+                    self.replace_scene(s, path.display().to_string());
+                    self.watch_scene();
+                    self.restart(true);
+                }
+            }
+            Err(e) => self.error(format!(
+                "{e} (after a save; the last good scene stays until the file loads again)"
+            )),
+        }
+    }
+
     /// Takes the tiles that arrived, within a time budget so the UI stays responsive.
     pub fn poll_session(&mut self) {
+        if self.watch.as_mut().is_some_and(watch::SceneWatch::poll) {
+            self.reload();
+        }
+        // A tracer built off the UI thread comes before its generation's first tile.
+        if let Some(tracer) = self.session.take_built() {
+            let scene_view = self.pending_build.take().unwrap_or(true);
+            self.install_tracer(tracer, scene_view);
+            self.progress.pass_label = "preview".into();
+        } else if let Some(t) = self.session.building_for() {
+            self.progress.pass_label = format!("building BVH… {:.1} s", t.as_secs_f64());
+        }
         self.scene_view.poll();
         let budget = Instant::now();
         let mut display = self.display.lock().unwrap_or_else(|p| p.into_inner());
@@ -493,6 +584,7 @@ impl ViewerApp {
                 Command::OpenFile(path) => match scene::load_scene_file(&path) {
                     Ok(s) => {
                         self.replace_scene(s, path.display().to_string());
+                        self.watch_scene();
                         rebuild = true;
                         restart = true;
                     }
@@ -502,6 +594,7 @@ impl ViewerApp {
                 Command::OpenBuiltin(name) => match scene::builtin::load_builtin(&name) {
                     Ok(s) => {
                         self.replace_scene(s, name);
+                        self.watch = None;
                         rebuild = true;
                         restart = true;
                     }
@@ -761,6 +854,9 @@ impl eframe::App for ViewerApp {
         self.refresh_if_mode_changed();
         if !self.is_finished() || !self.scene_view.is_finished() {
             ctx.request_repaint();
+        } else if self.watch.is_some() {
+            // Idle: wake up now and then to see whether the scene was saved.
+            ctx.request_repaint_after(watch::DEBOUNCE);
         }
     }
 

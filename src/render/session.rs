@@ -20,8 +20,8 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::{Rect, TILE_SIZE, accumulate_tile, panic_message, tiles, trace_sample};
-use crate::scene::CameraFrame;
-use crate::trace::{RayCounts, SampleInfo, Tracer};
+use crate::scene::{CameraFrame, Scene};
+use crate::trace::{RayCounts, SampleInfo, TraceSettings, Tracer};
 
 /// Side of the blocks of the coarse preview pass.
 pub const PREVIEW_BLOCK: u32 = 8;
@@ -151,6 +151,10 @@ pub struct Session {
     /// A start that could not spawn its thread: handed out by [`Self::try_next`], since no
     /// worker exists to send it.
     start_failure: Cell<Option<SessionEvent>>,
+    /// The tracer a [`Self::start_build`] made, with its generation, until taken.
+    built: Arc<BuiltSlot>,
+    /// The generation whose accelerator is being built and since when, until it is taken.
+    building: Cell<Option<(u64, Instant)>>,
 }
 
 impl Session {
@@ -168,6 +172,8 @@ impl Session {
             tile_hook: None,
             spawn_hook: None,
             start_failure: Cell::new(None),
+            built: Arc::new(Mutex::new(None)),
+            building: Cell::new(None),
         })
     }
 
@@ -211,23 +217,103 @@ impl Session {
     /// (pixels; `None`: the image centre) first. Returns the new generation; when its thread
     /// cannot be spawned, that generation's first event is [`SessionEvent::Failed`].
     pub fn start(&mut self, tracer: Arc<Tracer>, target: u32, focus: Option<(f32, f32)>) -> u64 {
+        self.spawn(Source::Ready(tracer), target, focus)
+    }
+
+    /// Like [`Self::start`], but first builds the tracer (its accelerator) of `scene` on the
+    /// coordinator thread, so the caller never waits for a build (SPEC §4: the window never
+    /// freezes). The tracer is handed out by [`Self::take_built`] once built, just before the
+    /// generation's first tile. A later start or stop supersedes the build: its result is
+    /// dropped, never handed out (the build itself runs to its end in the background, as
+    /// obvhs's cannot be interrupted). A panic in the build is that generation's
+    /// [`SessionEvent::Failed`].
+    pub fn start_build(
+        &mut self,
+        scene: Arc<Scene>,
+        settings: TraceSettings,
+        target: u32,
+        focus: Option<(f32, f32)>,
+    ) -> u64 {
+        let generation = self.spawn(Source::Build(scene, settings), target, focus);
+        self.building.set(Some((generation, Instant::now())));
+        generation
+    }
+
+    /// The tracer built for the current generation by [`Self::start_build`], once, when it is
+    /// ready; `None` before, after it was taken, and for superseded builds.
+    pub fn take_built(&self) -> Option<Arc<Tracer>> {
+        let mut slot = self.built.lock().unwrap_or_else(|p| p.into_inner());
+        match slot.take() {
+            Some((generation, tracer)) if generation == self.generation() => {
+                self.building.set(None);
+                Some(tracer)
+            }
+            _ => None,
+        }
+    }
+
+    /// How long the current generation's accelerator has been building, while it is (until
+    /// [`Self::take_built`] hands it out).
+    pub fn building_for(&self) -> Option<std::time::Duration> {
+        match self.building.get() {
+            Some((generation, since)) if generation == self.generation() => Some(since.elapsed()),
+            _ => None,
+        }
+    }
+
+    fn spawn(&mut self, source: Source, target: u32, focus: Option<(f32, f32)>) -> u64 {
         let generation = self.stop();
         self.start_failure.set(None);
+        self.building.set(None);
         self.stats = Arc::new(LiveStats::default());
-        let job = Job {
-            tracer,
-            target: target.max(1),
-            focus,
-            generation,
-            current: self.generation.clone(),
-            failed: AtomicBool::new(false),
-            sender: self.sender.clone(),
-            stats: self.stats.clone(),
-            tile_hook: self.tile_hook.clone(),
-        };
+        let current = self.generation.clone();
+        let sender = self.sender.clone();
+        let stats = self.stats.clone();
+        let tile_hook = self.tile_hook.clone();
+        let built = self.built.clone();
         let pool = self.pool.clone();
-        // The coordinator runs on its own thread so the UI never waits; it only hands passes to
-        // the pool and stops as soon as the generation moves on.
+        // The coordinator runs on its own thread so the UI never waits; it builds the
+        // accelerator if asked, only hands passes to the pool and stops as soon as the
+        // generation moves on.
+        let coordinator = move || {
+            let tracer = match source {
+                Source::Ready(tracer) => tracer,
+                Source::Build(scene, settings) => {
+                    match catch_unwind(AssertUnwindSafe(|| Tracer::new(scene, settings))) {
+                        Ok(tracer) => {
+                            let tracer = Arc::new(tracer);
+                            let mut slot = built.lock().unwrap_or_else(|p| p.into_inner());
+                            // Superseded while building: the result is dropped here.
+                            if current.load(Ordering::SeqCst) != generation {
+                                return;
+                            }
+                            *slot = Some((generation, tracer.clone()));
+                            tracer
+                        }
+                        Err(panic) => {
+                            let message = panic_message(panic.as_ref());
+                            let _ = sender.send(SessionEvent::Failed {
+                                generation,
+                                message: format!("building the accelerator failed: {message}"),
+                            });
+                            return;
+                        }
+                    }
+                }
+            };
+            let job = Job {
+                tracer,
+                target: target.max(1),
+                focus,
+                generation,
+                current,
+                failed: AtomicBool::new(false),
+                sender,
+                stats,
+                tile_hook,
+            };
+            job.run();
+        };
         let spawned = match &self.spawn_hook {
             Some(hook) => hook(),
             None => Ok(()),
@@ -235,7 +321,7 @@ impl Session {
         .and_then(|()| {
             std::thread::Builder::new()
                 .name(format!("raytree-render-{generation}"))
-                .spawn(move || pool.install(|| job.run()))
+                .spawn(move || pool.install(coordinator))
         });
         // Without its thread the generation would wait for tiles forever: say so instead.
         if let Err(e) = spawned {
@@ -285,6 +371,15 @@ impl Session {
             }
         }
     }
+}
+
+/// Where the coordinator leaves a built tracer, with its generation.
+type BuiltSlot = Mutex<Option<(u64, Arc<Tracer>)>>;
+
+/// What a generation renders: a tracer, or a scene whose tracer is built first.
+enum Source {
+    Ready(Arc<Tracer>),
+    Build(Arc<Scene>, TraceSettings),
 }
 
 fn build_pool(threads: usize) -> Result<rayon::ThreadPool, String> {

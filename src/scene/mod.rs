@@ -10,6 +10,7 @@ pub mod diag;
 pub mod files;
 pub mod load;
 pub mod obj;
+pub mod obj_parse;
 pub mod procedural;
 pub mod rules;
 pub mod sampling;

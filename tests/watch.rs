@@ -1,0 +1,139 @@
+//! Reload on save (headless viewer): a scene file saved in an editor reloads by itself, keeping
+//! the camera moved in the viewer and the clicked tree when the geometry is unchanged; a change
+//! of geometry rebuilds; a broken save shows its error and keeps the last good scene.
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use raytree::app::{Command, ViewerApp};
+use raytree::scene::load_scene_file;
+
+const SCENE: &str = r#"
+[render]
+width = 40
+height = 30
+samples = 1
+max_depth = 2
+
+[camera]
+position = [0, 1, 5]
+look_at = [0, 0.5, 0]
+fov_y = 45
+
+[[light]]
+position = [2, 5, 4]
+color = [1, 1, 1]
+
+[[material]]
+name = "red"
+diffuse = [0.8, 0.1, 0.1]
+
+[[sphere]]
+center = [0, 0.5, 0]
+radius = 0.7
+material = "red"
+"#;
+
+/// Polls the viewer until `done` or 20 s pass; false on timeout.
+fn poll_until(app: &mut ViewerApp, done: impl Fn(&ViewerApp) -> bool) -> bool {
+    let deadline = Instant::now() + Duration::from_secs(20);
+    while Instant::now() < deadline {
+        app.poll_session();
+        app.apply();
+        if done(app) {
+            return true;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    false
+}
+
+/// Saves `text` as an editor does: a new file renamed over the old one.
+fn save(path: &Path, text: &str) {
+    let tmp = path.with_extension("toml.tmp");
+    std::fs::write(&tmp, text).expect("write");
+    std::fs::rename(&tmp, path).expect("rename");
+}
+
+#[test]
+fn saving_the_scene_reloads_it_and_a_broken_save_keeps_the_last_good_one() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("watched.toml");
+    std::fs::write(&path, SCENE).expect("write");
+    let scene = load_scene_file(&path).expect("loads");
+    let mut app = ViewerApp::headless(scene, "watched".into()).expect("the viewer starts");
+    assert!(poll_until(&mut app, ViewerApp::is_finished));
+    // The user moves the camera and clicks a pixel.
+    app.edit.camera.position.x += 0.25;
+    app.command(Command::MoveCamera);
+    app.command(Command::Pick(20, 15));
+    app.apply();
+    assert!(poll_until(&mut app, ViewerApp::is_finished));
+    let camera = app.scene().camera.clone();
+    assert!(app.tree.is_some());
+
+    // A save that changes the light only: reloaded, camera and tree kept.
+    std::thread::sleep(Duration::from_millis(50));
+    save(
+        &path,
+        &SCENE.replace("color = [1, 1, 1]", "color = [0.5, 0.5, 1]"),
+    );
+    assert!(
+        poll_until(&mut app, |a| a.scene().lights[0].color.x == 0.5
+            && a.is_finished()),
+        "the save was not reloaded: {:?}",
+        app.messages
+    );
+    assert_eq!(app.scene().camera, camera, "the viewer's camera stays");
+    assert!(app.tree.is_some(), "the clicked tree stays");
+    assert!(
+        app.messages
+            .iter()
+            .any(|(e, m)| !e && m.starts_with("reloaded "))
+    );
+
+    // A save that moves the sphere: a new scene (rebuilt), its own camera.
+    save(
+        &path,
+        &SCENE.replace("center = [0, 0.5, 0]", "center = [0.3, 0.5, 0]"),
+    );
+    assert!(
+        poll_until(&mut app, |a| a.scene().spheres[0].center.x == 0.3
+            && a.is_finished()),
+        "the geometry change was not reloaded"
+    );
+
+    // A broken save: its error, and the scene stays.
+    let errors = app.messages.iter().filter(|(e, _)| *e).count();
+    save(&path, "[render]\nwidth = 0\n");
+    assert!(
+        poll_until(&mut app, |a| a.messages.iter().filter(|(e, _)| *e).count()
+            > errors),
+        "no error for the broken save"
+    );
+    let (_, message) = app
+        .messages
+        .iter()
+        .rev()
+        .find(|(e, _)| *e)
+        .expect("an error");
+    assert!(
+        message.contains("watched.toml:2:9: render field `width`")
+            && message.contains("the last good scene stays"),
+        "{message}"
+    );
+    assert_eq!(
+        app.scene().spheres[0].center.x,
+        0.3,
+        "the last good scene stays"
+    );
+    assert_eq!(app.scene().render.width, 40);
+
+    // Fixed again: reloaded.
+    save(&path, SCENE);
+    assert!(
+        poll_until(&mut app, |a| a.scene().spheres[0].center.x == 0.0
+            && a.is_finished()),
+        "the fixed file was not reloaded"
+    );
+}
