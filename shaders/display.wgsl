@@ -11,7 +11,7 @@ struct Params {
     // 1 for image modes: no exposure, no tonemap.
     raw: u32,
     // 1: bilinear between the four nearest pixels (a non-integer scale); 0: nearest pixel.
-    smooth: u32,
+    bilinear: u32,
     pad0: u32,
     pad1: u32,
     pad2: u32,
@@ -49,7 +49,7 @@ fn aces(c: vec3<f32>) -> vec3<f32> {
 fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     let size = textureDimensions(image);
     var c: vec3<f32>;
-    if (params.smooth == 1u) {
+    if (params.bilinear == 1u) {
         // Bilinear by hand: the float texture is not filterable on every adapter.
         let f = in.uv * vec2<f32>(size) - vec2<f32>(0.5);
         let base = floor(f);

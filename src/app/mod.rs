@@ -62,6 +62,10 @@ pub struct Prefs {
 /// The viewer's default sample target.
 pub const VIEWER_SAMPLES: u32 = 64;
 
+/// The narrowest window (points) whose first run shows the settings panel: below it the render
+/// would get less than half the window, so the panel starts hidden (Ctrl+B shows it).
+pub const SETTINGS_MIN_WIDTH: f32 = 1300.0;
+
 /// How long the render pane's size must hold before the render follows it.
 pub const PANE_SIZE_DEBOUNCE: Duration = Duration::from_millis(250);
 
@@ -152,6 +156,9 @@ pub struct ViewerApp {
     pane_px: Option<(u32, u32)>,
     /// The scene's own width and height (the working copy's, kept when an edit is refused).
     scene_size: (u32, u32),
+    /// Whether the settings panel's visibility is settled: by the saved preferences, or on
+    /// the first frame by the window's width (shown from [`SETTINGS_MIN_WIDTH`] up).
+    settings_settled: bool,
     /// An export rendering at the scene's size in the background: its message when done.
     export_job: Option<std::sync::mpsc::Receiver<(bool, String)>>,
     pub selected_material: Option<usize>,
@@ -246,17 +253,17 @@ impl ViewerApp {
             prefs.layout_version = workspace::LAYOUT_VERSION;
         }
         prefs.viewer_samples = prefs.viewer_samples.clamp(1, scene::rules::MAX_SAMPLES);
-        Self::with_limit(scene, label, max_side, prefs)
+        let saved = cc
+            .storage
+            .is_some_and(|s| s.get_string(eframe::APP_KEY).is_some());
+        let mut app = Self::with_limit(scene, label, max_side, prefs)?;
+        app.settings_settled = saved;
+        Ok(app)
     }
 
     /// The viewer's state without a window (the GPU display is installed by [`Self::new`]).
     pub fn headless(scene: Scene, label: String) -> Result<Self, String> {
-        Self::with_limit(
-            scene,
-            label,
-            scene::rules::MAX_IMAGE_SIZE,
-            Prefs::default(),
-        )
+        Self::with_limit(scene, label, scene::rules::MAX_IMAGE_SIZE, Prefs::default())
     }
 
     fn with_limit(
@@ -292,6 +299,7 @@ impl ViewerApp {
             pane_px: None,
             scene_size: (w, h),
             export_job: None,
+            settings_settled: false,
             selected_material: None,
             selected_light: None,
             tree: None,
@@ -883,12 +891,43 @@ impl eframe::App for ViewerApp {
         // Hover is transient: the views set it again while the pointer stays on a node.
         self.tree_state.hovered = None;
         scene_pane::advance_playback(self, &ctx);
-        if self.prefs.settings_panel {
+        if !self.settings_settled {
+            self.settings_settled = true;
+            if ctx.content_rect().width() < SETTINGS_MIN_WIDTH {
+                self.toggle_settings_panel();
+            }
+        }
+        if !self.prefs.settings_panel {
+            // A slim strip keeps the hidden settings one click away.
+            egui::Panel::left("settings strip")
+                .resizable(false)
+                .exact_size(30.0)
+                .show(ui, |ui| {
+                    if ui
+                        .button("⚙")
+                        .on_hover_text("show the settings (Ctrl+B)")
+                        .clicked()
+                    {
+                        self.toggle_settings_panel();
+                    }
+                });
+        } else {
             egui::Panel::left("settings")
                 .resizable(true)
-                .default_size(260.0)
+                .default_size(290.0)
                 .show(ui, |ui| {
-                    egui::ScrollArea::vertical().show(ui, |ui| panels::side_panel(self, ui));
+                    ui.with_layout(egui::Layout::right_to_left(egui::Align::Min), |ui| {
+                        if ui
+                            .small_button("« hide")
+                            .on_hover_text("hide the settings (Ctrl+B); the render gets the room")
+                            .clicked()
+                        {
+                            self.toggle_settings_panel();
+                        }
+                    });
+                    // Scrolled both ways: wide content (an opened material) scrolls instead of
+                    // widening the panel, which would move and resize the render.
+                    egui::ScrollArea::both().show(ui, |ui| panels::side_panel(self, ui));
                 });
         }
         // The panes fill the central panel edge to edge.

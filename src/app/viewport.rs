@@ -107,10 +107,7 @@ pub fn fit_image(avail: egui::Rect, width: u32, height: u32, ppp: f32) -> (egui:
     };
     let size = egui::vec2(w * scale, h * scale);
     let min = ((avail.center().to_vec2() * ppp - size * 0.5).round()) / ppp;
-    (
-        egui::Rect::from_min_size(min.to_pos2(), size / ppp),
-        scale,
-    )
+    (egui::Rect::from_min_size(min.to_pos2(), size / ppp), scale)
 }
 
 /// Which display a paint callback draws: the render view's or the scene view's.

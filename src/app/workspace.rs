@@ -56,7 +56,8 @@ pub fn default_layout() -> Layout {
     let diagram = tiles.insert_pane(Pane::Diagram);
     let list = tiles.insert_pane(Pane::TreeList);
     let tree = tiles.insert_tab_tile(vec![diagram, list]);
-    let right = tiles.insert_container(Linear::new_binary(LinearDir::Vertical, [scene, tree], 0.45));
+    let right =
+        tiles.insert_container(Linear::new_binary(LinearDir::Vertical, [scene, tree], 0.45));
     let root = tiles.insert_container(Linear::new_binary(
         LinearDir::Horizontal,
         [render, right],
@@ -128,7 +129,10 @@ pub fn pane_toggles(app: &mut ViewerApp, ui: &mut Ui) {
         }
     }
     let mut settings = app.prefs.settings_panel;
-    if ui.checkbox(&mut settings, "Settings panel (Ctrl+B)").changed() {
+    if ui
+        .checkbox(&mut settings, "Settings panel (Ctrl+B)")
+        .changed()
+    {
         app.toggle_settings_panel();
     }
     if ui.button("Reset layout").clicked() {
