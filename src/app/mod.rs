@@ -22,6 +22,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use eframe::egui;
+use egui_notify::ToastLevel;
 use serde::{Deserialize, Serialize};
 
 use crate::accel::Accel;
@@ -291,9 +292,7 @@ impl ViewerApp {
             film: Film::new(w, h),
             display: Arc::new(Mutex::new(DisplayState::new(w, h))),
             messages: Vec::new(),
-            toasts: egui_notify::Toasts::default()
-                .with_anchor(egui_notify::Anchor::BottomRight)
-                .with_margin(egui::vec2(12.0, 56.0)),
+            toasts: new_toasts(),
             toasted: 0,
             pane_seen: None,
             pane_px: None,
@@ -355,6 +354,17 @@ impl ViewerApp {
             self.pane_px = None;
         }
         self.pending.push(Command::Restart);
+    }
+
+    /// Shows or hides the settings panel (whatever the window's width).
+    pub fn set_settings_panel(&mut self, shown: bool) {
+        self.prefs.settings_panel = shown;
+        self.settings_settled = true;
+    }
+
+    /// Rays traced by the current generation so far.
+    pub fn rays_traced(&self) -> u64 {
+        self.session.stats().counts().total()
     }
 
     /// The size the viewer renders at: the render pane's pixels (when it follows the pane and
@@ -904,7 +914,7 @@ impl eframe::App for ViewerApp {
                 .exact_size(30.0)
                 .show(ui, |ui| {
                     if ui
-                        .button("⚙")
+                        .button("»")
                         .on_hover_text("show the settings (Ctrl+B)")
                         .clicked()
                     {
@@ -1008,6 +1018,13 @@ fn pane_ui(app: &mut ViewerApp, ui: &mut egui::Ui, pane: workspace::Pane) {
     }
 }
 
+/// The toasts' stack: bottom right, above the status bar, over the panes.
+fn new_toasts() -> egui_notify::Toasts {
+    egui_notify::Toasts::default()
+        .with_anchor(egui_notify::Anchor::BottomRight)
+        .with_margin(egui::vec2(12.0, 56.0))
+}
+
 /// `text` broken into lines of at most about `width` characters at spaces (a toast does not
 /// wrap its text itself).
 pub fn wrap_words(text: &str, width: usize) -> String {
@@ -1045,17 +1062,25 @@ impl ViewerApp {
     fn show_toasts(&mut self, ctx: &egui::Context) {
         for (is_error, text) in self.messages.iter().skip(self.toasted) {
             let text = wrap_words(text, 72);
-            let toast = if *is_error {
-                self.toasts.error(text)
+            // Plain-text marks: egui's default fonts have no emoji for the crate's icons.
+            let level = if *is_error {
+                ToastLevel::Custom("!".into(), egui::Color32::from_rgb(235, 100, 100))
             } else {
-                self.toasts.info(text)
+                ToastLevel::Custom("i".into(), egui::Color32::from_rgb(150, 200, 210))
             };
-            toast
-                .closable(true)
+            self.toasts
+                .add(egui_notify::Toast::custom(text, level))
+                .closable(false)
                 .duration(Some(Duration::from_secs(if *is_error { 20 } else { 6 })));
         }
         self.toasted = self.messages.len();
         self.toasts.show(ctx);
+    }
+
+    /// Takes every toast off the screen at once (the messages stay in the log).
+    pub fn clear_toasts(&mut self) {
+        self.toasts = new_toasts();
+        self.toasted = self.messages.len();
     }
 
     /// The toasts on screen now.
