@@ -61,8 +61,38 @@ fn main() {
     }
     let (p, f) = (median(preview), median(full));
 
+    // The same edits with the viewer's sample target: a restart stops the refining render,
+    // so the preview and the 1-sample pass arrive as soon as with a 1-sample target.
+    let (mut preview64, mut full64) = (Vec::new(), Vec::new());
+    for i in 0..10 {
+        scene.camera.position.x -= 0.01 * (i as f32 + 1.0);
+        let tracer = Tracer::with_accel(Arc::new(scene.clone()), settings, base.accel.clone());
+        let start = Instant::now();
+        session.start(Arc::new(tracer), raytree::app::VIEWER_SAMPLES, None);
+        loop {
+            match session.try_next() {
+                Some(SessionEvent::PassDone {
+                    pass: Pass::Preview,
+                    ..
+                }) => preview64.push(start.elapsed().as_secs_f64()),
+                Some(SessionEvent::PassDone {
+                    pass: Pass::Samples(1),
+                    ..
+                }) => {
+                    full64.push(start.elapsed().as_secs_f64());
+                    break;
+                }
+                Some(_) => {}
+                None => std::thread::sleep(Duration::from_micros(200)),
+            }
+        }
+    }
+    let (p64, f64_) = (median(preview64), median(full64));
+
     // The UI thread: a frame every 16 ms takes what arrived; time that work per frame.
     let mut app = ViewerApp::headless(scene.clone(), "default".into()).expect("viewer state");
+    // One sample: the frames of a whole render, not of a 64-sample one.
+    app.set_view(1, false);
     let mut frames = Vec::new();
     for _ in 0..3 {
         app.command(Command::Restart);
@@ -87,6 +117,12 @@ fn main() {
         "  edit -> full 1-sample image:   {:.1} ms ({:.2}x the baseline)",
         f * 1e3,
         f / batch
+    );
+    println!(
+        "  with the viewer's {}-sample target: preview {:.1} ms, 1-sample image {:.1} ms",
+        raytree::app::VIEWER_SAMPLES,
+        p64 * 1e3,
+        f64_ * 1e3
     );
     println!(
         "  UI thread per frame taking tiles: median {:.2} ms, worst {:.2} ms over {} frames",
