@@ -749,3 +749,21 @@ fn render_at_pane_size_follows_the_window_and_export_keeps_the_scene_size() {
         "{text:?}"
     );
 }
+
+#[test]
+fn ctrl_b_hides_the_settings_and_the_render_takes_the_room() {
+    let mut h = window(small("default"), [1600.0, 1000.0]);
+    follow_pane(&mut h);
+    assert!(h.state().prefs.settings_panel, "shown in a 1600 px window");
+    let before = h.get_by_label("render viewport").rect();
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::B);
+    h.step();
+    assert!(!h.state().prefs.settings_panel);
+    follow_pane(&mut h);
+    let after = h.get_by_label("render viewport").rect();
+    assert!(after.width() > before.width() + 100.0, "{before:?} -> {after:?}");
+    // The strip left in its place brings the settings back.
+    h.get_by_role_and_label(Role::Button, "»").click();
+    h.step();
+    assert!(h.state().prefs.settings_panel);
+}
