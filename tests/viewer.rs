@@ -761,7 +761,10 @@ fn ctrl_b_hides_the_settings_and_the_render_takes_the_room() {
     assert!(!h.state().prefs.settings_panel);
     follow_pane(&mut h);
     let after = h.get_by_label("render viewport").rect();
-    assert!(after.width() > before.width() + 100.0, "{before:?} -> {after:?}");
+    assert!(
+        after.width() > before.width() + 100.0,
+        "{before:?} -> {after:?}"
+    );
     // The strip left in its place brings the settings back.
     h.get_by_role_and_label(Role::Button, "»").click();
     h.step();

@@ -1208,3 +1208,25 @@ impl ViewerApp {
         &self.tracer.accel
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_pixel_keeps_its_place_at_another_render_size() {
+        assert_eq!(remap_pixel([0, 0], (640, 480), (1280, 960)), [1, 1]);
+        assert_eq!(remap_pixel([639, 479], (640, 480), (320, 240)), [319, 239]);
+        assert_eq!(remap_pixel([320, 240], (640, 480), (800, 300)), [400, 150]);
+        // Never outside the new image.
+        assert_eq!(remap_pixel([9, 9], (10, 10), (3, 3)), [2, 2]);
+    }
+
+    #[test]
+    fn words_wrap_at_spaces_only() {
+        assert_eq!(wrap_words("a bb ccc dddd", 6), "a bb\nccc\ndddd");
+        let long = "x".repeat(30);
+        assert_eq!(wrap_words(&long, 10), long);
+        assert_eq!(wrap_words("", 10), "");
+    }
+}
