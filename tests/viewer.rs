@@ -603,8 +603,8 @@ fn follow_pane(h: &mut Harness<'static, ViewerApp>) {
         h.step();
         let image = h.get_by_label("render viewport").rect();
         let (w, hh) = h.state().render_size();
-        let pane = h.state().prefs.pane_size;
-        if pane
+        // The pane's pixels are the render's, and the image fills it 1:1.
+        if h.state().pane_pixels() == Some((w, hh))
             && (image.width() - w as f32).abs() <= 1.0
             && (image.height() - hh as f32).abs() <= 1.0
         {

@@ -48,7 +48,9 @@ pub struct Prefs {
     pub last_dir: Option<PathBuf>,
     /// The panes' arrangement (replaced by the default when unusable).
     pub layout: workspace::Layout,
-    /// The version of the default layout `layout` grew from: an older one is replaced.
+    /// The version of the default layout `layout` grew from: an older one is replaced (the
+    /// preferences of a run before versions were kept read as 0).
+    #[serde(default)]
     pub layout_version: u32,
     /// Samples per pixel the viewer refines to before it idles (the scene's `samples` is the
     /// batch render's, for export and the command line).
@@ -365,6 +367,14 @@ impl ViewerApp {
     /// Rays traced by the current generation so far.
     pub fn rays_traced(&self) -> u64 {
         self.session.stats().counts().total()
+    }
+
+    /// The render pane's size in pixels as last drawn (`None`: not drawn yet, or the render
+    /// does not follow it).
+    pub fn pane_pixels(&self) -> Option<(u32, u32)> {
+        self.pane_seen
+            .map(|(px, _)| px)
+            .filter(|_| self.prefs.pane_size)
     }
 
     /// The size the viewer renders at: the render pane's pixels (when it follows the pane and
@@ -829,7 +839,7 @@ impl ViewerApp {
             ..self.scene_view.filter.clone()
         };
         let drawn = if scene_view {
-            let (w, h) = (self.scene.render.width, self.scene.render.height);
+            let (w, h) = self.scene_size;
             let camera = self.scene_view.camera.clone();
             crate::scene_view::headless::scene_view_image(
                 &self.scene,
@@ -1212,6 +1222,17 @@ impl ViewerApp {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn preferences_saved_before_layout_versions_get_the_new_layout() {
+        let old: Prefs = serde_json::from_str(r#"{"exposure": 2.0}"#).expect("old prefs");
+        assert_eq!(old.layout_version, 0);
+        assert_eq!(old.exposure, 2.0);
+        assert_eq!(old.viewer_samples, VIEWER_SAMPLES);
+        assert!(old.pane_size);
+        let now = Prefs::default();
+        assert_eq!(now.layout_version, workspace::LAYOUT_VERSION);
+    }
 
     #[test]
     fn a_pixel_keeps_its_place_at_another_render_size() {
