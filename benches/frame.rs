@@ -51,7 +51,14 @@ fn main() {
     let mut h = Harness::builder()
         .with_size([1600.0, 1000.0])
         .renderer(renderer)
-        .build_eframe(|cc| ViewerApp::new(cc, scene, "kitchen".into()).expect("the viewer"));
+        .build_eframe(|cc| {
+            // The scene's size and sample count, as before the viewer's own target.
+            let samples = scene.render.samples;
+            let mut app = ViewerApp::new(cc, scene, "kitchen".into()).expect("the viewer");
+            app.set_view(samples, false);
+            app.set_settings_panel(true);
+            app
+        });
     settle(&mut h);
     let (base, base_worst) = frames(&mut h, 60);
 

@@ -23,8 +23,9 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// Batch (packets), batch (single rays), edit → preview and edit → full image, in seconds.
-fn latencies(mut scene: Scene) -> [f64; 4] {
+/// Batch (packets), batch (single rays), edit → preview and edit → full image, then preview
+/// and full image with the viewer's sample target, in seconds.
+fn latencies(mut scene: Scene) -> [f64; 6] {
     scene.render.width = 1280;
     scene.render.height = 720;
     let settings = TraceSettings::default();
@@ -65,7 +66,40 @@ fn latencies(mut scene: Scene) -> [f64; 4] {
             }
         }
     }
-    [median(batch), median(single), median(preview), median(full)]
+    // The same edits with the viewer's sample target: a restart stops the refining render,
+    // so the preview and the 1-sample pass arrive as soon as with a 1-sample target.
+    let (mut preview64, mut full64) = (Vec::new(), Vec::new());
+    for i in 0..10 {
+        scene.camera.position.x -= 0.01 * (i as f32 + 1.0);
+        let tracer = Tracer::with_accel(Arc::new(scene.clone()), settings, base.accel.clone());
+        let start = Instant::now();
+        session.start(Arc::new(tracer), raytree::app::VIEWER_SAMPLES, None);
+        loop {
+            match session.try_next() {
+                Some(SessionEvent::PassDone {
+                    pass: Pass::Preview,
+                    ..
+                }) => preview64.push(start.elapsed().as_secs_f64()),
+                Some(SessionEvent::PassDone {
+                    pass: Pass::Samples(1),
+                    ..
+                }) => {
+                    full64.push(start.elapsed().as_secs_f64());
+                    break;
+                }
+                Some(_) => {}
+                None => std::thread::sleep(Duration::from_micros(200)),
+            }
+        }
+    }
+    [
+        median(batch),
+        median(single),
+        median(preview),
+        median(full),
+        median(preview64),
+        median(full64),
+    ]
 }
 
 fn main() {
@@ -83,7 +117,7 @@ fn main() {
     ];
     let threads = Session::new(0).expect("pool").threads();
     for (name, scene) in scenes {
-        let [batch, single, p, f] = latencies(scene);
+        let [batch, single, p, f, p64, f64_] = latencies(scene);
         println!("viewer latency, {name} 1280x720, {threads} threads, median of 10 edits");
         println!("  batch 1-spp render (baseline): {:.1} ms", batch * 1e3);
         println!(
@@ -101,6 +135,12 @@ fn main() {
             f * 1e3,
             f / batch
         );
+        println!(
+            "  with the viewer's {}-sample target: preview {:.1} ms, 1-sample image {:.1} ms",
+            raytree::app::VIEWER_SAMPLES,
+            p64 * 1e3,
+            f64_ * 1e3
+        );
     }
     let mut scene = load_builtin("default").expect("built-in scene");
     scene.render.width = 1280;
@@ -108,6 +148,8 @@ fn main() {
 
     // The UI thread: a frame every 16 ms takes what arrived; time that work per frame.
     let mut app = ViewerApp::headless(scene.clone(), "default".into()).expect("viewer state");
+    // One sample: the frames of a whole render, not of a 64-sample one.
+    app.set_view(1, false);
     let mut frames = Vec::new();
     for _ in 0..3 {
         app.command(Command::Restart);

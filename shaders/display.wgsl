@@ -10,6 +10,11 @@ struct Params {
     encode_srgb: u32,
     // 1 for image modes: no exposure, no tonemap.
     raw: u32,
+    // 1: bilinear between the four nearest pixels (a non-integer scale); 0: nearest pixel.
+    bilinear: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 };
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -43,9 +48,23 @@ fn aces(c: vec3<f32>) -> vec3<f32> {
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     let size = textureDimensions(image);
-    // Nearest pixel: the viewer is for reading pixel values, not for smoothing them.
-    let p = min(vec2<u32>(in.uv * vec2<f32>(size)), size - vec2<u32>(1u, 1u));
-    var c = textureLoad(image, p, 0).rgb;
+    var c: vec3<f32>;
+    if (params.bilinear == 1u) {
+        // Bilinear by hand: the float texture is not filterable on every adapter.
+        let f = in.uv * vec2<f32>(size) - vec2<f32>(0.5);
+        let base = floor(f);
+        let t = f - base;
+        let last = vec2<i32>(size) - vec2<i32>(1);
+        let a = clamp(vec2<i32>(base), vec2<i32>(0), last);
+        let b = clamp(vec2<i32>(base) + vec2<i32>(1), vec2<i32>(0), last);
+        let top = mix(textureLoad(image, a, 0).rgb, textureLoad(image, vec2<i32>(b.x, a.y), 0).rgb, t.x);
+        let bottom = mix(textureLoad(image, vec2<i32>(a.x, b.y), 0).rgb, textureLoad(image, b, 0).rgb, t.x);
+        c = mix(top, bottom, t.y);
+    } else {
+        // Nearest pixel at whole scales: pixel values read as they are.
+        let p = min(vec2<u32>(in.uv * vec2<f32>(size)), size - vec2<u32>(1u, 1u));
+        c = textureLoad(image, p, 0).rgb;
+    }
     if (params.raw == 0u) {
         c = c * params.exposure;
         if (params.tonemap == 1u) {

@@ -30,7 +30,20 @@ fn small(name: &str) -> Scene {
     s
 }
 
+/// The viewer at 1280×800 rendering the scene at its own size to its own sample count (so
+/// its image equals the batch render's), the settings shown.
 fn harness(scene: Scene) -> Harness<'static, ViewerApp> {
+    let samples = scene.render.samples;
+    let mut h = window(scene, [1280.0, 800.0]);
+    h.state_mut().set_view(samples, false);
+    h.state_mut().set_settings_panel(true);
+    h.step();
+    h
+}
+
+/// The viewer in a `size` window, as a new user gets it: the viewer's sample target, the
+/// render at the pane's size, the settings panel as the window's width has it.
+fn window(scene: Scene, size: [f32; 2]) -> Harness<'static, ViewerApp> {
     let renderer =
         std::panic::catch_unwind(AssertUnwindSafe(egui_kittest::wgpu::WgpuTestRenderer::new))
             .unwrap_or_else(|_| {
@@ -40,7 +53,7 @@ fn harness(scene: Scene) -> Harness<'static, ViewerApp> {
                 )
             });
     Harness::builder()
-        .with_size([1280.0, 800.0])
+        .with_size(size)
         .renderer(renderer)
         .build_eframe(|cc| ViewerApp::new(cc, scene, "test".into()).expect("the viewer starts"))
 }
@@ -125,8 +138,8 @@ fn dropping_a_bad_scene_shows_its_error_and_keeps_the_old_scene() {
         message.contains("broken.toml:2:") && message.contains("radius"),
         "{message}"
     );
-    // The message is on screen, and the quiz scene is still the one shown.
-    h.get_by_label_contains("broken.toml:2:");
+    // The message is on screen as a toast, and the quiz scene is still the one shown.
+    assert!(h.state().toasts_shown() >= 1);
     assert_eq!(h.state().scene().triangles.len(), triangles);
     assert!(h.state().scene().spheres.is_empty());
 }
@@ -141,7 +154,10 @@ fn export_via(h: &mut Harness<'static, ViewerApp>, choice: &str, out: &std::path
     h.step();
     h.step();
     h.step();
-    h.get_by_role(Role::TextInput)
+    // The file name field is the dialog's last text field (the folder's path is the first).
+    h.get_all_by_role(Role::TextInput)
+        .last()
+        .expect("the file name field")
         .set_text_value_accesskit(out.to_str().expect("utf-8 path"));
     h.step();
     h.get_by_role_and_label(Role::Button, "Save").click();
@@ -287,8 +303,16 @@ fn clicking_a_pixel_shows_its_ray_tree_in_every_view() {
     assert_eq!(tree.pixel, [GLASS.0, GLASS.1]);
     assert!(tree.nodes > 3, "the glass sphere's tree has children");
     let [x, y] = tree.pixel;
+    // The list is the diagram's neighbouring tab.
+    h.get_by_role_and_label(Role::Button, "Ray tree").click();
+    h.step();
+    h.step();
     h.get_by_label_contains(&format!("Ray tree of ({x}, {y})"));
     assert!(h.query_all_by_label_contains("primary d0").count() >= 1);
+    h.get_by_role_and_label(Role::Button, "Ray tree diagram")
+        .click();
+    h.step();
+    h.step();
     // The diagram shows the same tree, its root labelled with what the primary ray met.
     h.get_by_label(&format!("ray tree diagram of ({x}, {y})"));
     let root = tree.root.hit.as_ref().expect("the sphere").object.clone();
@@ -427,13 +451,29 @@ fn mask_status(h: &mut Harness<'static, ViewerApp>) {
     ));
 }
 
-#[test]
-fn window_snapshot() {
-    let mut h = harness(small("default"));
+/// A snapshot of the window at `size` as a new user sees it (the render at the pane's size,
+/// 4 samples for speed).
+fn window_snapshot(size: [f32; 2], name: &str) {
+    let mut h = window(small("default"), size);
+    h.state_mut().set_view(4, true);
+    follow_pane(&mut h);
     settle(&mut h);
+    // The toast of the hidden settings (at 1024) fades on a timer: take it off.
+    h.state_mut().clear_toasts();
+    h.step();
     // Timings and rates differ from run to run: hide the status line that shows them.
     mask_status(&mut h);
-    h.snapshot("viewer_default");
+    h.snapshot(name);
+}
+
+#[test]
+fn window_snapshot_1024x640() {
+    window_snapshot([1024.0, 640.0], "viewer_1024x640");
+}
+
+#[test]
+fn window_snapshot_1600x1000() {
+    window_snapshot([1600.0, 1000.0], "viewer_1600x1000");
 }
 
 #[test]
@@ -540,6 +580,9 @@ fn opening_another_scene_clears_the_pinned_and_extra_trees() {
     let (a, b) = (pixel_pos(&h, GLASS.0, GLASS.1), pixel_pos(&h, 99, 53));
     click(&mut h, a, egui::Modifiers::NONE);
     click(&mut h, b, egui::Modifiers::SHIFT);
+    h.get_by_role_and_label(Role::Button, "Ray tree").click();
+    h.step();
+    h.step();
     h.get_by_role_and_label(Role::Button, "Pin for comparison")
         .click();
     h.step();
@@ -551,4 +594,179 @@ fn opening_another_scene_clears_the_pinned_and_extra_trees() {
     h.step();
     assert!(h.state().tree_state.pinned.is_none());
     assert_eq!(h.state().trees().count(), 0);
+}
+
+/// Steps until the render follows the pane (the pane's pixels are the render's), or panics.
+fn follow_pane(h: &mut Harness<'static, ViewerApp>) {
+    let deadline = Instant::now() + Duration::from_secs(30);
+    loop {
+        h.step();
+        let image = h.get_by_label("render viewport").rect();
+        let (w, hh) = h.state().render_size();
+        // The pane's pixels are the render's, and the image fills it 1:1.
+        if h.state().pane_pixels() == Some((w, hh))
+            && (image.width() - w as f32).abs() <= 1.0
+            && (image.height() - hh as f32).abs() <= 1.0
+        {
+            return;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "the render ({w}x{hh}) never followed the pane ({image:?})"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+/// The render image's area as a fraction of the window's.
+fn image_share(h: &Harness<'static, ViewerApp>) -> f32 {
+    let image = h.get_by_label("render viewport").rect();
+    let window = h.ctx.content_rect();
+    image.area() / window.area()
+}
+
+#[test]
+fn the_render_holds_half_the_window_and_its_place_when_a_pixel_is_clicked() {
+    for size in [[1024.0, 640.0], [1600.0, 1000.0]] {
+        let mut h = window(small("default"), size);
+        follow_pane(&mut h);
+        let before = h.get_by_label("render viewport").rect();
+        let share = image_share(&h);
+        assert!(
+            share >= 0.5,
+            "{size:?}: the render has {share:.2} of the window"
+        );
+        // Click a third of the way across: the tree is of the pixel under the pointer.
+        let at = before.lerp_inside(egui::vec2(0.35, 0.6));
+        click(&mut h, at, egui::Modifiers::NONE);
+        h.run_steps(3);
+        let tree = h.state().tree.clone().expect("a tree after the click");
+        let after = h.get_by_label("render viewport").rect();
+        assert_eq!(before, after, "{size:?}: the render moved or changed size");
+        assert!(image_share(&h) >= 0.5);
+        let [x, y] = tree.pixel;
+        let centre = pixel_pos(&h, x, y);
+        assert!(
+            (centre - at).length() <= 1.0,
+            "{size:?}: pixel ({x}, {y}) is at {centre:?}, the click at {at:?}"
+        );
+        // The diagram opened in its own pane, beside the render.
+        let diagram = h
+            .get_by_label(&format!("ray tree diagram of ({x}, {y})"))
+            .rect();
+        assert!(
+            !diagram.intersects(after),
+            "{size:?}: the diagram covers the render"
+        );
+    }
+}
+
+#[test]
+fn toasts_do_not_move_the_layout() {
+    let mut h = window(small("default"), [1024.0, 640.0]);
+    follow_pane(&mut h);
+    let before = h.get_by_label("render viewport").rect();
+    let menu = h.get_by_label("Scene").rect();
+    let shown = h.state().toasts_shown();
+    for i in 0..4 {
+        h.state_mut()
+            .messages
+            .push((i % 2 == 0, format!("message {i}")));
+    }
+    h.run_steps(3);
+    assert_eq!(h.state().toasts_shown(), shown + 4);
+    assert_eq!(h.get_by_label("render viewport").rect(), before);
+    assert_eq!(h.get_by_label("Scene").rect(), menu);
+}
+
+#[test]
+fn the_viewer_refines_to_its_sample_target_then_idles() {
+    let mut h = harness(small("glass"));
+    h.state_mut().set_view(8, false);
+    h.step();
+    settle(&mut h);
+    // The viewer's target, not the scene's batch samples (1), which stay for export.
+    assert_eq!(h.state().samples_done(), 8);
+    assert_eq!(h.state().scene().render.samples, 1);
+    let rays = h.state().rays_traced();
+    let generation = h.state().generation();
+    for _ in 0..10 {
+        h.step();
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert_eq!(
+        h.state().rays_traced(),
+        rays,
+        "rays traced after the target"
+    );
+    assert_eq!(h.state().generation(), generation);
+    // Nothing asks for another frame: the window idles.
+    h.run_steps(2);
+    assert!(
+        !h.ctx.has_requested_repaint(),
+        "a finished render keeps repainting"
+    );
+    // The converged film is the batch render at 8 samples.
+    let mut scene = h.state().scene().clone();
+    scene.render.samples = 8;
+    assert!(h.state().image() == batch(&scene));
+}
+
+#[test]
+fn render_at_pane_size_follows_the_window_and_export_keeps_the_scene_size() {
+    let mut h = window(small("glass"), [1280.0, 800.0]);
+    h.state_mut().set_view(1, true);
+    follow_pane(&mut h);
+    let first = h.state().render_size();
+    assert!(first.0 > 300 && first.1 > 300, "{first:?}");
+    h.set_size(egui::vec2(1000.0, 700.0));
+    // The size settles after the debounce; until then the old render is shown scaled.
+    h.step();
+    assert_eq!(h.state().render_size(), first);
+    follow_pane(&mut h);
+    let second = h.state().render_size();
+    assert_ne!(second, first);
+    // The scene's own size is kept for export and saving.
+    assert_eq!(
+        (h.state().edit.render.width, h.state().edit.render.height),
+        (160, 120)
+    );
+    settle(&mut h);
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("shot.png");
+    export_via(&mut h, "Render (PNG or EXR)", &out);
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while h.state().exporting() {
+        assert!(Instant::now() < deadline, "the export did not finish");
+        h.step();
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let (size, _, text) = read_png(&out);
+    assert_eq!(size, (160, 120));
+    assert!(
+        text.iter()
+            .any(|(k, v)| k == "raytree.samples" && v == "1/1"),
+        "{text:?}"
+    );
+}
+
+#[test]
+fn ctrl_b_hides_the_settings_and_the_render_takes_the_room() {
+    let mut h = window(small("default"), [1600.0, 1000.0]);
+    follow_pane(&mut h);
+    assert!(h.state().prefs.settings_panel, "shown in a 1600 px window");
+    let before = h.get_by_label("render viewport").rect();
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::B);
+    h.step();
+    assert!(!h.state().prefs.settings_panel);
+    follow_pane(&mut h);
+    let after = h.get_by_label("render viewport").rect();
+    assert!(
+        after.width() > before.width() + 100.0,
+        "{before:?} -> {after:?}"
+    );
+    // The strip left in its place brings the settings back.
+    h.get_by_role_and_label(Role::Button, "»").click();
+    h.step();
+    assert!(h.state().prefs.settings_panel);
 }

@@ -33,10 +33,16 @@ fn harness(scene: Scene) -> Harness<'static, ViewerApp> {
                      (apt-get install mesa-vulkan-drivers libvulkan1)"
                 )
             });
-    Harness::builder()
+    let samples = scene.render.samples;
+    let mut h = Harness::builder()
         .with_size([1280.0, 800.0])
         .renderer(renderer)
-        .build_eframe(|cc| ViewerApp::new(cc, scene, "test".into()).expect("the viewer starts"))
+        .build_eframe(|cc| ViewerApp::new(cc, scene, "test".into()).expect("the viewer starts"));
+    // The scene's own size and samples (quick to settle), the settings shown.
+    h.state_mut().set_view(samples, false);
+    h.state_mut().set_settings_panel(true);
+    h.step();
+    h
 }
 
 /// Steps frames until both progressive renders reach their target.
@@ -277,7 +283,9 @@ fn f1_lists_ray_colours_glyphs_and_the_built_in_scenes() {
 
 #[test]
 fn dragging_a_light_in_the_scene_view_moves_it_as_one_undoable_step() {
-    let scene = small("default");
+    let mut scene = small("default");
+    // A light near the middle of the scene, in view of the narrow scene-view column.
+    scene.lights[0].position = Vec3::new(0.3, 2.5, 0.5);
     let mut h = harness(scene.clone());
     settle(&mut h);
     let rect = h.get_by_label("scene view").rect();
@@ -304,6 +312,7 @@ fn dragging_a_light_in_the_scene_view_moves_it_as_one_undoable_step() {
     assert_eq!(h.state().scene_view.camera, view_camera, "the view orbited");
     assert_eq!(h.state().history.undo_steps(), 1);
     keys(&mut h, egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(&mut h);
     assert!(*h.state().scene() == scene);
 }
 
@@ -335,6 +344,9 @@ fn shift_dragging_a_sphere_in_the_scene_view_moves_it_as_one_undoable_step() {
     let found = raytree::app::gesture::sphere_at(&scene.spheres, &view_camera, rect, from);
     assert_eq!(found, Some(i), "the ray through its centre meets it first");
     drag_with(&mut h, from, egui::vec2(0.0, -40.0), egui::Modifiers::SHIFT);
+    // Moving a sphere rebuilds the accelerator off the UI thread: the scene shown changes
+    // when the new one is built.
+    settle(&mut h);
     let moved = h.state().scene().spheres[i].center;
     assert!(moved != scene.spheres[i].center, "the sphere did not move");
     let (_, y) = frame.project(moved).expect("in view");
@@ -345,5 +357,6 @@ fn shift_dragging_a_sphere_in_the_scene_view_moves_it_as_one_undoable_step() {
     assert_eq!(h.state().scene_view.camera, view_camera, "the view orbited");
     assert_eq!(h.state().history.undo_steps(), 1);
     keys(&mut h, egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(&mut h);
     assert!(*h.state().scene() == scene);
 }

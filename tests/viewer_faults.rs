@@ -30,6 +30,16 @@ fn small(name: &str, width: u32, height: u32, samples: u32) -> Scene {
     s
 }
 
+/// The viewer without a window, refining to the scene's own sample count (not the viewer's
+/// target), so its converged film is the batch render's.
+fn headless(scene: Scene, label: &str) -> ViewerApp {
+    let samples = scene.render.samples;
+    let mut app = ViewerApp::headless(scene, label.into()).expect("the viewer starts");
+    app.set_view(samples, false);
+    app.apply();
+    app
+}
+
 fn batch(scene: &Scene, trace: TraceSettings) -> Image {
     let tracer = Tracer::new(Arc::new(scene.clone()), trace);
     render(&tracer, scene.render.samples, 0, &|_, _| {})
@@ -55,8 +65,11 @@ fn assert_converged(app: &ViewerApp) {
         (image.width, image.height),
         (scene.render.width, scene.render.height)
     );
+    // The film holds the viewer's target of samples.
+    let mut scene = scene.clone();
+    scene.render.samples = app.viewer_target();
     assert!(
-        image == batch(scene, app.settings.trace),
+        image == batch(&scene, app.settings.trace),
         "the converged film differs from the batch render of the final scene: a stale tile"
     );
 }
@@ -66,8 +79,7 @@ fn assert_converged(app: &ViewerApp) {
 /// rebuilds. No edit waits for a render, and then the film converges to the final scene exactly.
 #[test]
 fn bursts_of_edits_never_deadlock_or_leave_stale_tiles() {
-    let mut app = ViewerApp::headless(small("default", 48, 36, 4), "burst".into())
-        .expect("the viewer starts");
+    let mut app = headless(small("default", 48, 36, 4), "burst");
     let start = Instant::now();
     let edits = 400;
     let mut finished_at_once = 0u32;
@@ -116,8 +128,7 @@ fn bursts_of_edits_never_deadlock_or_leave_stale_tiles() {
 #[test]
 fn opening_a_scene_mid_render() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let mut app = ViewerApp::headless(small("default", 160, 120, 8), "default".into())
-        .expect("the viewer starts");
+    let mut app = headless(small("default", 160, 120, 8), "default");
     app.poll_session();
 
     let bad = dir.path().join("bad.toml");
@@ -172,7 +183,14 @@ fn harness(scene: Scene, size: egui::Vec2) -> Harness<'static, ViewerApp> {
     Harness::builder()
         .with_size(size)
         .renderer(renderer)
-        .build_eframe(|cc| ViewerApp::new(cc, scene, "faults".into()).expect("the viewer starts"))
+        .build_eframe(|cc| {
+            // The scene's size and sample count, the settings shown whatever the width.
+            let samples = scene.render.samples;
+            let mut app = ViewerApp::new(cc, scene, "faults".into()).expect("the viewer starts");
+            app.set_view(samples, false);
+            app.set_settings_panel(true);
+            app
+        })
 }
 
 /// Steps the window until its render finishes. The deadline is a hang guard, not a measure of
@@ -266,8 +284,7 @@ fn a_scene_wider_than_the_largest_texture_is_refused() {
 /// scene stays and renders.
 #[test]
 fn an_edit_far_beyond_the_scene_size_limit_is_refused() {
-    let mut app =
-        ViewerApp::headless(small("default", 32, 24, 1), "far".into()).expect("the viewer starts");
+    let mut app = headless(small("default", 32, 24, 1), "far");
     let spheres = app.scene().spheres.clone();
     let messages = app.messages.len();
     let mut far = app.edit.spheres[0];

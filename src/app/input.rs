@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use eframe::egui;
 
-use super::file_browser::{BrowseFor, FileBrowser};
+use super::dialog::{BrowseFor, FileBrowser};
 use super::paint3d::ScreenView;
 use super::viewport::{DisplayCallback, DisplayId};
 use super::{Command, ViewerApp, gesture, legend, scene_pane};
@@ -79,21 +79,18 @@ impl ViewerApp {
 
     /// Draws the render fitted into `ui`'s space and handles orbit, pan, zoom, click and hover.
     pub(super) fn viewport(&mut self, ui: &mut egui::Ui) {
-        let (w, h) = (
-            self.scene.render.width as f32,
-            self.scene.render.height as f32,
-        );
         let mut avail = ui.available_rect_before_wrap();
         if avail.width() < 1.0 || avail.height() < 1.0 {
             return; // a zero-area window: nothing to draw
         }
-        // A mode that maps values to colours gets its scale in a strip beside the image.
+        // A mode that maps values to colours gets its scale in a strip beside (or under) the image.
         let scale = super::modes::colour_scale(self.prefs.mode, self.scene.render.max_depth);
         if let Some(scale) = &scale
             && avail.width() > 2.0 * legend::SCALE_WIDTH
             && avail.height() > 2.0 * legend::SCALE_HEIGHT
         {
-            let (image, strip, below) = legend::place_scale(avail, w, h);
+            let (rw, rh) = self.render_size();
+            let (image, strip, below) = legend::place_scale(avail, rw as f32, rh as f32);
             avail = image;
             let length = if below {
                 strip.width() * 0.8
@@ -105,9 +102,15 @@ impl ViewerApp {
                 |ui| legend::colour_scale_ui(ui, scale, length, below),
             );
         }
-        let scale = (avail.width() / w).min(avail.height() / h);
-        let size = egui::vec2(w * scale, h * scale);
-        let rect = egui::Rect::from_center_size(avail.center(), size);
+        // The render follows the image area's size (when set); it is drawn fitted, on whole pixels.
+        self.observe_pane(ui.ctx(), avail);
+        let (w, h) = (
+            self.scene.render.width as f32,
+            self.scene.render.height as f32,
+        );
+        let rect = self.image_rect(ui.ctx(), avail);
+        let size = rect.size();
+        let scale = size.x / w;
         let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
         response
             .widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, "render viewport"));

@@ -5,7 +5,7 @@
 //! and the settings and return [`Command`]s; [`ViewerApp::apply`] carries them out once, at the
 //! end of the frame, where any edit restarts the progressive render with a new generation.
 
-mod file_browser;
+mod dialog;
 mod film;
 pub mod gesture;
 mod input;
@@ -26,6 +26,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use eframe::egui;
+use egui_notify::ToastLevel;
 use serde::{Deserialize, Serialize};
 
 use crate::accel::Accel;
@@ -35,7 +36,7 @@ use crate::render::session::{Pass, Session, SessionEvent};
 use crate::render::{Image, RenderSettings};
 use crate::scene::{self, Scene};
 use crate::trace::{TraceSettings, Tracer};
-use file_browser::{BrowseFor, FileBrowser};
+use dialog::{BrowseFor, FileBrowser};
 use film::Film;
 use modes::ImageMode;
 use viewport::{DisplayState, GpuDisplay, SharedDisplay};
@@ -53,7 +54,29 @@ pub struct Prefs {
     pub layout: workspace::Layout,
     /// Degrees the camera orbits for a drag across the whole image width.
     pub orbit_degrees: f32,
+    /// The version of the default layout `layout` grew from: an older one is replaced (the
+    /// preferences of a run before versions were kept read as 0).
+    #[serde(default)]
+    pub layout_version: u32,
+    /// Samples per pixel the viewer refines to before it idles (the scene's `samples` is the
+    /// batch render's, for export and the command line).
+    pub viewer_samples: u32,
+    /// Render at the render pane's pixel size (the scene's width and height are kept for
+    /// export and saving); off: render at the scene's size.
+    pub pane_size: bool,
+    /// Whether the settings panel on the left is shown (F9).
+    pub settings_panel: bool,
 }
+
+/// The viewer's default sample target.
+pub const VIEWER_SAMPLES: u32 = 64;
+
+/// The narrowest window (points) whose first run shows the settings panel: below it the render
+/// would get less than half the window, so the panel starts hidden (Ctrl+B shows it).
+pub const SETTINGS_MIN_WIDTH: f32 = 1300.0;
+
+/// How long the render pane's size must hold before the render follows it.
+pub const PANE_SIZE_DEBOUNCE: Duration = Duration::from_millis(250);
 
 impl Default for Prefs {
     fn default() -> Self {
@@ -64,6 +87,10 @@ impl Default for Prefs {
             last_dir: None,
             layout: workspace::default_layout(),
             orbit_degrees: 180.0,
+            layout_version: workspace::LAYOUT_VERSION,
+            viewer_samples: VIEWER_SAMPLES,
+            pane_size: true,
+            settings_panel: true,
         }
     }
 }
@@ -133,8 +160,23 @@ pub struct ViewerApp {
     /// The film as the latest tiles left it: linear colour and sample-0 facts per pixel.
     film: Film,
     display: SharedDisplay,
-    /// Errors and notices, newest last; shown until dismissed.
+    /// Errors (true) and notices, newest last: the log the toasts are made from.
     pub messages: Vec<(bool, String)>,
+    /// The toasts over the window (they never move the layout), and how many of `messages`
+    /// they have shown.
+    toasts: egui_notify::Toasts,
+    toasted: usize,
+    /// The render pane's size in pixels as last seen, and since when it has held.
+    pane_seen: Option<((u32, u32), Instant)>,
+    /// The size the render follows (`None`: the scene's), set once [`Self::pane_seen`] held.
+    pane_px: Option<(u32, u32)>,
+    /// The scene's own width and height (the working copy's, kept when an edit is refused).
+    scene_size: (u32, u32),
+    /// Whether the settings panel's visibility is settled: by the saved preferences, or on
+    /// the first frame by the window's width (shown from [`SETTINGS_MIN_WIDTH`] up).
+    settings_settled: bool,
+    /// An export rendering at the scene's size in the background: its message when done.
+    export_job: Option<std::sync::mpsc::Receiver<(bool, String)>>,
     pub selected_material: Option<usize>,
     pub selected_light: Option<usize>,
     pub tree: Option<RayTree>,
@@ -164,6 +206,14 @@ pub struct ViewerApp {
     pub history: undo::History,
 }
 
+/// Pixel `p` of a `from`-sized image as the pixel at the same place of a `to`-sized one.
+pub fn remap_pixel(p: [u32; 2], from: (u32, u32), to: (u32, u32)) -> [u32; 2] {
+    let axis = |v: u32, a: u32, b: u32| {
+        (((v as f64 + 0.5) * b as f64 / a.max(1) as f64) as u32).min(b.saturating_sub(1))
+    };
+    [axis(p[0], from.0, to.0), axis(p[1], from.1, to.1)]
+}
+
 /// The most trees shown at once (the current one and the extra ones).
 pub const MAX_TREES: usize = 64;
 
@@ -188,12 +238,7 @@ pub fn run(scene_arg: Option<&str>) -> anyhow::Result<()> {
         "raytree",
         options,
         Box::new(move |cc| {
-            let mut app = ViewerApp::new(cc, scene, label).map_err(|e| -> Box<dyn std::error::Error + Send + Sync> { e.into() })?;
-            if let Some(storage) = cc.storage
-                && let Some(prefs) = eframe::get_value::<Prefs>(storage, eframe::APP_KEY)
-            {
-                app.prefs = prefs;
-            }
+            let app = ViewerApp::new(cc, scene, label).map_err(|e| -> Box<dyn std::error::Error + Send + Sync> { e.into() })?;
             Ok(Box::new(app))
         }),
     )
@@ -216,15 +261,35 @@ impl ViewerApp {
         })?;
         GpuDisplay::install(render_state);
         let max_side = render_state.device.limits().max_texture_dimension_2d;
-        Self::with_limit(scene, label, max_side)
+        // The preferences of the last run, read before the first render so it uses them.
+        let mut prefs = cc
+            .storage
+            .and_then(|s| eframe::get_value::<Prefs>(s, eframe::APP_KEY))
+            .unwrap_or_default();
+        if prefs.layout_version != workspace::LAYOUT_VERSION {
+            prefs.layout = workspace::default_layout();
+            prefs.layout_version = workspace::LAYOUT_VERSION;
+        }
+        prefs.viewer_samples = prefs.viewer_samples.clamp(1, scene::rules::MAX_SAMPLES);
+        let saved = cc
+            .storage
+            .is_some_and(|s| s.get_string(eframe::APP_KEY).is_some());
+        let mut app = Self::with_limit(scene, label, max_side, prefs)?;
+        app.settings_settled = saved;
+        Ok(app)
     }
 
     /// The viewer's state without a window (the GPU display is installed by [`Self::new`]).
     pub fn headless(scene: Scene, label: String) -> Result<Self, String> {
-        Self::with_limit(scene, label, scene::rules::MAX_IMAGE_SIZE)
+        Self::with_limit(scene, label, scene::rules::MAX_IMAGE_SIZE, Prefs::default())
     }
 
-    fn with_limit(scene: Scene, label: String, max_side: u32) -> Result<Self, String> {
+    fn with_limit(
+        scene: Scene,
+        label: String,
+        max_side: u32,
+        prefs: Prefs,
+    ) -> Result<Self, String> {
         let settings = RenderSettings::default();
         let session = Session::new(settings.threads)?;
         let scene_view = scene_pane::SceneView::new(settings.threads)?;
@@ -232,7 +297,7 @@ impl ViewerApp {
         let tracer = Arc::new(Tracer::new(scene.clone(), settings.trace));
         let (w, h) = (scene.render.width, scene.render.height);
         let mut app = Self {
-            prefs: Prefs::default(),
+            prefs,
             edit: (*scene).clone(),
             scene,
             settings,
@@ -246,6 +311,13 @@ impl ViewerApp {
             film: Film::new(w, h),
             display: Arc::new(Mutex::new(DisplayState::new(w, h))),
             messages: Vec::new(),
+            toasts: new_toasts(),
+            toasted: 0,
+            pane_seen: None,
+            pane_px: None,
+            scene_size: (w, h),
+            export_job: None,
+            settings_settled: false,
             selected_material: None,
             selected_light: None,
             tree: None,
@@ -289,6 +361,47 @@ impl ViewerApp {
         self.progress.finished_secs.is_some()
     }
 
+    /// Samples per pixel the viewer refines to (then it idles).
+    pub fn viewer_target(&self) -> u32 {
+        self.prefs.viewer_samples.max(1)
+    }
+
+    /// Sets the viewer's sample target and whether the render follows the pane's size, and
+    /// renders again with them.
+    pub fn set_view(&mut self, viewer_samples: u32, pane_size: bool) {
+        self.prefs.viewer_samples = viewer_samples.clamp(1, scene::rules::MAX_SAMPLES);
+        self.prefs.pane_size = pane_size;
+        if !pane_size {
+            self.pane_px = None;
+        }
+        self.pending.push(Command::Restart);
+    }
+
+    /// Shows or hides the settings panel (whatever the window's width).
+    pub fn set_settings_panel(&mut self, shown: bool) {
+        self.prefs.settings_panel = shown;
+        self.settings_settled = true;
+    }
+
+    /// Rays traced by the current generation so far.
+    pub fn rays_traced(&self) -> u64 {
+        self.session.stats().counts().total()
+    }
+
+    /// The render pane's size in pixels as last drawn (`None`: not drawn yet, or the render
+    /// does not follow it).
+    pub fn pane_pixels(&self) -> Option<(u32, u32)> {
+        self.pane_seen
+            .map(|(px, _)| px)
+            .filter(|_| self.prefs.pane_size)
+    }
+
+    /// The size the viewer renders at: the render pane's pixels (when it follows the pane and
+    /// the pane has been seen) or the scene's width and height.
+    pub fn render_size(&self) -> (u32, u32) {
+        (self.scene.render.width, self.scene.render.height)
+    }
+
     /// The film as it stands: the mean of the samples done so far.
     pub fn image(&self) -> Image {
         self.film.image()
@@ -316,21 +429,33 @@ impl ViewerApp {
         // An edit is held to the loader's rules; a bad one is refused and the scene stays.
         if let Err(e) = scene::rules::check_scene(&self.edit, rebuild) {
             self.error(format!("{e}; the edit was undone"));
+            // The scene rendered may be at the pane's size: the scene's own size comes back.
             self.edit = (*self.scene).clone();
+            (self.edit.render.width, self.edit.render.height) = self.scene_size;
             if self.generation > 0 {
                 return;
             }
         }
+        self.scene_size = (self.edit.render.width, self.edit.render.height);
         // The viewer's buffers must fit the GPU's largest texture and the memory budget: a
         // larger render is shown scaled down (with a message); `raytree render` does full size.
-        let (w, h) = (self.edit.render.width, self.edit.render.height);
+        let (w, h) = match self.pane_px {
+            Some(px) if self.prefs.pane_size => px,
+            _ => (self.edit.render.width, self.edit.render.height),
+        };
         let limit = crate::scene::budget::memory_limit();
         let per_pixel = crate::scene::budget::viewer_memory_estimate(1, 1).max(1);
         let max_pixels = (limit.bytes / per_pixel).max(1) as f64;
         let k = (self.max_side as f64 / w.max(h) as f64)
             .min((max_pixels / (w as f64 * h as f64)).sqrt())
             .min(1.0);
-        if k < 1.0 {
+        let mut render_scene = self.edit.clone();
+        (render_scene.render.width, render_scene.render.height) = (w, h);
+        if k < 1.0 && self.prefs.pane_size && self.pane_px.is_some() {
+            // A pane larger than the GPU or the budget allows: render fewer pixels, scaled up.
+            render_scene.render.width = ((w as f64 * k) as u32).max(1);
+            render_scene.render.height = ((h as f64 * k) as u32).max(1);
+        } else if k < 1.0 {
             let (nw, nh) = (
                 ((w as f64 * k) as u32).max(1),
                 ((h as f64 * k) as u32).max(1),
@@ -343,9 +468,11 @@ impl ViewerApp {
             ));
             self.edit.render.width = nw;
             self.edit.render.height = nh;
+            self.scene_size = (nw, nh);
+            (render_scene.render.width, render_scene.render.height) = (nw, nh);
         }
-        let scene = Arc::new(self.edit.clone());
-        let target = scene.render.samples;
+        let scene = Arc::new(render_scene);
+        let target = self.viewer_target();
         let focus = self.hover.map(|(x, y)| (x as f32, y as f32));
         if rebuild
             || self.pending_build.is_some()
@@ -384,6 +511,15 @@ impl ViewerApp {
         self.tracer = tracer;
         let scene = self.tracer.scene.clone();
         let (w, h) = (scene.render.width, scene.render.height);
+        // Pixels picked at another render size keep their place in the image.
+        let old = (self.scene.render.width, self.scene.render.height);
+        if old != (w, h) {
+            let map = |[x, y]: [u32; 2]| remap_pixel([x, y], old, (w, h));
+            for t in self.tree.iter_mut().chain(self.extra_trees.iter_mut()) {
+                t.pixel = map(t.pixel);
+            }
+            self.hover = None;
+        }
         self.film.resize(w, h);
         self.scene = scene;
         self.display
@@ -707,7 +843,10 @@ impl ViewerApp {
     }
 
     fn export(&mut self, path: &Path) {
-        let target = self.scene.render.samples;
+        if self.render_size() != self.scene_size {
+            return self.export_at_scene_size(path);
+        }
+        let target = self.viewer_target();
         let text = export::stamp(
             &self.scene_label,
             self.progress.samples_done,
@@ -730,6 +869,67 @@ impl ViewerApp {
         }
     }
 
+    /// The render follows the pane: the export renders the scene at its own size and sample
+    /// count in the background (the viewer stays live) and says when the file is written.
+    fn export_at_scene_size(&mut self, path: &Path) {
+        if self.export_job.is_some() {
+            return self.error("an export is still rendering: wait for its message");
+        }
+        let mut scene = (*self.scene).clone();
+        (scene.render.width, scene.render.height) = self.scene_size;
+        let (w, h) = self.scene_size;
+        let samples = scene.render.samples;
+        let stamp = export::stamp(
+            &self.scene_label,
+            samples,
+            samples,
+            &scene.render,
+            &self.settings.trace,
+            self.tracer.accel.kind(),
+        );
+        let tracer = Tracer::with_accel(
+            Arc::new(scene),
+            self.settings.trace,
+            self.tracer.accel.clone(),
+        );
+        let threads = self.settings.threads;
+        let shown = path.display().to_string();
+        let path = path.to_path_buf();
+        let (tx, rx) = std::sync::mpsc::channel();
+        let job = move || {
+            let message = match crate::render::render(&tracer, samples, threads, &|_, _| {}) {
+                Ok((image, _)) => match export::write_image(&path, &image, &stamp) {
+                    Ok(()) => (
+                        false,
+                        format!(
+                            "exported {} ({w}x{h}, the scene's size, {samples} samples)",
+                            path.display()
+                        ),
+                    ),
+                    Err(e) => (true, e.to_string()),
+                },
+                Err(e) => (true, format!("cannot export {}: {e}", path.display())),
+            };
+            // The viewer may have closed meanwhile: then nobody waits for the message.
+            let _ = tx.send(message);
+        };
+        match std::thread::Builder::new()
+            .name("raytree-export".into())
+            .spawn(job)
+        {
+            Ok(_) => {
+                self.export_job = Some(rx);
+                self.messages.push((
+                    false,
+                    format!(
+                        "exporting {shown} at the scene's size ({w}x{h}, {samples} samples)..."
+                    ),
+                ));
+            }
+            Err(e) => self.error(format!("cannot start the export: {e}")),
+        }
+    }
+
     /// Writes the render with the trees drawn over it (`scene_view`: false) or the scene view
     /// at the scene's size (true) as a stamped PNG, drawn by the headless scene view's rules.
     fn export_drawn(&mut self, path: &Path, scene_view: bool) {
@@ -742,7 +942,7 @@ impl ViewerApp {
             ..self.scene_view.filter.clone()
         };
         let drawn = if scene_view {
-            let (w, h) = (self.scene.render.width, self.scene.render.height);
+            let (w, h) = self.scene_size;
             let camera = self.scene_view.camera.clone();
             crate::scene_view::headless::scene_view_image(
                 &self.scene,
@@ -799,18 +999,60 @@ impl eframe::App for ViewerApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
         self.poll_session();
+        self.poll_export();
         self.shortcuts(&ctx);
+        if ctx.input_mut(|i| {
+            i.consume_shortcut(&egui::KeyboardShortcut::new(
+                egui::Modifiers::COMMAND,
+                egui::Key::B,
+            ))
+        }) {
+            self.toggle_settings_panel();
+        }
         panels::top_bar(self, ui);
         panels::status_bar(self, ui);
         // Hover is transient: the views set it again while the pointer stays on a node.
         self.tree_state.hovered = None;
         scene_pane::advance_playback(self, &ctx);
-        egui::Panel::left("settings")
-            .resizable(true)
-            .default_size(300.0)
-            .show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| panels::side_panel(self, ui));
-            });
+        if !self.settings_settled {
+            self.settings_settled = true;
+            if ctx.content_rect().width() < SETTINGS_MIN_WIDTH {
+                self.toggle_settings_panel();
+            }
+        }
+        if !self.prefs.settings_panel {
+            // A slim strip keeps the hidden settings one click away.
+            egui::Panel::left("settings strip")
+                .resizable(false)
+                .exact_size(30.0)
+                .show(ui, |ui| {
+                    if ui
+                        .button("»")
+                        .on_hover_text("show the settings (Ctrl+B)")
+                        .clicked()
+                    {
+                        self.toggle_settings_panel();
+                    }
+                });
+        } else {
+            egui::Panel::left("settings")
+                .resizable(true)
+                .default_size(290.0)
+                .show(ui, |ui| {
+                    ui.with_layout(egui::Layout::right_to_left(egui::Align::Min), |ui| {
+                        if ui
+                            .small_button("« hide")
+                            .on_hover_text("hide the settings (Ctrl+B); the render gets the room")
+                            .clicked()
+                        {
+                            self.toggle_settings_panel();
+                        }
+                    });
+                    // Scrolled both ways: wide content (an opened material) scrolls instead of
+                    // widening the panel, which would move and resize the render.
+                    egui::ScrollArea::both().show(ui, |ui| panels::side_panel(self, ui));
+                });
+        }
         // The panes fill the central panel edge to edge.
         let frame = egui::Frame::central_panel(ui.style()).inner_margin(0);
         egui::CentralPanel::default()
@@ -818,9 +1060,9 @@ impl eframe::App for ViewerApp {
             .show(ui, |ui| workspace::show(self, ui, pane_ui));
         if let Some(browser) = &mut self.browser {
             match browser.show(&ctx) {
-                file_browser::Outcome::Open => {}
-                file_browser::Outcome::Cancel => self.browser = None,
-                file_browser::Outcome::Chose(purpose, path) => {
+                dialog::Outcome::Open => {}
+                dialog::Outcome::Cancel => self.browser = None,
+                dialog::Outcome::Chose(purpose, path) => {
                     self.prefs.last_dir = path.parent().map(Path::to_path_buf);
                     self.pending.push(match purpose {
                         BrowseFor::Open => Command::OpenFile(path),
@@ -849,10 +1091,11 @@ impl eframe::App for ViewerApp {
             self.settings.trace = point.trace;
             self.pending.push(Command::Rebuild);
         }
+        self.show_toasts(&ctx);
         self.apply();
         self.track_edits(&ctx);
         self.refresh_if_mode_changed();
-        if !self.is_finished() || !self.scene_view.is_finished() {
+        if !self.is_finished() || !self.scene_view.is_finished() || self.export_job.is_some() {
             ctx.request_repaint();
         } else if self.watch.is_some() {
             // Idle: wake up now and then to see whether the scene was saved.
@@ -895,7 +1138,169 @@ fn pane_ui(app: &mut ViewerApp, ui: &mut egui::Ui, pane: workspace::Pane) {
     }
 }
 
+/// The toasts' stack: bottom right, above the status bar, over the panes.
+fn new_toasts() -> egui_notify::Toasts {
+    egui_notify::Toasts::default()
+        .with_anchor(egui_notify::Anchor::BottomRight)
+        .with_margin(egui::vec2(12.0, 56.0))
+}
+
+/// `text` broken into lines of at most about `width` characters at spaces (a toast does not
+/// wrap its text itself).
+pub fn wrap_words(text: &str, width: usize) -> String {
+    let mut out = String::new();
+    let mut line = 0;
+    for word in text.split(' ') {
+        let n = word.chars().count();
+        if line > 0 && line + 1 + n > width {
+            out.push('\n');
+            line = 0;
+        } else if line > 0 {
+            out.push(' ');
+            line += 1;
+        }
+        out.push_str(word);
+        line += n;
+    }
+    out
+}
+
 impl ViewerApp {
+    /// Shows the settings panel, or hides it (saying how it comes back).
+    pub fn toggle_settings_panel(&mut self) {
+        self.prefs.settings_panel = !self.prefs.settings_panel;
+        if !self.prefs.settings_panel {
+            self.messages.push((
+                false,
+                "settings hidden: Ctrl+B or View > Settings panel shows them".into(),
+            ));
+        }
+    }
+
+    /// Messages not yet shown become toasts: over the panes, bottom right, never moving the
+    /// layout; notices go after a few seconds, errors stay longer (hover keeps either).
+    fn show_toasts(&mut self, ctx: &egui::Context) {
+        for (is_error, text) in self.messages.iter().skip(self.toasted) {
+            let text = wrap_words(text, 72);
+            // Plain-text marks: egui's default fonts have no emoji for the crate's icons.
+            let level = if *is_error {
+                ToastLevel::Custom("!".into(), egui::Color32::from_rgb(235, 100, 100))
+            } else {
+                ToastLevel::Custom("i".into(), egui::Color32::from_rgb(150, 200, 210))
+            };
+            self.toasts
+                .add(egui_notify::Toast::custom(text, level))
+                .closable(false)
+                .duration(Some(Duration::from_secs(if *is_error { 20 } else { 6 })));
+        }
+        self.toasted = self.messages.len();
+        self.toasts.show(ctx);
+    }
+
+    /// Takes every toast off the screen at once (the messages stay in the log).
+    pub fn clear_toasts(&mut self) {
+        self.toasts = new_toasts();
+        self.toasted = self.messages.len();
+    }
+
+    /// The toasts on screen now.
+    pub fn toasts_shown(&self) -> usize {
+        self.toasts.len()
+    }
+
+    /// Notes the render pane's size `avail` (screen points). When the render follows the pane,
+    /// a size that held for [`PANE_SIZE_DEBOUNCE`] (at once the first time) becomes the render
+    /// size, within the loader's limits.
+    pub(super) fn observe_pane(&mut self, ctx: &egui::Context, avail: egui::Rect) {
+        if !self.prefs.pane_size {
+            return;
+        }
+        let ppp = ctx.pixels_per_point();
+        let max = scene::rules::MAX_IMAGE_SIZE as f32;
+        let side = |v: f32| (v * ppp).floor().clamp(1.0, max) as u32;
+        let px = (side(avail.width()), side(avail.height()));
+        let now = Instant::now();
+        let since = match self.pane_seen {
+            Some((seen, since)) if seen == px => since,
+            _ => {
+                self.pane_seen = Some((px, now));
+                now
+            }
+        };
+        if self.pane_px == Some(px) {
+            return;
+        }
+        let waited = now.duration_since(since);
+        if self.pane_px.is_none() || waited >= PANE_SIZE_DEBOUNCE {
+            self.pane_px = Some(px);
+            self.pending.push(Command::MoveCamera);
+        } else {
+            ctx.request_repaint_after(PANE_SIZE_DEBOUNCE - waited);
+        }
+    }
+
+    /// Where the render is drawn in `avail` (its aspect kept, on whole pixels), the display
+    /// filtering set for that scale.
+    pub(super) fn image_rect(&mut self, ctx: &egui::Context, avail: egui::Rect) -> egui::Rect {
+        let (w, h) = self.render_size();
+        let (rect, scale) = viewport::fit_image(avail, w, h, ctx.pixels_per_point());
+        self.display
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .params
+            .smooth = viewport::smooth_at(scale);
+        rect
+    }
+
+    /// The viewer's own settings, in the render panel: the sample target and the pane size.
+    pub fn view_settings_ui(&mut self, ui: &mut egui::Ui) {
+        let mut target = self.prefs.viewer_samples;
+        let mut pane = self.prefs.pane_size;
+        let changed_target = ui
+            .add(
+                egui::Slider::new(&mut target, 1..=4096)
+                    .logarithmic(true)
+                    .text("viewer samples"),
+            )
+            .on_hover_text(
+                "samples per pixel the viewer refines to, then it idles; the scene's `samples` \
+                 is for export and `raytree render`",
+            )
+            .changed();
+        let changed_pane = ui
+            .checkbox(&mut pane, "render at pane size")
+            .on_hover_text(
+                "render as many pixels as the render pane has (sharp at any window size); the \
+                 scene's width and height stay for export and saving",
+            )
+            .changed();
+        if changed_target || changed_pane {
+            self.set_view(target, pane);
+        }
+    }
+
+    /// Takes the message of a finished background export.
+    fn poll_export(&mut self) {
+        if let Some(rx) = &self.export_job {
+            match rx.try_recv() {
+                Ok(message) => {
+                    self.messages.push(message);
+                    self.export_job = None;
+                }
+                Err(std::sync::mpsc::TryRecvError::Empty) => {}
+                Err(std::sync::mpsc::TryRecvError::Disconnected) => {
+                    self.export_job = None;
+                    self.error("the export stopped before it wrote its file");
+                }
+            }
+        }
+    }
+
+    /// Whether an export is rendering in the background.
+    pub fn exporting(&self) -> bool {
+        self.export_job.is_some()
+    }
+
     fn refresh_if_mode_changed(&mut self) {
         let (mode, exposure, tonemap) = {
             let d = self.display.lock().unwrap_or_else(|p| p.into_inner());
@@ -921,5 +1326,38 @@ impl ViewerApp {
     /// The accelerator in use.
     pub fn accel(&self) -> &Accel {
         &self.tracer.accel
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn preferences_saved_before_layout_versions_get_the_new_layout() {
+        let old: Prefs = serde_json::from_str(r#"{"exposure": 2.0}"#).expect("old prefs");
+        assert_eq!(old.layout_version, 0);
+        assert_eq!(old.exposure, 2.0);
+        assert_eq!(old.viewer_samples, VIEWER_SAMPLES);
+        assert!(old.pane_size);
+        let now = Prefs::default();
+        assert_eq!(now.layout_version, workspace::LAYOUT_VERSION);
+    }
+
+    #[test]
+    fn a_pixel_keeps_its_place_at_another_render_size() {
+        assert_eq!(remap_pixel([0, 0], (640, 480), (1280, 960)), [1, 1]);
+        assert_eq!(remap_pixel([639, 479], (640, 480), (320, 240)), [319, 239]);
+        assert_eq!(remap_pixel([320, 240], (640, 480), (800, 300)), [400, 150]);
+        // Never outside the new image.
+        assert_eq!(remap_pixel([9, 9], (10, 10), (3, 3)), [2, 2]);
+    }
+
+    #[test]
+    fn words_wrap_at_spaces_only() {
+        assert_eq!(wrap_words("a bb ccc dddd", 6), "a bb\nccc\ndddd");
+        let long = "x".repeat(30);
+        assert_eq!(wrap_words(&long, 10), long);
+        assert_eq!(wrap_words("", 10), "");
     }
 }

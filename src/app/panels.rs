@@ -1,10 +1,10 @@
 //! The panels: each edits the working copy of the scene or settings and queues commands; none
 //! applies anything itself.
 
-use eframe::egui::{self, Color32, DragValue, RichText, Ui};
+use eframe::egui::{self, DragValue, RichText, Ui};
 use glam::Vec3;
 
-use super::file_browser::{BrowseFor, FileBrowser};
+use super::dialog::{BrowseFor, FileBrowser};
 use super::modes::ImageMode;
 use super::tree_view;
 use super::{Command, ViewerApp};
@@ -228,29 +228,12 @@ pub fn top_bar(app: &mut ViewerApp, ui: &mut Ui) {
             ui.separator();
             ui.label(RichText::new(&app.scene_label).strong());
         });
-        let mut dismiss = None;
-        for (i, (is_error, msg)) in app.messages.iter().enumerate().rev().take(3) {
-            ui.horizontal(|ui| {
-                let color = if *is_error {
-                    Color32::LIGHT_RED
-                } else {
-                    Color32::LIGHT_YELLOW
-                };
-                ui.colored_label(color, msg);
-                if ui.small_button("x").clicked() {
-                    dismiss = Some(i);
-                }
-            });
-        }
-        if let Some(i) = dismiss {
-            app.messages.remove(i);
-        }
     });
 }
 
 pub fn status_bar(app: &mut ViewerApp, ui: &mut Ui) {
     egui::Panel::bottom("status").show(ui, |ui| {
-        let target = app.scene.render.samples;
+        let target = app.viewer_target();
         let stats = app.session.stats().counts();
         let elapsed = match (app.progress.finished_secs, app.progress.started) {
             (Some(s), _) => s,
@@ -305,6 +288,7 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
     egui::CollapsingHeader::new("Render settings")
         .default_open(true)
         .show(ui, |ui| {
+            app.view_settings_ui(ui);
             let r = &mut app.edit.render;
             restart |= ui
                 .add(egui::Slider::new(&mut r.max_depth, rules::DEPTH).text("max depth"))

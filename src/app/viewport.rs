@@ -7,6 +7,7 @@
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
+use eframe::egui;
 use eframe::egui_wgpu::{self, CallbackResources, CallbackTrait, ScreenDescriptor, wgpu};
 
 use crate::render::Rect;
@@ -19,6 +20,8 @@ pub struct DisplayParams {
     pub tonemap: u32,
     /// Image modes are display colours already: no exposure, no tonemap.
     pub raw: bool,
+    /// Bilinear filtering (the image drawn at a non-integer scale); otherwise nearest pixel.
+    pub smooth: bool,
 }
 
 /// What the texture should hold, shared between the UI thread (which writes pixels and marks
@@ -46,6 +49,7 @@ impl DisplayState {
                 exposure: 1.0,
                 tonemap: 0,
                 raw: false,
+                smooth: false,
             },
         }
     }
@@ -79,6 +83,33 @@ impl DisplayState {
 
 pub type SharedDisplay = Arc<Mutex<DisplayState>>;
 
+/// Whether an image drawn at `scale` screen pixels per image pixel is filtered: nearest pixel
+/// at a whole scale (1:1, or 2×, 3×… for pixel peeping, within 1%), bilinear otherwise, so a
+/// minified or oddly magnified render shows neither jaggies nor dropped pixels.
+pub fn smooth_at(scale: f32) -> bool {
+    let n = scale.round();
+    !(n >= 1.0 && (scale - n).abs() <= 0.01 * n)
+}
+
+/// Where a `width × height` image is drawn in `avail` (screen points, `ppp` pixels per
+/// point): as large as fits with its aspect kept, centred, its corners on whole screen pixels.
+/// Returns the rectangle and the scale in screen pixels per image pixel.
+pub fn fit_image(avail: egui::Rect, width: u32, height: u32, ppp: f32) -> (egui::Rect, f32) {
+    let (w, h) = (width.max(1) as f32, height.max(1) as f32);
+    let px = avail.size() * ppp;
+    let scale = (px.x / w).min(px.y / h).max(f32::MIN_POSITIVE);
+    // Within half a percent of a whole scale, snap to it: 1:1 stays sharp.
+    let n = scale.round();
+    let scale = if n >= 1.0 && (scale - n).abs() <= 0.005 * n {
+        n
+    } else {
+        scale
+    };
+    let size = egui::vec2(w * scale, h * scale);
+    let min = ((avail.center().to_vec2() * ppp - size * 0.5).round()) / ppp;
+    (egui::Rect::from_min_size(min.to_pos2(), size / ppp), scale)
+}
+
 /// Which display a paint callback draws: the render view's or the scene view's.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum DisplayId {
@@ -111,6 +142,8 @@ struct Uniform {
     tonemap: u32,
     encode_srgb: u32,
     raw: u32,
+    smooth: u32,
+    _pad: [u32; 3],
 }
 
 impl GpuDisplay {
@@ -315,6 +348,8 @@ impl CallbackTrait for DisplayCallback {
                 tonemap: state.params.tonemap,
                 encode_srgb: encode_srgb as u32,
                 raw: state.params.raw as u32,
+                smooth: state.params.smooth as u32,
+                _pad: [0; 3],
             };
             queue.write_buffer(uniform, 0, bytemuck::bytes_of(&u));
         }
@@ -337,5 +372,33 @@ impl CallbackTrait for DisplayCallback {
             render_pass.set_bind_group(0, &slot.bind_group, &[]);
             render_pass.draw(0..3, 0..1);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn whole_scales_are_nearest_and_others_smooth() {
+        assert!(!smooth_at(1.0));
+        assert!(!smooth_at(2.0));
+        assert!(!smooth_at(3.004));
+        assert!(smooth_at(1.7));
+        assert!(smooth_at(0.5));
+        assert!(smooth_at(2.5));
+    }
+
+    #[test]
+    fn a_fitted_image_keeps_its_aspect_and_sits_on_whole_pixels() {
+        let avail = egui::Rect::from_min_size(egui::pos2(10.3, 20.0), egui::vec2(400.0, 300.0));
+        let (r, s) = fit_image(avail, 200, 100, 1.0);
+        assert_eq!(s, 2.0);
+        assert_eq!(r.size(), egui::vec2(400.0, 200.0));
+        assert_eq!(r.min.x.fract(), 0.0);
+        // At pane size (the image as many pixels as the pane) the image fills the pane.
+        let (r, s) = fit_image(avail, 600, 450, 1.5);
+        assert_eq!(s, 1.0);
+        assert!((r.width() - 400.0).abs() < 1e-3 && (r.height() - 300.0).abs() < 1e-3);
     }
 }

@@ -1,7 +1,10 @@
 //! The workspace of panes (egui_tiles): the render view, the scene view, the tree diagram and
 //! the tree list with its detail, resizable, hideable (View menu) and re-dockable by dragging
-//! their tabs. The tree's panes open when a pixel is clicked. The layout is part of [`super::Prefs`], so it is remembered between runs; a saved
-//! layout that lacks a pane or holds one twice is replaced by the default.
+//! their tabs. The render has the left of the workspace to itself; the scene view and the
+//! tree's panes share a column on the right, so the tree's panes, which open when a pixel is
+//! clicked, never move or shrink the render. The layout is part of [`super::Prefs`], so it is
+//! remembered between runs; a saved layout that lacks a pane or holds one twice, or grew from
+//! an older default, is replaced by the default.
 
 use eframe::egui::{self, Ui};
 use egui_tiles::{Behavior, Linear, LinearDir, SimplificationOptions, Tile, TileId};
@@ -33,30 +36,33 @@ impl Pane {
 
 pub type Layout = egui_tiles::Tree<Pane>;
 
+/// The version of [`default_layout`]: a saved layout of another version is replaced.
+pub const LAYOUT_VERSION: u32 = 2;
+
+/// The render pane's share of the workspace's width in the default layout.
+pub const RENDER_SHARE: f32 = 0.74;
+
 fn tabs(tiles: &mut egui_tiles::Tiles<Pane>, pane: Pane) -> TileId {
     let id = tiles.insert_pane(pane);
     tiles.insert_tab_tile(vec![id])
 }
 
-/// Render view and scene view side by side on top (two thirds of the height), the diagram and
-/// the tree list below.
+/// The render view on the left ([`RENDER_SHARE`] of the width); on the right the scene view
+/// above and the tree's diagram and list below, as two tabs of one pane (the diagram in front).
 pub fn default_layout() -> Layout {
     let mut tiles = egui_tiles::Tiles::default();
     let render = tabs(&mut tiles, Pane::Render);
     let scene = tabs(&mut tiles, Pane::SceneView);
-    let diagram = tabs(&mut tiles, Pane::Diagram);
-    let list = tabs(&mut tiles, Pane::TreeList);
-    let top = tiles.insert_container(Linear::new_binary(
+    let diagram = tiles.insert_pane(Pane::Diagram);
+    let list = tiles.insert_pane(Pane::TreeList);
+    let tree = tiles.insert_tab_tile(vec![diagram, list]);
+    let right =
+        tiles.insert_container(Linear::new_binary(LinearDir::Vertical, [scene, tree], 0.45));
+    let root = tiles.insert_container(Linear::new_binary(
         LinearDir::Horizontal,
-        [render, scene],
-        0.5,
+        [render, right],
+        RENDER_SHARE,
     ));
-    let bottom = tiles.insert_container(Linear::new_binary(
-        LinearDir::Horizontal,
-        [diagram, list],
-        0.55,
-    ));
-    let root = tiles.insert_container(Linear::new_binary(LinearDir::Vertical, [top, bottom], 0.68));
     egui_tiles::Tree::new(egui::Id::unique("raytree workspace"), root, tiles)
 }
 
@@ -122,8 +128,16 @@ pub fn pane_toggles(app: &mut ViewerApp, ui: &mut Ui) {
             }
         }
     }
-    if ui.button("Default layout").clicked() {
+    let mut settings = app.prefs.settings_panel;
+    if ui
+        .checkbox(&mut settings, "Settings panel (Ctrl+B)")
+        .changed()
+    {
+        app.toggle_settings_panel();
+    }
+    if ui.button("Reset layout").clicked() {
         app.prefs.layout = default_layout();
+        app.prefs.settings_panel = true;
         app.tree_panes_shown = None;
     }
 }
