@@ -14,17 +14,17 @@
 
 use std::sync::Arc;
 
-use glam::{Vec3, Vec3A};
+use glam::{Vec2, Vec3, Vec3A};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::accel::{Accel, AccelKind, PrimHit, PrimSet, Visits};
 use crate::geometry::{
-    Methods, OffsetMethod, Ray, intersect_sphere, offset_ray_origin, sphere_hit_point,
-    triangle_hit_point,
+    Methods, OffsetMethod, Ray, ShadingNormals, interpolate_normal, intersect_sphere, keep_side,
+    offset_ray_origin, sphere_hit_point, terminator_origin, triangle_hit_point,
 };
 use crate::scene::{MaterialId, ObjectId, Scene};
-use crate::shade::{LightTerms, ambient_term, light_terms, reflect, refract};
+use crate::shade::{LightTerms, light_terms_with, reflect, refract};
 
 /// Rays (shadow rays included) one sample may trace; past it, branches end as
 /// [`EndReason::Budget`]. Natural scenes use a few dozen; the budget bounds the work of
@@ -127,13 +127,24 @@ impl Default for SampleInfo {
 pub struct SurfaceHit {
     pub t: f32,
     pub point: Vec3,
-    /// Unit normal turned towards the incoming ray.
+    /// Unit shading normal: the geometric normal, or the one interpolated from the mesh's
+    /// vertex normals, on the side of the surface the ray came from (the geometric side).
     pub normal: Vec3,
+    /// Unit geometric normal turned towards the incoming ray: decides front/back, entering or
+    /// leaving and the ray-origin offset.
+    pub geometric_normal: Vec3,
     pub object: ObjectId,
     pub material: MaterialId,
     pub front_face: bool,
     /// Barycentric weights of the triangle's vertices; `None` for spheres.
     pub barycentric: Option<[f32; 3]>,
+    /// The triangle's unit vertex normals, turned like `geometric_normal`, when it has them.
+    pub vertex_normals: Option<[Vec3; 3]>,
+    /// Texture coordinates where the triangle has them and its material a texture.
+    pub uv: Option<Vec2>,
+    /// The diffuse (`map_Kd`) and ambient (`map_Ka`) texels at `uv`, linear RGB.
+    pub texel_kd: Option<Vec3>,
+    pub texel_ka: Option<Vec3>,
 }
 
 /// One light's shadow ray at a hit, as the tree shows it.
@@ -148,6 +159,10 @@ pub struct ShadowTest {
     pub blocked_by: Option<ObjectId>,
     /// Distance along the shadow ray (from its offset origin) to the blocker.
     pub blocked_at: Option<f32>,
+    /// The shading normal faces the light but the light is behind the geometric surface and
+    /// the smooth surface does not reach above it (STABILITY N3): the light adds nothing, and
+    /// no shadow ray is cast.
+    pub behind_surface: bool,
     pub terms: LightTerms,
 }
 
@@ -156,6 +171,9 @@ pub trait Recorder {
     /// `false` lets the trace skip work done only for the recorder (finding the blocker's name).
     const ENABLED: bool;
     fn enter(&mut self, _kind: RayKind, _depth: u32, _ray: &Ray, _weight: Vec3) {}
+    /// The ray just entered had its direction mirrored back across the geometric plane of the
+    /// surface it leaves (STABILITY N2).
+    fn direction_corrected(&mut self) {}
     fn end(&mut self, _reason: EndReason) {}
     /// The ray ended on visible light `light` at distance `t`.
     fn light(&mut self, _light: usize, _t: f32) {}
@@ -248,6 +266,8 @@ struct Branch {
     kind: RayKind,
     depth: u32,
     weight: Vec3,
+    /// Its direction was bent back across the geometric plane (STABILITY N2).
+    corrected: bool,
 }
 
 /// What every ray of one sample adds to: the ray counts, the pixel's facts and the recorder.
@@ -333,6 +353,7 @@ impl Tracer {
             kind,
             depth,
             weight,
+            corrected: false,
         };
         self.trace_ray(ray, branch, &mut Sample { counts, info, rec })
     }
@@ -340,6 +361,9 @@ impl Tracer {
     /// [`Tracer::trace`] of one ray of a sample.
     fn trace_ray<R: Recorder>(&self, ray: &Ray, b: Branch, s: &mut Sample<'_, R>) -> Vec3 {
         s.rec.enter(b.kind, b.depth, ray, b.weight);
+        if b.corrected {
+            s.rec.direction_corrected();
+        }
         let background = self.scene.render.background;
         let color = if let Some(reason) = self.ends_untraced(b.depth, b.weight, s.info) {
             ended(s, reason);
@@ -384,35 +408,94 @@ impl Tracer {
         }
     }
 
-    /// Hit point, its error bound, geometric normal, object, material and barycentrics.
+    /// Hit point, its error bound, normals, object, material, barycentrics and texture.
     fn surface(&self, ray: &Ray, hit: &PrimHit) -> (SurfaceHit, Vec3) {
         let scene = &self.scene;
         let n_spheres = scene.spheres.len();
         let prim = hit.prim as usize;
+        let mut vertex_normals = None;
+        let mut uvs = None;
         let (point, error, normal, object, material, barycentric) = if prim < n_spheres {
             let s = &scene.spheres[prim];
             let (p, err) = sphere_hit_point(self.methods().sphere, s.center, s.radius, ray, hit.t);
             let n = div3(p - s.center, s.radius).normalize();
             (p, err, n, s.object, s.material, None)
         } else {
-            let tri = &scene.triangles[prim - n_spheres];
+            let index = prim - n_spheres;
+            let tri = &scene.triangles[index];
             let v = &tri.vertices;
             let (p, err) = triangle_hit_point(v, hit.b1, hit.b2);
             let n = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
             let b = [1.0 - hit.b1 - hit.b2, hit.b1, hit.b2];
+            if let Some((attrs, local)) = scene.attributes_of(index) {
+                vertex_normals = attrs.normals_of(local);
+                uvs = attrs.uvs_of(local);
+            }
             (p, err, n, tri.object, tri.material, Some(b))
         };
         let front_face = ray.dir.dot(normal) < 0.0;
+        let side = if front_face { 1.0 } else { -1.0 };
+        let geometric_normal = side * normal;
+        let mut shading_normal = geometric_normal;
+        let b = barycentric.unwrap_or([1.0, 0.0, 0.0]);
+        if let Some(ns) = vertex_normals.as_mut() {
+            *ns = ns.map(|n| side * n);
+            if let Some(n) = interpolate_normal(ns, b) {
+                shading_normal = n;
+            }
+        }
+        let uv = uvs.map(|t| b[0] * t[0] + b[1] * t[1] + b[2] * t[2]);
+        let (mut texel_kd, mut texel_ka) = (None, None);
+        if let Some(uv) = uv {
+            let m = scene.material(material);
+            let texel = |map: Option<crate::scene::TextureId>| {
+                map.and_then(|id| scene.texture(id)).map(|t| t.sample(uv))
+            };
+            texel_kd = texel(m.diffuse_map);
+            texel_ka = texel(m.ambient_map);
+        }
         let surface = SurfaceHit {
             t: hit.t,
             point,
-            normal: if front_face { normal } else { -normal },
+            normal: shading_normal,
+            geometric_normal,
             object,
             material,
             front_face,
             barycentric,
+            vertex_normals,
+            uv,
+            texel_kd,
+            texel_ka,
         };
         (surface, error)
+    }
+
+    /// Where the shadow ray towards a light in direction `l` starts, and the error bound of
+    /// that point; `None` when the light adds nothing without one (STABILITY N3, robust: the
+    /// light is behind the geometric surface and the smooth surface does not reach above it).
+    /// Flat surfaces, and the naive method, start from the hit point.
+    #[inline(always)]
+    fn shadow_start(
+        &self,
+        surface: &SurfaceHit,
+        prim: u32,
+        error: Vec3,
+        l: Vec3,
+    ) -> Option<(Vec3, Vec3)> {
+        let (p, ng) = (surface.point, surface.geometric_normal);
+        let robust = self.methods().shading_normals == ShadingNormals::Robust;
+        let (Some(ns), Some(b), true) = (surface.vertex_normals, surface.barycentric, robust)
+        else {
+            return Some((p, error));
+        };
+        let index = prim as usize - self.scene.spheres.len();
+        let v = &self.scene.triangles[index].vertices;
+        // N1 (Hanika 2021): from the smooth surface, when it lies outside the flat one.
+        if let Some(start) = terminator_origin(v, &ns, b, p, error, ng) {
+            return Some(start);
+        }
+        (ng.dot(l) > 0.0).then_some((p, error))
     }
 
     /// The colour of a ray `b` that hit `hit`: the local model with a shadow ray per light,
@@ -427,7 +510,7 @@ impl Tracer {
         let scene = &*self.scene;
         let offset = self.methods().offset;
         let (surface, error) = self.surface(ray, hit);
-        let (p, n) = (surface.point, surface.normal);
+        let (p, n, ng) = (surface.point, surface.normal, surface.geometric_normal);
         let v = -ray.dir;
         s.rec.hit(&surface, v);
         if b.depth == 0 {
@@ -435,8 +518,20 @@ impl Tracer {
             s.info.hit_t = surface.t;
         }
         let material = scene.material(surface.material);
+        // Texels multiply kd and ka where the material has textures (flat colours otherwise).
+        let kd = match surface.texel_kd {
+            Some(t) => material.diffuse * t,
+            None => material.diffuse,
+        };
+        let ka = match surface.texel_ka {
+            Some(t) => material.ambient * t,
+            None => material.ambient,
+        };
+        let terms_of = |color: Vec3, l: Vec3| {
+            light_terms_with(scene.render.shading, material, kd, color, n, l, v)
+        };
 
-        let ambient = ambient_term(material, scene.render.ambient_light);
+        let ambient = ka * scene.render.ambient_light;
         let mut diffuse = Vec3::ZERO;
         let mut specular = Vec3::ZERO;
         for (i, light) in scene.lights.iter().enumerate() {
@@ -446,14 +541,19 @@ impl Tracer {
             // The recorder shows every light's terms; tiles need them only for lights that
             // are not blocked, so they compute them after the shadow ray (N·L is the same
             // product `light_terms` forms, so the answer is unchanged).
-            let terms = R::ENABLED
-                .then(|| light_terms(scene.render.shading, material, light.color, n, l, v));
+            let terms = R::ENABLED.then(|| terms_of(light.color, l));
             let n_dot_l = n.dot(l);
             let mut blocked_by = None;
             let mut blocked_at = None;
-            if n_dot_l > 0.0 {
+            let start = if n_dot_l > 0.0 {
+                self.shadow_start(&surface, hit.prim, error, l)
+            } else {
+                None
+            };
+            let behind_surface = n_dot_l > 0.0 && start.is_none();
+            if let Some((q, q_error)) = start {
                 // Only objects count as blockers, never lights.
-                let (shadow_ray, length) = shadow_ray(offset, p, error, n, l, light.position);
+                let (shadow_ray, length) = shadow_ray(offset, q, q_error, ng, l, light.position);
                 s.counts.count(RayKind::Shadow);
                 s.info.rays += 1;
                 let blocked = if R::ENABLED {
@@ -468,9 +568,7 @@ impl Tracer {
                         .occluded(self.methods(), &shadow_ray, 0.0, length)
                 };
                 if !blocked {
-                    let terms = terms.unwrap_or_else(|| {
-                        light_terms(scene.render.shading, material, light.color, n, l, v)
-                    });
+                    let terms = terms.unwrap_or_else(|| terms_of(light.color, l));
                     diffuse += terms.diffuse;
                     specular += terms.specular;
                 }
@@ -482,6 +580,7 @@ impl Tracer {
                     distance,
                     blocked_by,
                     blocked_at,
+                    behind_surface,
                     terms,
                 });
             }
@@ -514,13 +613,23 @@ impl Tracer {
             reflected_weight,
             if refracted.is_some() { kt } else { Vec3::ZERO },
         );
-        // Each child leaves the surface on the side it goes to and carries its weight.
+        // Each child leaves the surface on the side it goes to and carries its weight. About a
+        // shading normal, a direction can cross the geometric plane into the surface it
+        // leaves; the robust method mirrors it back (STABILITY N2).
+        let keep = surface.vertex_normals.is_some()
+            && self.methods().shading_normals == ShadingNormals::Robust;
         let child = |kind, dir: Vec3, k: Vec3, s: &mut Sample<'_, R>| {
-            let ray = Ray::new(offset_ray_origin(offset, p, error, n, dir), dir);
+            let (dir, corrected) = if keep {
+                keep_side(dir, ng, kind == RayKind::Reflected)
+            } else {
+                (dir, false)
+            };
+            let ray = Ray::new(offset_ray_origin(offset, p, error, ng, dir), dir);
             let branch = Branch {
                 kind,
                 depth: b.depth + 1,
                 weight: b.weight * k,
+                corrected,
             };
             k * self.trace_ray(&ray, branch, s)
         };
@@ -555,10 +664,13 @@ impl Tracer {
         let (surface, error) = self.surface(&ray, &hit);
         let to_light = light.position - surface.point;
         let l = div3(to_light, to_light.length());
-        // As in `shade`: no shadow ray unless N·L > 0.
-        if surface.normal.dot(l) > 0.0 {
-            let (p, n) = (surface.point, surface.normal);
-            let (shadow, length) = shadow_ray(m.offset, p, error, n, l, light.position);
+        // As in `shade`: no shadow ray unless N·L > 0, and from where `shade` starts it.
+        let start = (surface.normal.dot(l) > 0.0)
+            .then(|| self.shadow_start(&surface, hit.prim, error, l))
+            .flatten();
+        if let Some((q, q_error)) = start {
+            let ng = surface.geometric_normal;
+            let (shadow, length) = shadow_ray(m.offset, q, q_error, ng, l, light.position);
             self.accel.occluded_visits(m, &shadow, 0.0, length)
         } else {
             Visits::default()

@@ -328,6 +328,8 @@ fn mesh_placement_scales_rotates_and_translates() {
             translate: Vec3::new(1.0, 2.0, 3.0),
             rotate_deg: Vec3::new(0.0, 0.0, 90.0),
             scale: Vec3::splat(2.0),
+            normals: raytree::scene::NormalsMode::File,
+            crease_angle_deg: 60.0,
         }
     );
     assert_eq!(names(&scene), ["default"]);

@@ -228,6 +228,7 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
             restart |= combo(ui, "sphere", &mut t.methods.sphere);
             restart |= combo(ui, "triangle", &mut t.methods.triangle);
             restart |= combo(ui, "offset", &mut t.methods.offset);
+            restart |= combo(ui, "shading normals", &mut t.methods.shading_normals);
             rebuild |= combo(ui, "accelerator", &mut t.accel);
             ui.horizontal(|ui| {
                 restart |= drag(

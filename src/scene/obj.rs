@@ -12,13 +12,17 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
 use std::sync::Once;
 
-use glam::{Mat3, Vec3};
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use glam::{Mat3, Vec2, Vec3};
 
 use super::budget::{MemoryLimit, memory_limit, mesh_memory_estimate};
 use super::diag::{SceneError, list_and, short, short_path};
 use super::rules::{MAX_COORDINATE, check_camera, is_visible_triangle};
 use super::{
-    Camera, Light, Material, MaterialId, Object, ObjectId, ObjectSource, ResolveFn, Scene, Triangle,
+    Camera, DEFAULT_CREASE_ANGLE_DEG, Light, Material, MaterialId, MeshAttributes, NO_INDEX,
+    NormalsMode, Object, ObjectId, ObjectSource, ResolveFn, Scene, Triangle,
 };
 
 /// Where a mesh goes: `scale` first, then the rotation (degrees about X, then Y, then Z), then
@@ -117,6 +121,10 @@ pub(crate) struct MeshRequest<'a> {
     /// A scene material for every face instead of the MTL's.
     pub material_override: Option<MaterialId>,
     pub placement: &'a MeshPlacement,
+    /// Where shading normals come from.
+    pub normals: NormalsMode,
+    /// Faces meeting at more than this (degrees) keep apart normals, for `Smooth`.
+    pub crease_angle_deg: f32,
 }
 
 fn load_options() -> tobj::LoadOptions {
@@ -362,9 +370,19 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     }
 
     let linear = req.placement.linear();
+    // Normals go through the inverse transpose, which keeps them perpendicular to the placed
+    // surface (and on its outside when a mirroring scale swaps the corners).
+    let normal_matrix = linear.inverse().transpose();
     let mirrors = req.placement.mirrors();
     let mut mtl_ids: Vec<Option<MaterialId>> = vec![None; mtl_materials.len()];
     let (mut added, mut dropped, mut too_far) = (0usize, 0usize, 0usize);
+    let first_triangle = scene.triangles.len();
+    let file_normals = req.normals == NormalsMode::File;
+    let mut attrs = MeshAttributes {
+        first_triangle: first_triangle as u32,
+        ..MeshAttributes::default()
+    };
+    let mut corners = Corners::default();
     for model in &models {
         let mesh = &model.mesh;
         let mut material = None;
@@ -374,11 +392,69 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
                 .get(i..i + 3)
                 .map_or(Vec3::NAN, |p| Vec3::new(p[0], p[1], p[2]))
         };
-        for face in mesh.indices.chunks_exact(3) {
+        // Per-face normal and texture indices exist only when every face gives them.
+        let normal_base = attrs.normals.len() as u32;
+        let has_normals = file_normals
+            && !mesh.normals.is_empty()
+            && mesh.normal_indices.len() == mesh.indices.len();
+        if has_normals {
+            attrs
+                .normals
+                .extend(mesh.normals.chunks_exact(3).map(|n| {
+                    (normal_matrix * Vec3::new(n[0], n[1], n[2])).normalize_or_zero()
+                }));
+        }
+        let n_normals = attrs.normals.len() as u32 - normal_base;
+        let uv_base = attrs.uvs.len() as u32;
+        let has_uvs =
+            !mesh.texcoords.is_empty() && mesh.texcoord_indices.len() == mesh.indices.len();
+        if has_uvs {
+            attrs.uvs.extend(
+                mesh.texcoords
+                    .chunks_exact(2)
+                    .map(|t| Vec2::new(t[0], t[1])),
+            );
+        }
+        let n_uvs = attrs.uvs.len() as u32 - uv_base;
+        for (k, face) in mesh.indices.chunks_exact(3).enumerate() {
             let mut v =
                 [face[0], face[1], face[2]].map(|i| linear * corner(i) + req.placement.translate);
+            let lookup = |indices: &[u32], base: u32, count: u32, ok: &dyn Fn(u32) -> bool| {
+                let idx = indices.get(3 * k..3 * k + 3)?;
+                let idx = [idx[0], idx[1], idx[2]];
+                idx.iter()
+                    .all(|&i| i < count && ok(base + i))
+                    .then(|| idx.map(|i| base + i))
+            };
+            let mut ni = if has_normals {
+                let normals = &attrs.normals;
+                let usable = |i: u32| {
+                    let n = normals[i as usize];
+                    n.is_finite() && n != Vec3::ZERO
+                };
+                let found = lookup(&mesh.normal_indices, normal_base, n_normals, &usable);
+                corners.bad_normals += usize::from(found.is_none());
+                found
+            } else {
+                None
+            };
+            let mut ti = if has_uvs {
+                let uvs = &attrs.uvs;
+                let usable = |i: u32| uvs[i as usize].is_finite();
+                let found = lookup(&mesh.texcoord_indices, uv_base, n_uvs, &usable);
+                corners.bad_uvs += usize::from(found.is_none());
+                found
+            } else {
+                None
+            };
             if mirrors {
                 v.swap(1, 2);
+                if let Some(n) = ni.as_mut() {
+                    n.swap(1, 2);
+                }
+                if let Some(t) = ti.as_mut() {
+                    t.swap(1, 2);
+                }
             }
             if !is_visible_triangle(&v) {
                 dropped += 1;
@@ -404,9 +480,15 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
                 material: id,
                 object: req.object,
             });
+            corners.normals.push(ni.unwrap_or([NO_INDEX; 3]));
+            corners.uvs.push(ti.unwrap_or([NO_INDEX; 3]));
             added += 1;
         }
     }
+    let textured = scene.triangles[first_triangle..]
+        .iter()
+        .any(|t| scene.material(t.material).diffuse_map.is_some() || scene.material(t.material).ambient_map.is_some());
+    finish_attributes(scene, req, attrs, corners, textured, &mut warnings);
     if dropped > 0 {
         let s = if dropped == 1 { "" } else { "s" };
         warnings.push(format!(
@@ -423,6 +505,138 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     }
     scene.warnings.extend(warnings);
     Ok(added)
+}
+
+/// The normal and texture-coordinate indices of a mesh's kept triangles, while it loads.
+#[derive(Default)]
+struct Corners {
+    normals: Vec<[u32; 3]>,
+    uvs: Vec<[u32; 3]>,
+    /// Faces whose `vn` indices are out of range or name a zero or non-finite normal.
+    bad_normals: usize,
+    /// Faces whose `vt` indices are out of range or name non-finite coordinates.
+    bad_uvs: usize,
+}
+
+/// Keeps the mesh's normals (from the file, or computed for `normals = "smooth"`) and, when a
+/// material of it has a texture, its texture coordinates; adds them to the scene only if there
+/// are any, so flat untextured meshes cost nothing. Warns about unusable `vn`/`vt` once each.
+fn finish_attributes(
+    scene: &mut Scene,
+    req: &MeshRequest,
+    mut attrs: MeshAttributes,
+    corners: Corners,
+    textured: bool,
+    warnings: &mut Vec<String>,
+) {
+    let first = attrs.first_triangle as usize;
+    let count = scene.triangles.len() - first;
+    attrs.triangle_count = count as u32;
+    let plural = |n: usize| if n == 1 { "" } else { "s" };
+    if corners.bad_normals > 0 {
+        let n = corners.bad_normals;
+        warnings.push(format!(
+            "{}: {n} face{} name normals (`vn`) that are out of range, zero or not finite; they are shaded flat.",
+            req.label,
+            plural(n)
+        ));
+    }
+    if corners.bad_uvs > 0 && textured {
+        let n = corners.bad_uvs;
+        warnings.push(format!(
+            "{}: {n} face{} name texture coordinates (`vt`) that are out of range or not finite; they are not textured.",
+            req.label,
+            plural(n)
+        ));
+    }
+    match req.normals {
+        NormalsMode::Flat => attrs.normals.clear(),
+        NormalsMode::File => {
+            if corners.normals.iter().any(|n| n[0] != NO_INDEX) {
+                attrs.normal_indices = corners.normals;
+            } else {
+                attrs.normals.clear();
+            }
+        }
+        NormalsMode::Smooth => {
+            let (normals, indices) =
+                smooth_normals(&scene.triangles[first..], req.crease_angle_deg);
+            attrs.normals = normals;
+            attrs.normal_indices = indices;
+        }
+    }
+    if textured && corners.uvs.iter().any(|t| t[0] != NO_INDEX) {
+        attrs.uv_indices = corners.uvs;
+    } else {
+        attrs.uvs.clear();
+    }
+    attrs.normals.shrink_to_fit();
+    attrs.uvs.shrink_to_fit();
+    if count > 0 && (!attrs.normal_indices.is_empty() || !attrs.uv_indices.is_empty()) {
+        scene.attributes.push(Arc::new(attrs));
+    }
+}
+
+/// Area-weighted vertex normals for `triangles` (SPEC §3b `normals = "smooth"`): at each corner,
+/// the sum of the cross products (twice the area times the unit normal) of the triangles that
+/// share the corner's position and whose normal is within `crease_angle_deg` of this
+/// triangle's, normalised. Corners are shared by position, so a mesh split into groups or
+/// materials is still smooth across them. Returns the normals and each triangle's indices.
+pub fn smooth_normals(triangles: &[Triangle], crease_angle_deg: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let key = |p: Vec3| p.to_array().map(|x| (x + 0.0).to_bits());
+    let mut ids: HashMap<[u32; 3], u32> = HashMap::with_capacity(triangles.len());
+    let corner_ids: Vec<[u32; 3]> = triangles
+        .iter()
+        .map(|t| {
+            t.vertices.map(|p| {
+                let next = ids.len() as u32;
+                *ids.entry(key(p)).or_insert(next)
+            })
+        })
+        .collect();
+    // The triangles around each position, as one flat list with offsets.
+    let mut start = vec![0u32; ids.len() + 1];
+    for c in corner_ids.iter().flatten() {
+        start[*c as usize + 1] += 1;
+    }
+    for i in 0..ids.len() {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start.clone();
+    let mut around = vec![0u32; 3 * triangles.len()];
+    for (k, c) in corner_ids.iter().enumerate() {
+        for &id in c {
+            around[fill[id as usize] as usize] = k as u32;
+            fill[id as usize] += 1;
+        }
+    }
+    let weighted: Vec<Vec3> = triangles
+        .iter()
+        .map(|t| (t.vertices[1] - t.vertices[0]).cross(t.vertices[2] - t.vertices[0]))
+        .collect();
+    let unit: Vec<Vec3> = weighted.iter().map(|w| w.normalize_or_zero()).collect();
+    let cos_crease = crease_angle_deg.to_radians().cos();
+    let mut normals = Vec::with_capacity(3 * triangles.len());
+    let mut indices = Vec::with_capacity(triangles.len());
+    for (k, c) in corner_ids.iter().enumerate() {
+        let mut idx = [0u32; 3];
+        for (slot, &id) in idx.iter_mut().zip(c) {
+            let (a, b) = (start[id as usize] as usize, start[id as usize + 1] as usize);
+            let mut sum = Vec3::ZERO;
+            for &other in &around[a..b] {
+                if unit[k].dot(unit[other as usize]) >= cos_crease {
+                    sum += weighted[other as usize];
+                }
+            }
+            // The triangle itself is always in its own sum, so this has a direction unless
+            // the sum overflowed.
+            let n = sum.normalize_or_zero();
+            *slot = normals.len() as u32;
+            normals.push(if n == Vec3::ZERO { unit[k] } else { n });
+        }
+        indices.push(idx);
+    }
+    (normals, indices)
 }
 
 /// `usemtl` names that no loaded library defines: tobj silently gives those faces no material.
@@ -542,6 +756,8 @@ pub fn material_from_mtl(
         reflectivity: if mirror { specular } else { Vec3::ZERO },
         transparency: Vec3::splat(transparency),
         ior,
+        diffuse_map: None,
+        ambient_map: None,
     }
 }
 
@@ -565,6 +781,8 @@ pub(crate) fn load_obj_scene(
             translate: placement.translate,
             rotate_deg: placement.rotate_deg,
             scale: placement.scale,
+            normals: NormalsMode::default(),
+            crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG,
         },
     });
     let request = MeshRequest {
@@ -576,6 +794,8 @@ pub(crate) fn load_obj_scene(
         resolve,
         material_override: None,
         placement: &placement,
+        normals: NormalsMode::default(),
+        crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG,
     };
     let added = add_mesh(&mut scene, &request).map_err(|p| {
         let at = p.line.map(|l| format!(":{l}")).unwrap_or_default();
