@@ -229,7 +229,10 @@ impl Recorder for TreeRecorder<'_> {
                 front_face: hit.front_face,
                 barycentric: hit.barycentric,
                 geometric_normal: hit.vertex_normals.map(|_| hit.geometric_normal),
-                uv: hit.uv.filter(|_| hit.texel_kd.is_some() || hit.texel_ka.is_some()).map(|t| t.to_array()),
+                uv: hit
+                    .uv
+                    .filter(|_| hit.texel_kd.is_some() || hit.texel_ka.is_some())
+                    .map(|t| t.to_array()),
                 texel: hit.texel_kd,
             });
             node.view = Some(view);
@@ -239,8 +242,7 @@ impl Recorder for TreeRecorder<'_> {
     fn shadow(&mut self, test: &ShadowTest) {
         let scene = self.scene;
         if let Some(node) = self.top() {
-            let lit =
-                test.blocked_by.is_none() && !test.behind_surface && test.terms.n_dot_l > 0.0;
+            let lit = test.blocked_by.is_none() && !test.behind_surface && test.terms.n_dot_l > 0.0;
             let (n, v) = match (&node.hit, node.view) {
                 (Some(h), Some(v)) => (h.normal, v),
                 _ => (Vec3::ZERO, Vec3::ZERO),

@@ -110,7 +110,10 @@ mod tests {
         assert_eq!(interpolate_normal(&n, [1.0, 0.0, 0.0]), Some(Vec3::X));
         let m = interpolate_normal(&n, [1.0 / 3.0; 3]).expect("a direction");
         assert!((m.length() - 1.0).abs() < 1e-6);
-        assert_eq!(interpolate_normal(&[Vec3::X, -Vec3::X, Vec3::X], [0.5, 0.5, 0.0]), None);
+        assert_eq!(
+            interpolate_normal(&[Vec3::X, -Vec3::X, Vec3::X], [0.5, 0.5, 0.0]),
+            None
+        );
     }
 
     #[test]
@@ -136,7 +139,8 @@ mod tests {
         let n = v;
         let b = [1.0 / 3.0; 3];
         let p = b[0] * v[0] + b[1] * v[1] + b[2] * v[2];
-        let (q, _) = terminator_origin(&v, &n, b, p, Vec3::ZERO, Vec3::ONE.normalize()).expect("moves out");
+        let (q, _) =
+            terminator_origin(&v, &n, b, p, Vec3::ZERO, Vec3::ONE.normalize()).expect("moves out");
         assert!(q.length() > p.length(), "{q} further out than {p}");
         // Flat normals: the triangle is its own surface, nothing moves.
         let ng = Vec3::ONE.normalize();

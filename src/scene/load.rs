@@ -17,8 +17,8 @@ use super::obj::{self, MeshPlacement};
 use super::rules;
 use super::toml_reader::{Section, describe, syntax_error};
 use super::{
-    Camera, Light, Material, MaterialId, Object, ObjectId, ObjectSource, RenderParams, ResolveFn,
-    NormalsMode, Scene, Shading, Sphere, Triangle,
+    Camera, Light, Material, MaterialId, NormalsMode, Object, ObjectId, ObjectSource, RenderParams,
+    ResolveFn, Scene, Shading, Sphere, Triangle,
 };
 use crate::choice::Choice;
 

@@ -398,11 +398,11 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
             && !mesh.normals.is_empty()
             && mesh.normal_indices.len() == mesh.indices.len();
         if has_normals {
-            attrs
-                .normals
-                .extend(mesh.normals.chunks_exact(3).map(|n| {
-                    (normal_matrix * Vec3::new(n[0], n[1], n[2])).normalize_or_zero()
-                }));
+            attrs.normals.extend(
+                mesh.normals
+                    .chunks_exact(3)
+                    .map(|n| (normal_matrix * Vec3::new(n[0], n[1], n[2])).normalize_or_zero()),
+            );
         }
         let n_normals = attrs.normals.len() as u32 - normal_base;
         let uv_base = attrs.uvs.len() as u32;
@@ -485,9 +485,10 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
             added += 1;
         }
     }
-    let textured = scene.triangles[first_triangle..]
-        .iter()
-        .any(|t| scene.material(t.material).diffuse_map.is_some() || scene.material(t.material).ambient_map.is_some());
+    let textured = scene.triangles[first_triangle..].iter().any(|t| {
+        scene.material(t.material).diffuse_map.is_some()
+            || scene.material(t.material).ambient_map.is_some()
+    });
     finish_attributes(scene, req, attrs, corners, textured, &mut warnings);
     if dropped > 0 {
         let s = if dropped == 1 { "" } else { "s" };
