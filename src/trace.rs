@@ -471,10 +471,11 @@ impl Tracer {
         (surface, error)
     }
 
-    /// Where the shadow ray towards a light in direction `l` starts, and the error bound of
-    /// that point; `None` when the light adds nothing without one (STABILITY N3, robust: the
-    /// light is behind the geometric surface and the smooth surface does not reach above it).
-    /// Flat surfaces, and the naive method, start from the hit point.
+    /// Where the shadow ray towards a light in direction `l` starts, the error bound of that
+    /// point and the side it is offset to; `None` when the light adds nothing without one
+    /// (STABILITY N3, robust: the light is behind the geometric surface and the smooth surface
+    /// does not reach above it). Flat surfaces, and the naive method, start from the hit point
+    /// offset to the light's side.
     #[inline(always)]
     fn shadow_start(
         &self,
@@ -482,20 +483,23 @@ impl Tracer {
         prim: u32,
         error: Vec3,
         l: Vec3,
-    ) -> Option<(Vec3, Vec3)> {
+    ) -> Option<(Vec3, Vec3, Vec3)> {
         let (p, ng) = (surface.point, surface.geometric_normal);
         let robust = self.methods().shading_normals == ShadingNormals::Robust;
         let (Some(ns), Some(b), true) = (surface.vertex_normals, surface.barycentric, robust)
         else {
-            return Some((p, error));
+            return Some((p, error, l));
         };
         let index = prim as usize - self.scene.spheres.len();
         let v = &self.scene.triangles[index].vertices;
-        // N1 (Hanika 2021): from the smooth surface, when it lies outside the flat one.
-        if let Some(start) = terminator_origin(v, &ns, b, p, error, ng) {
-            return Some(start);
+        // N1 (Hanika 2021): from the smooth surface, when it lies outside the flat one, offset
+        // to the visible side: a light behind the surface is then reached only past its edge
+        // (N3), never through it.
+        let in_front = ng.dot(l) > 0.0;
+        match terminator_origin(v, &ns, b, p, error, ng) {
+            Some((q, q_error, clear)) if in_front || clear => Some((q, q_error, ng)),
+            _ => in_front.then_some((p, error, l)),
         }
-        (ng.dot(l) > 0.0).then_some((p, error))
     }
 
     /// The colour of a ray `b` that hit `hit`: the local model with a shadow ray per light,
@@ -551,9 +555,9 @@ impl Tracer {
                 None
             };
             let behind_surface = n_dot_l > 0.0 && start.is_none();
-            if let Some((q, q_error)) = start {
+            if let Some((q, q_error, side)) = start {
                 // Only objects count as blockers, never lights.
-                let (shadow_ray, length) = shadow_ray(offset, q, q_error, ng, l, light.position);
+                let (shadow_ray, length) = shadow_ray(offset, q, q_error, ng, side, light.position);
                 s.counts.count(RayKind::Shadow);
                 s.info.rays += 1;
                 let blocked = if R::ENABLED {
@@ -668,9 +672,9 @@ impl Tracer {
         let start = (surface.normal.dot(l) > 0.0)
             .then(|| self.shadow_start(&surface, hit.prim, error, l))
             .flatten();
-        if let Some((q, q_error)) = start {
+        if let Some((q, q_error, side)) = start {
             let ng = surface.geometric_normal;
-            let (shadow, length) = shadow_ray(m.offset, q, q_error, ng, l, light.position);
+            let (shadow, length) = shadow_ray(m.offset, q, q_error, ng, side, light.position);
             self.accel.occluded_visits(m, &shadow, 0.0, length)
         } else {
             Visits::default()
@@ -689,18 +693,20 @@ impl Tracer {
     }
 }
 
-/// The shadow ray from hit point `p` (error bound `error`, normal `n`) towards the light at
-/// `light` in direction `l`: from the offset origin to the light's centre, and its length.
+/// The shadow ray from hit point `p` (error bound `error`, geometric normal `n`) towards the
+/// light at `light`: from the origin offset to the side of the surface `side` points to (the
+/// direction `l` to the light; the visible side for robust shading normals, so the ray never
+/// starts behind the surface, STABILITY N3) to the light's centre, and its length.
 #[inline(always)]
 fn shadow_ray(
     offset: OffsetMethod,
     p: Vec3,
     error: Vec3,
     n: Vec3,
-    l: Vec3,
+    side: Vec3,
     light: Vec3,
 ) -> (Ray, f32) {
-    let origin = offset_ray_origin(offset, p, error, n, l);
+    let origin = offset_ray_origin(offset, p, error, n, side);
     let segment = light - origin;
     let length = segment.length();
     (Ray::new(origin, div3(segment, length)), length)

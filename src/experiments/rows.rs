@@ -1192,14 +1192,15 @@ fn row_n2(o: &StabilityOptions, rng: &mut Pcg) -> Row {
     let mut naive_text = Vec::new();
     let (mut robust_wrong, mut naive_wrong, mut corrected) = (0usize, 0usize, 0usize);
     for level in [1u32, 3, 5] {
+        // The same rays for both methods.
+        let seeds: Vec<u64> = views.iter().map(|_| u64::from(rng.next_u32())).collect();
         for (m, name) in [
             (ShadingNormals::Naive, "naive"),
             (ShadingNormals::Robust, "robust"),
         ] {
             let mut points = Vec::new();
             let mut worst = (0.0f64, 0.0f32);
-            for &view in &views {
-                let seed = u64::from(rng.next_u32());
+            for (&view, &seed) in views.iter().zip(&seeds) {
                 let c = side_cell(m, level, view, false, o.rays, &mut Pcg::new(seed));
                 let t = side_cell(m, level, view, true, o.rays / 4, &mut Pcg::new(seed));
                 let wrong = c.wrong_side + t.wrong_side;

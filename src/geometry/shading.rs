@@ -39,6 +39,13 @@ crate::choice::choice!(ShadingNormals {
     Naive => ("naive", "shading normals used as the surface's: terminator bands, R/T into the surface, leaks"),
 });
 
+/// How far (relative to the coordinates' magnitude) the smooth-surface point must lie above
+/// the triangle's plane for a shadow ray from it to a light *behind* the plane to be trusted:
+/// `γ(64)`, about 9× the error of the `t` at which a grazing ray meets a neighbouring triangle
+/// (`≈ γ(7)·|P| / |N·L|` against the true `lift / |N·L|`). Below it, the light counts as behind
+/// the surface (STABILITY N3: a 0.5° grazing light otherwise leaked through a flat wall).
+pub const MIN_LIFT: f32 = 64.0 * f32::EPSILON * 0.5 / (1.0 - 64.0 * f32::EPSILON * 0.5);
+
 /// The unit normal interpolated from vertex normals `n` with barycentric weights `b`, or `None`
 /// when it has no direction (opposite normals cancelling, or non-finite input).
 #[inline]
@@ -52,7 +59,10 @@ pub fn interpolate_normal(n: &[Vec3; 3], b: [f32; 3]) -> Option<Vec3> {
 /// smooth surface described by the unit vertex normals `n`, all turned to the side the ray came
 /// from, and `ng` the geometric normal on that side. Each vertex contributes `p` projected onto its tangent plane when `p` lies below that
 /// plane (and `p` itself otherwise), weighted by `b`. Returns the point and its absolute error
-/// bound per axis, or `None` when the point does not move outside (where the flat triangle
+/// bound per axis and whether it lies clearly above the triangle's plane (by at least
+/// [`MIN_LIFT`] of the coordinates' magnitude: a ray from it that crosses the plane at a
+/// grazing angle then meets the plane where `f32` can tell; below that it is as good as on the
+/// flat triangle). `None` when the point does not move outside (where the flat triangle
 /// already is the surface, or bulges above it), so the flat point is used.
 #[inline]
 pub fn terminator_origin(
@@ -62,7 +72,7 @@ pub fn terminator_origin(
     p: Vec3,
     p_error: Vec3,
     ng: Vec3,
-) -> Option<(Vec3, Vec3)> {
+) -> Option<(Vec3, Vec3, bool)> {
     let mut lift = Vec3::ZERO;
     let mut scale = p.abs();
     for i in 0..3 {
@@ -76,7 +86,8 @@ pub fn terminator_origin(
     }
     // Each `(p − v_i)·n_i` is a handful of roundings of numbers of size `scale`.
     let error = p_error + Vec3::splat(gamma(12)) * (scale + p2.abs());
-    Some((p2, error))
+    let clear = lift.dot(ng) > MIN_LIFT * scale.max_element();
+    Some((p2, error, clear))
 }
 
 /// `dir` kept on the side of the geometric plane (unit normal `ng`) it must go to: `above`

@@ -18,21 +18,34 @@ use super::rules;
 use super::toml_reader::{Section, describe, syntax_error};
 use super::{
     Camera, Light, Material, MaterialId, NormalsMode, Object, ObjectId, ObjectSource, RenderParams,
-    ResolveFn, Scene, Shading, Sphere, Triangle,
+    ResolveBytesFn, ResolveFn, Scene, Shading, Sphere, Triangle,
 };
 use crate::choice::Choice;
 
-/// Parses scene TOML, reading meshes and material libraries through `resolve`.
+/// Parses scene TOML, reading meshes and material libraries through `resolve` (textures are
+/// not read: each is a missing-texture warning).
 pub fn load_scene_str_with(
     text: &str,
     name: &str,
     resolve: &ResolveFn<'_>,
+) -> Result<Scene, SceneError> {
+    load_scene_str_with_files(text, name, resolve, &super::no_binary_files)
+}
+
+/// Parses scene TOML, reading meshes and material libraries through `resolve` and textures
+/// through `resolve_bytes`.
+pub fn load_scene_str_with_files(
+    text: &str,
+    name: &str,
+    resolve: &ResolveFn<'_>,
+    resolve_bytes: &ResolveBytesFn<'_>,
 ) -> Result<Scene, SceneError> {
     let src = Src { file: name, text };
     let root = DeTable::parse(text).map_err(|e| syntax_error(&src, &e))?;
     SceneBuilder {
         src: &src,
         resolve,
+        resolve_bytes,
         scene: Scene::default(),
         user_materials: HashMap::new(),
     }
@@ -105,6 +118,7 @@ impl Kind {
 struct SceneBuilder<'a> {
     src: &'a Src<'a>,
     resolve: &'a ResolveFn<'a>,
+    resolve_bytes: &'a ResolveBytesFn<'a>,
     scene: Scene,
     /// The `[[material]]` entries by name (MTL materials are not referable by name).
     user_materials: HashMap<String, MaterialId>,
@@ -428,6 +442,7 @@ impl SceneBuilder<'_> {
                 key: &file,
                 text: &text,
                 resolve: self.resolve,
+                resolve_bytes: self.resolve_bytes,
                 material_override,
                 placement: &placement,
                 normals,

@@ -14,6 +14,7 @@ pub mod procedural;
 pub mod rules;
 pub mod sampling;
 pub mod save;
+pub mod texture;
 pub mod toml_reader;
 
 use std::path::PathBuf;
@@ -26,12 +27,20 @@ pub use builtin::load_builtin;
 pub use camera::{Camera, CameraFrame, primary_ray};
 pub use diag::SceneError;
 pub use files::{fs_resolver, load_scene_file, load_scene_str, open_scene_arg};
-pub use load::load_scene_str_with;
+pub use load::{load_scene_str_with, load_scene_str_with_files};
 
 /// Returns the text of a mesh or material library, given its path as written in the scene
 /// (relative to the scene file's folder), or the reason it cannot, as a short phrase. Built-in
 /// scenes resolve from strings compiled into the binary, files from the scene's folder.
 pub type ResolveFn<'a> = dyn Fn(&str) -> Result<String, String> + 'a;
+
+/// As [`ResolveFn`], for binary files (textures).
+pub type ResolveBytesFn<'a> = dyn Fn(&str) -> Result<Vec<u8>, String> + 'a;
+
+/// The binary resolver of scenes loaded without one: every texture is missing (a warning).
+pub fn no_binary_files(path: &str) -> Result<Vec<u8>, String> {
+    Err(format!("{path}: textures are not read for this scene"))
+}
 pub use save::scene_to_toml;
 
 /// Index into [`Scene::materials`].

@@ -20,9 +20,11 @@ use glam::{Mat3, Vec2, Vec3};
 use super::budget::{MemoryLimit, memory_limit, mesh_memory_estimate};
 use super::diag::{SceneError, list_and, short, short_path};
 use super::rules::{MAX_COORDINATE, check_camera, is_visible_triangle};
+use super::texture::decode_texture;
 use super::{
     Camera, DEFAULT_CREASE_ANGLE_DEG, Light, Material, MaterialId, MeshAttributes, NO_INDEX,
-    NormalsMode, Object, ObjectId, ObjectSource, ResolveFn, Scene, Triangle,
+    NormalsMode, Object, ObjectId, ObjectSource, ResolveBytesFn, ResolveFn, Scene, Texture,
+    TextureId, Triangle,
 };
 
 /// Where a mesh goes: `scale` first, then the rotation (degrees about X, then Y, then Z), then
@@ -118,6 +120,8 @@ pub(crate) struct MeshRequest<'a> {
     pub key: &'a str,
     pub text: &'a str,
     pub resolve: &'a ResolveFn<'a>,
+    /// Reads textures (binary), relative to the same folder as `resolve`.
+    pub resolve_bytes: &'a ResolveBytesFn<'a>,
     /// A scene material for every face instead of the MTL's.
     pub material_override: Option<MaterialId>,
     pub placement: &'a MeshPlacement,
@@ -261,6 +265,35 @@ pub(crate) fn obj_counts(text: &str) -> (u64, u64) {
     (vertices, triangles)
 }
 
+/// Bytes the per-vertex normals and texture coordinates of an OBJ may keep (SPEC §3b): the
+/// file's `vn` and `vt` and an index triple per triangle for each, or computed normals (three
+/// per triangle) for `normals = "smooth"`; 0 for a flat mesh without `vt`.
+pub(crate) fn attribute_memory_estimate(text: &str, normals: NormalsMode) -> u64 {
+    let (mut vn, mut vt, mut faces) = (0u64, 0u64, 0u64);
+    for line in text.lines() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("vn") => vn += 1,
+            Some("vt") => vt += 1,
+            Some("f") => faces += (words.count() as u64).saturating_sub(2).max(1),
+            _ => {}
+        }
+    }
+    let per_triangle_index = 12u64;
+    let normal_bytes = match normals {
+        NormalsMode::Flat => 0,
+        NormalsMode::File if vn == 0 => 0,
+        NormalsMode::File => vn * 12 + faces * per_triangle_index,
+        NormalsMode::Smooth => faces * (36 + per_triangle_index),
+    };
+    let uv_bytes = if vt == 0 {
+        0
+    } else {
+        vt * 8 + faces * per_triangle_index
+    };
+    normal_bytes.saturating_add(uv_bytes)
+}
+
 /// Refuses an OBJ whose reading (with the triangles the scene already has) would exceed
 /// `limit`, before tobj allocates anything for it.
 pub(crate) fn check_mesh_memory(
@@ -318,7 +351,28 @@ fn error_line(text: &str) -> Option<usize> {
 pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, ObjProblem> {
     check_mesh_memory(scene, req.text, &memory_limit())
         .map_err(|reason| ObjProblem { line: None, reason })?;
+    let attributes = attribute_memory_estimate(req.text, req.normals);
+    if attributes > 0 {
+        let (_, triangles) = obj_counts(req.text);
+        let all = mesh_memory_estimate(
+            req.text.len() as u64,
+            obj_counts(req.text).0,
+            triangles.saturating_add(scene.triangles.len() as u64),
+        )
+        .saturating_add(attributes);
+        memory_limit()
+            .check(
+                format!("its {triangles} triangles with their normals and texture coordinates"),
+                all,
+            )
+            .map_err(|e| ObjProblem {
+                line: None,
+                reason: e.to_string(),
+            })?;
+    }
     let mtl_warnings = RefCell::new(Vec::new());
+    // The libraries as read, so that a texture's warning can name its line.
+    let mtl_texts: RefCell<Vec<(String, String)>> = RefCell::new(Vec::new());
     let load_mtl = |path: &Path| -> tobj::MTLLoadResult {
         if req.material_override.is_some() {
             return Ok(Default::default());
@@ -331,6 +385,7 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
             ));
             tobj::LoadError::OpenFileFailed
         })?;
+        mtl_texts.borrow_mut().push((name.clone(), text.clone()));
         let text = mtl_for_tobj(&text).map_err(|(line, reason)| {
             mtl_warnings.borrow_mut().push(format!(
                 "{}: cannot read the material library `{name}` (line {line}: {reason}); its faces use the default material.",
@@ -358,6 +413,7 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     };
     let mtl_materials = mtl_materials.unwrap_or_default();
     let mut warnings = mtl_warnings.into_inner();
+    let mtl_texts = mtl_texts.into_inner();
     if polylines > 0 {
         let s = if polylines == 1 { "" } else { "s" };
         warnings.push(format!(
@@ -470,7 +526,7 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
                     (Some(id), _) => id,
                     (None, Some(i)) if i < mtl_materials.len() => {
                         *mtl_ids[i].get_or_insert_with(|| {
-                            mtl_material(scene, req, &mtl_materials[i], &mut warnings)
+                            mtl_material(scene, req, &mtl_materials[i], &mtl_texts, &mut warnings)
                         })
                     }
                     (None, _) => scene.default_material(),
@@ -674,15 +730,100 @@ fn mtl_material(
     scene: &mut Scene,
     req: &MeshRequest,
     m: &tobj::Material,
+    mtl_texts: &[(String, String)],
     warnings: &mut Vec<String>,
 ) -> MaterialId {
     let name = format!("{}/{}", req.object_name, m.name);
-    if let Some(i) = scene.materials.iter().position(|x| x.name == name) {
-        return MaterialId(i as u32);
+    let id = match scene.materials.iter().position(|x| x.name == name) {
+        Some(i) => MaterialId(i as u32),
+        None => {
+            let material = material_from_mtl(m, name, req.label, warnings);
+            scene.materials.push(material);
+            MaterialId(scene.materials.len() as u32 - 1)
+        }
+    };
+    // Textures come from the MTL even when a `[[material]]` of this name overrides its
+    // colours (a scene file has no texture keys, so a saved scene keeps its textures).
+    let mut texture = |key: &str, file: &Option<String>| {
+        let file = file.as_deref()?;
+        load_texture(scene, req, &m.name, key, file, mtl_texts, warnings)
+    };
+    let diffuse = texture("map_Kd", &m.diffuse_texture);
+    let ambient = texture("map_Ka", &m.ambient_texture);
+    let material = &mut scene.materials[id.0 as usize];
+    material.diffuse_map = material.diffuse_map.or(diffuse);
+    material.ambient_map = material.ambient_map.or(ambient);
+    id
+}
+
+/// The file a `map_Kd` value names: the value, or its last word when it starts with options
+/// (`-s 2 2 1 wood.png`).
+fn texture_file(value: &str) -> &str {
+    let value = value.trim();
+    if value.starts_with('-') {
+        value.split_whitespace().last().unwrap_or(value)
+    } else {
+        value
     }
-    let material = material_from_mtl(m, name, req.label, warnings);
-    scene.materials.push(material);
-    MaterialId(scene.materials.len() as u32 - 1)
+}
+
+/// The texture `value` of MTL statement `key` of material `material`, loaded once per scene
+/// (materials that share a file share the texture); `None` with one warning naming the file
+/// and the MTL line when it cannot be read, decoded, or fit in the memory budget.
+fn load_texture(
+    scene: &mut Scene,
+    req: &MeshRequest,
+    material: &str,
+    key: &str,
+    value: &str,
+    mtl_texts: &[(String, String)],
+    warnings: &mut Vec<String>,
+) -> Option<TextureId> {
+    let file = texture_file(value);
+    let path = sibling(req.key, file);
+    if let Some(i) = scene.textures.iter().position(|t| t.name == path) {
+        return Some(TextureId(i as u32));
+    }
+    let place = mtl_texts
+        .iter()
+        .find_map(|(mtl, text)| {
+            text.lines()
+                .position(|l| {
+                    let l = l.trim_start();
+                    l.starts_with(key) && l.contains(file)
+                })
+                .map(|i| format!("`{mtl}` line {}", i + 1))
+        })
+        .unwrap_or_else(|| "its material library".into());
+    let limit = memory_limit();
+    let used: u64 = scene
+        .textures
+        .iter()
+        .map(|t| Texture::bytes(t.width, t.height))
+        .sum();
+    let left = MemoryLimit {
+        bytes: limit.bytes.saturating_sub(used),
+        source: limit.source,
+    };
+    let loaded = (req.resolve_bytes)(&path).and_then(|bytes| {
+        quietly(|| decode_texture(&path, &bytes, &left))
+            .unwrap_or_else(|()| Err("the image reader failed on it".into()))
+    });
+    match loaded {
+        Ok(texture) => {
+            scene.textures.push(Arc::new(texture));
+            Some(TextureId(scene.textures.len() as u32 - 1))
+        }
+        Err(reason) => {
+            warnings.push(format!(
+                "{}: material `{}` ({place}): cannot use the texture `{}` of `{key}` ({reason}); its flat colour stays.",
+                req.label,
+                short(material),
+                short_path(file)
+            ));
+            None
+        }
+    }
 }
 
 /// Maps an MTL material to the Phong material: Ka→ambient, Kd→diffuse, Ks→specular,
@@ -770,6 +911,7 @@ pub(crate) fn load_obj_scene(
     label: &str,
     key: &str,
     resolve: &ResolveFn<'_>,
+    resolve_bytes: &ResolveBytesFn<'_>,
 ) -> Result<Scene, SceneError> {
     let name = file_stem(key).unwrap_or_else(|| "mesh".into());
     let placement = MeshPlacement::default();
@@ -793,6 +935,7 @@ pub(crate) fn load_obj_scene(
         key,
         text,
         resolve,
+        resolve_bytes,
         material_override: None,
         placement: &placement,
         normals: NormalsMode::default(),
