@@ -150,8 +150,9 @@ mod tests {
         let n = v;
         let b = [1.0 / 3.0; 3];
         let p = b[0] * v[0] + b[1] * v[1] + b[2] * v[2];
-        let (q, _) =
+        let (q, _, clear) =
             terminator_origin(&v, &n, b, p, Vec3::ZERO, Vec3::ONE.normalize()).expect("moves out");
+        assert!(clear);
         assert!(q.length() > p.length(), "{q} further out than {p}");
         // Flat normals: the triangle is its own surface, nothing moves.
         let ng = Vec3::ONE.normalize();
