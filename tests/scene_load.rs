@@ -516,6 +516,7 @@ fn builtin_scenes_load_cleanly() {
         ("quiz", 1, 0, 1, 1, 1),
         ("glass", 4, 1, 128 + 128 + 8, 2, 5),
         ("box", 3, 2, 12, 1, 6),
+        ("smooth", 3, 0, 128 + 2 * 224, 2, 4),
         ("acne", 5, 3, 2, 1, 3),
         ("cracks", 1, 0, 128, 1, 1),
     ];
@@ -550,7 +551,7 @@ fn builtin_scenes_load_cleanly() {
     assert_eq!(
         e,
         "there is no built-in scene \"cornell\"; the built-in scenes are \"default\", \"quiz\", \
-         \"glass\", \"box\", \"acne\" and \"cracks\"."
+         \"glass\", \"box\", \"smooth\", \"acne\" and \"cracks\"."
     );
 }
 
@@ -596,7 +597,7 @@ fn scene_to_toml_round_trips_every_builtin_scene() {
     for name in builtin::NAMES {
         let scene = load_builtin(name).unwrap_or_else(|e| panic!("{e}"));
         let text = scene_to_toml(&scene);
-        let back = load_scene_str_with(&text, name, &builtin::resolve)
+        let back = raytree::scene::load_scene_str_with_files(&text, name, &builtin::resolve, &builtin::resolve_bytes)
             .unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
         assert_scene_eq(&scene, &back, name);
         // Meshes are written as meshes, not as their triangles.
