@@ -193,7 +193,12 @@ fn an_edit_the_viewer_accepts_saves_a_scene_that_loads_and_a_refused_one_does_no
                 apply(&mut scene, e);
             }
             let text = scene_to_toml(&scene);
-            let loaded = raytree::scene::load_scene_str_with_files(&text, name, &builtin::resolve, &builtin::resolve_bytes);
+            let loaded = raytree::scene::load_scene_str_with_files(
+                &text,
+                name,
+                &builtin::resolve,
+                &builtin::resolve_bytes,
+            );
             match rules::check_scene(&scene, true) {
                 Ok(()) => {
                     accepted.set(accepted.get() + 1);

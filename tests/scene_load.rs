@@ -597,8 +597,13 @@ fn scene_to_toml_round_trips_every_builtin_scene() {
     for name in builtin::NAMES {
         let scene = load_builtin(name).unwrap_or_else(|e| panic!("{e}"));
         let text = scene_to_toml(&scene);
-        let back = raytree::scene::load_scene_str_with_files(&text, name, &builtin::resolve, &builtin::resolve_bytes)
-            .unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
+        let back = raytree::scene::load_scene_str_with_files(
+            &text,
+            name,
+            &builtin::resolve,
+            &builtin::resolve_bytes,
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
         assert_scene_eq(&scene, &back, name);
         // Meshes are written as meshes, not as their triangles.
         let meshes = scene
