@@ -9,7 +9,7 @@ use glam::Vec3;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use raytree::scene::builtin::{self, NAMES, load_builtin};
-use raytree::scene::{Light, Scene, load_scene_str_with, rules, scene_to_toml};
+use raytree::scene::{Light, Scene, rules, scene_to_toml};
 
 /// Numbers an edit may bring: ordinary ones, the edges of every rule, and hostile ones.
 const NUMBERS: &[f32] = &[

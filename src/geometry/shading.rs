@@ -81,7 +81,8 @@ pub fn terminator_origin(
         scale = scale.max(v[i].abs());
     }
     let p2 = p + lift;
-    if !(lift.dot(ng) > 0.0) || !p2.is_finite() {
+    // NaN (a degenerate normal) counts as not moving out.
+    if lift.dot(ng).is_nan() || lift.dot(ng) <= 0.0 || !p2.is_finite() {
         return None;
     }
     // Each `(p − v_i)·n_i` is a handful of roundings of numbers of size `scale`.
