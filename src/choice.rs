@@ -63,5 +63,7 @@ mod tests {
         names_are_serde_names::<SphereMethod>();
         names_are_serde_names::<TriangleMethod>();
         names_are_serde_names::<Shading>();
+        names_are_serde_names::<crate::geometry::ShadingNormals>();
+        names_are_serde_names::<crate::scene::NormalsMode>();
     }
 }

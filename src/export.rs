@@ -587,7 +587,7 @@ mod tests {
         assert_eq!(
             text[3].1,
             "{\"accel_used\":\"bvh\",\"height\":201,\"max_depth\":5,\"shading\":\"blinn-phong\",\
-             \"trace\":{\"accel\":\"auto\",\"cutoff\":0.0,\"methods\":{\"offset\":\"error-bound\",\
+             \"trace\":{\"accel\":\"auto\",\"cutoff\":0.0,\"methods\":{\"offset\":\"error-bound\",\"shading_normals\":\"robust\",\
              \"sphere\":\"robust\",\"triangle\":\"watertight\"}},\"width\":201}"
         );
     }

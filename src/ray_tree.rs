@@ -20,13 +20,24 @@ pub const MAX_NODES: usize = 4096;
 pub struct HitRecord {
     pub t: f32,
     pub point: Vec3,
-    /// Unit normal turned towards the incoming ray.
+    /// Unit shading normal (turned like the geometric one, towards the incoming ray's side):
+    /// what the local model and R/T use.
     pub normal: Vec3,
     pub object: String,
     pub material: String,
     pub front_face: bool,
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub barycentric: Option<[f32; 3]>,
+    /// The triangle's own normal, where shading normals apply (the mesh has vertex normals):
+    /// front/back, entering/leaving and the ray-origin offset follow it.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub geometric_normal: Option<Vec3>,
+    /// Texture coordinates, where a texture applies.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub uv: Option<[f32; 2]>,
+    /// The `map_Kd` texel at `uv` (linear RGB), which multiplies the material's diffuse.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub texel: Option<Vec3>,
 }
 
 /// A visible light met by a ray.
@@ -64,6 +75,10 @@ pub struct ShadowRecord {
     /// render ("not traced: contributes nothing").
     #[serde(default)]
     pub contributes_nothing: bool,
+    /// The shading normal faces the light but the geometric surface does not, and the smooth
+    /// surface does not reach above it (STABILITY N3, robust): the light adds nothing.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub behind_surface: bool,
     pub n_dot_l: f32,
     pub n_dot_h: f32,
     pub r_dot_v: f32,
@@ -92,6 +107,10 @@ pub struct Node {
     pub hit: Option<HitRecord>,
     /// `V`, unit vector from the hit towards the ray's origin.
     pub view: Option<Vec3>,
+    /// The direction (reflected or refracted about a shading normal) crossed the geometric
+    /// plane of the surface it left and was mirrored back (STABILITY N2).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub direction_corrected: bool,
     pub local: Option<LocalRecord>,
     pub shadow_rays: Vec<ShadowRecord>,
     pub total_internal_reflection: bool,
@@ -170,6 +189,7 @@ impl Recorder for TreeRecorder<'_> {
             light: None,
             hit: None,
             view: None,
+            direction_corrected: false,
             local: None,
             shadow_rays: Vec::new(),
             total_internal_reflection: false,
@@ -178,6 +198,12 @@ impl Recorder for TreeRecorder<'_> {
             color: Vec3::ZERO,
             children: Vec::new(),
         });
+    }
+
+    fn direction_corrected(&mut self) {
+        if let Some(node) = self.top() {
+            node.direction_corrected = true;
+        }
     }
 
     fn end(&mut self, reason: EndReason) {
@@ -207,6 +233,12 @@ impl Recorder for TreeRecorder<'_> {
                 material: scene.material(hit.material).name.clone(),
                 front_face: hit.front_face,
                 barycentric: hit.barycentric,
+                geometric_normal: hit.vertex_normals.map(|_| hit.geometric_normal),
+                uv: hit
+                    .uv
+                    .filter(|_| hit.texel_kd.is_some() || hit.texel_ka.is_some())
+                    .map(|t| t.to_array()),
+                texel: hit.texel_kd,
             });
             node.view = Some(view);
         }
@@ -215,7 +247,7 @@ impl Recorder for TreeRecorder<'_> {
     fn shadow(&mut self, test: &ShadowTest) {
         let scene = self.scene;
         if let Some(node) = self.top() {
-            let lit = test.blocked_by.is_none() && test.terms.n_dot_l > 0.0;
+            let lit = test.blocked_by.is_none() && !test.behind_surface && test.terms.n_dot_l > 0.0;
             let (n, v) = match (&node.hit, node.view) {
                 (Some(h), Some(v)) => (h.normal, v),
                 _ => (Vec3::ZERO, Vec3::ZERO),
@@ -228,7 +260,10 @@ impl Recorder for TreeRecorder<'_> {
                 blocked_by: test.blocked_by.map(|o| scene.object(o).name.clone()),
                 blocked_at: test.blocked_at,
                 facing_away: test.terms.n_dot_l.is_nan() || test.terms.n_dot_l <= 0.0,
-                contributes_nothing: !test.traced && test.terms.n_dot_l > 0.0,
+                contributes_nothing: !test.traced
+                    && test.terms.n_dot_l > 0.0
+                    && !test.behind_surface,
+                behind_surface: test.behind_surface,
                 n_dot_l: test.terms.n_dot_l,
                 n_dot_h: test.terms.n_dot_h,
                 r_dot_v: test.terms.r_dot_v,

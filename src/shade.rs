@@ -66,6 +66,20 @@ pub fn light_terms(
     l: Vec3,
     v: Vec3,
 ) -> LightTerms {
+    light_terms_with(shading, material, material.diffuse, color, n, l, v)
+}
+
+/// [`light_terms`] with the diffuse coefficient `kd` given (the material's, times a texel).
+#[inline]
+pub fn light_terms_with(
+    shading: Shading,
+    material: &Material,
+    kd: Vec3,
+    color: Vec3,
+    n: Vec3,
+    l: Vec3,
+    v: Vec3,
+) -> LightTerms {
     let n_dot_l = n.dot(l);
     let h = halfway(l, v);
     let n_dot_h = n.dot(h);
@@ -89,7 +103,7 @@ pub fn light_terms(
         n_dot_l,
         n_dot_h,
         r_dot_v,
-        diffuse: color * material.diffuse * n_dot_l,
+        diffuse: color * kd * n_dot_l,
         specular: color * material.specular * spec,
     }
 }

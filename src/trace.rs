@@ -14,17 +14,17 @@
 
 use std::sync::Arc;
 
-use glam::{Vec3, Vec3A};
+use glam::{Vec2, Vec3, Vec3A};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::accel::{Accel, AccelKind, PrimHit, PrimSet, Visits};
 use crate::geometry::{
-    Methods, OffsetMethod, Ray, intersect_sphere, offset_ray_origin, sphere_hit_point,
-    triangle_hit_point,
+    Methods, OffsetMethod, Ray, ShadingNormals, interpolate_normal, intersect_sphere, keep_side,
+    offset_ray_origin, sphere_hit_point, terminator_origin, triangle_hit_point,
 };
 use crate::scene::{MaterialId, ObjectId, Scene};
-use crate::shade::{LightTerms, ambient_term, light_terms, reflect, refract};
+use crate::shade::{LightTerms, light_terms_with, reflect, refract};
 
 /// Rays (shadow rays included) one sample may trace; past it, branches end as
 /// [`EndReason::Budget`]. Natural scenes use a few dozen; the budget bounds the work of
@@ -127,13 +127,24 @@ impl Default for SampleInfo {
 pub struct SurfaceHit {
     pub t: f32,
     pub point: Vec3,
-    /// Unit normal turned towards the incoming ray.
+    /// Unit shading normal: the geometric normal, or the one interpolated from the mesh's
+    /// vertex normals, on the side of the surface the ray came from (the geometric side).
     pub normal: Vec3,
+    /// Unit geometric normal turned towards the incoming ray: decides front/back, entering or
+    /// leaving and the ray-origin offset.
+    pub geometric_normal: Vec3,
     pub object: ObjectId,
     pub material: MaterialId,
     pub front_face: bool,
     /// Barycentric weights of the triangle's vertices; `None` for spheres.
     pub barycentric: Option<[f32; 3]>,
+    /// The triangle's unit vertex normals, turned like `geometric_normal`, when it has them.
+    pub vertex_normals: Option<[Vec3; 3]>,
+    /// Texture coordinates where the triangle has them and its material a texture.
+    pub uv: Option<Vec2>,
+    /// The diffuse (`map_Kd`) and ambient (`map_Ka`) texels at `uv`, linear RGB.
+    pub texel_kd: Option<Vec3>,
+    pub texel_ka: Option<Vec3>,
 }
 
 /// One light's shadow ray at a hit, as the tree shows it.
@@ -151,6 +162,10 @@ pub struct ShadowTest {
     /// Whether the shadow ray was cast: not when the light is behind the surface (`N·L ≤ 0`)
     /// nor when its unshadowed contribution is exactly zero (see [`casts_shadow_ray`]).
     pub traced: bool,
+    /// The shading normal faces the light but the light is behind the geometric surface and
+    /// the smooth surface does not reach above it (STABILITY N3): the light adds nothing, and
+    /// no shadow ray is cast.
+    pub behind_surface: bool,
     pub terms: LightTerms,
 }
 
@@ -159,6 +174,9 @@ pub trait Recorder {
     /// `false` lets the trace skip work done only for the recorder (finding the blocker's name).
     const ENABLED: bool;
     fn enter(&mut self, _kind: RayKind, _depth: u32, _ray: &Ray, _weight: Vec3) {}
+    /// The ray just entered had its direction mirrored back across the geometric plane of the
+    /// surface it leaves (STABILITY N2).
+    fn direction_corrected(&mut self) {}
     fn end(&mut self, _reason: EndReason) {}
     /// The ray ended on visible light `light` at distance `t`.
     fn light(&mut self, _light: usize, _t: f32) {}
@@ -274,6 +292,8 @@ struct Branch {
     kind: RayKind,
     depth: u32,
     weight: Vec3,
+    /// Its direction was bent back across the geometric plane (STABILITY N2).
+    corrected: bool,
 }
 
 /// What every ray of one sample adds to: the ray counts, the pixel's facts and the recorder.
@@ -369,6 +389,7 @@ impl Tracer {
             kind,
             depth,
             weight,
+            corrected: false,
         };
         self.trace_ray(ray, branch, &mut Sample { counts, info, rec })
     }
@@ -390,6 +411,9 @@ impl Tracer {
         given: Option<&Given>,
     ) -> Vec3 {
         s.rec.enter(b.kind, b.depth, ray, b.weight);
+        if b.corrected {
+            s.rec.direction_corrected();
+        }
         let background = self.scene.render.background;
         let color = if let Some(reason) = self.ends_untraced(b.depth, b.weight, s.info) {
             ended(s, reason);
@@ -454,6 +478,7 @@ impl Tracer {
             kind: RayKind::Primary,
             depth: 0,
             weight: Vec3::ONE,
+            corrected: false,
         };
         let bits = || (0..K).filter(move |&i| active & (1 << i) != 0);
         if self
@@ -497,8 +522,12 @@ impl Tracer {
                     let material = scene.material(surface.material);
                     let v = -rays[i].dir;
                     let mut terms = None;
-                    let (_, _, ray) =
-                        self.light_ray::<NoRecord>(surface, *error, material, v, light, &mut terms);
+                    let Found::Prim(hit) = g.found else { continue };
+                    let ray = self
+                        .light_ray::<NoRecord>(
+                            surface, hit.prim, *error, material, v, light, &mut terms,
+                        )
+                        .ray;
                     if let Some((ray, length)) = ray {
                         shadow[i] = ray;
                         lengths[i] = length;
@@ -541,66 +570,156 @@ impl Tracer {
         }
     }
 
-    /// Hit point, its error bound, geometric normal, object, material and barycentrics.
+    /// Hit point, its error bound, normals, object, material, barycentrics and texture.
     fn surface(&self, ray: &Ray, hit: &PrimHit) -> (SurfaceHit, Vec3) {
         let scene = &self.scene;
         let n_spheres = scene.spheres.len();
         let prim = hit.prim as usize;
+        let mut vertex_normals = None;
+        let mut uvs = None;
         let (point, error, normal, object, material, barycentric) = if prim < n_spheres {
             let s = &scene.spheres[prim];
             let (p, err) = sphere_hit_point(self.methods().sphere, s.center, s.radius, ray, hit.t);
             let n = div3(p - s.center, s.radius).normalize();
             (p, err, n, s.object, s.material, None)
         } else {
-            let tri = &scene.triangles[prim - n_spheres];
+            let index = prim - n_spheres;
+            let tri = &scene.triangles[index];
             let v = &tri.vertices;
             let (p, err) = triangle_hit_point(v, hit.b1, hit.b2);
             let n = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
             let b = [1.0 - hit.b1 - hit.b2, hit.b1, hit.b2];
+            if let Some((attrs, local)) = scene.attributes_of(index) {
+                vertex_normals = attrs.normals_of(local);
+                uvs = attrs.uvs_of(local);
+            }
             (p, err, n, tri.object, tri.material, Some(b))
         };
         let front_face = ray.dir.dot(normal) < 0.0;
+        let side = if front_face { 1.0 } else { -1.0 };
+        let geometric_normal = side * normal;
+        let mut shading_normal = geometric_normal;
+        let b = barycentric.unwrap_or([1.0, 0.0, 0.0]);
+        if let Some(ns) = vertex_normals.as_mut() {
+            *ns = ns.map(|n| side * n);
+            if let Some(n) = interpolate_normal(ns, b) {
+                shading_normal = n;
+            }
+        }
+        let uv = uvs.map(|t| b[0] * t[0] + b[1] * t[1] + b[2] * t[2]);
+        let (mut texel_kd, mut texel_ka) = (None, None);
+        if let Some(uv) = uv {
+            let m = scene.material(material);
+            let texel = |map: Option<crate::scene::TextureId>| {
+                map.and_then(|id| scene.texture(id)).map(|t| t.sample(uv))
+            };
+            texel_kd = texel(m.diffuse_map);
+            texel_ka = texel(m.ambient_map);
+        }
         let surface = SurfaceHit {
             t: hit.t,
             point,
-            normal: if front_face { normal } else { -normal },
+            normal: shading_normal,
+            geometric_normal,
             object,
             material,
             front_face,
             barycentric,
+            vertex_normals,
+            uv,
+            texel_kd,
+            texel_ka,
         };
         (surface, error)
     }
 
-    /// Light `light` at a hit (`surface`, its point's error bound `error`, its material, `v`
-    /// towards the viewer): the unit vector `L` to the light, the distance, and the shadow
-    /// ray with its length when one is cast (see [`casts_shadow_ray`]). `terms` gets the
-    /// light's terms when the recorder is on or the decision needed them. The one place that
-    /// decides, for the single and the packet trace alike.
+    /// Light `light` at a hit (`surface` of primitive `prim`, its point's error bound `error`,
+    /// its material, `v` towards the viewer): the unit vector `L` to the light, the distance,
+    /// the shadow ray with its length when one is cast, and whether the light is behind the
+    /// geometric surface (STABILITY N3, robust; then no ray either). No ray where `N·L ≤ 0` or
+    /// the light's unshadowed contribution is exactly zero (see [`casts_shadow_ray`]). `terms`
+    /// gets the light's terms when the recorder is on or the decision needed them. The one
+    /// place that decides, for the single and the packet trace alike.
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn light_ray<R: Recorder>(
         &self,
         surface: &SurfaceHit,
+        prim: u32,
         error: Vec3,
         material: &crate::scene::Material,
         v: Vec3,
         light: &crate::scene::Light,
         terms: &mut Option<LightTerms>,
-    ) -> (Vec3, f32, Option<(Ray, f32)>) {
+    ) -> LightRay {
         let (p, n) = (surface.point, surface.normal);
         let shading = self.scene.render.shading;
         let to_light = light.position - p;
         let distance = to_light.length();
         let l = div3(to_light, distance);
+        let kd = texelled(material.diffuse, surface.texel_kd);
         if R::ENABLED {
-            *terms = Some(light_terms(shading, material, light.color, n, l, v));
+            *terms = Some(light_terms_with(
+                shading,
+                material,
+                kd,
+                light.color,
+                n,
+                l,
+                v,
+            ));
         }
-        let cast =
-            n.dot(l) > 0.0 && casts_shadow_ray(shading, material, light.color, n, l, v, terms);
-        // Only objects count as blockers, never lights.
-        let offset = self.methods().offset;
-        let ray = cast.then(|| shadow_ray(offset, p, error, n, l, light.position));
-        (l, distance, ray)
+        let mut out = LightRay {
+            l,
+            distance,
+            ray: None,
+            behind_surface: false,
+        };
+        if !(n.dot(l) > 0.0 && casts_shadow_ray(shading, material, kd, light.color, n, l, v, terms))
+        {
+            return out;
+        }
+        match self.shadow_start(surface, prim, error, l) {
+            Some((q, q_error, side)) => {
+                // Only objects count as blockers, never lights.
+                let offset = self.methods().offset;
+                let ng = surface.geometric_normal;
+                out.ray = Some(shadow_ray(offset, q, q_error, ng, side, light.position));
+            }
+            None => out.behind_surface = true,
+        }
+        out
+    }
+
+    /// Where the shadow ray towards a light in direction `l` starts, the error bound of that
+    /// point and the side it is offset to; `None` when the light adds nothing without one
+    /// (STABILITY N3, robust: the light is behind the geometric surface and the smooth surface
+    /// does not reach above it). Flat surfaces, and the naive method, start from the hit point
+    /// offset to the light's side.
+    #[inline(always)]
+    fn shadow_start(
+        &self,
+        surface: &SurfaceHit,
+        prim: u32,
+        error: Vec3,
+        l: Vec3,
+    ) -> Option<(Vec3, Vec3, Vec3)> {
+        let (p, ng) = (surface.point, surface.geometric_normal);
+        let robust = self.methods().shading_normals == ShadingNormals::Robust;
+        let (Some(ns), Some(b), true) = (surface.vertex_normals, surface.barycentric, robust)
+        else {
+            return Some((p, error, l));
+        };
+        let index = prim as usize - self.scene.spheres.len();
+        let v = &self.scene.triangles[index].vertices;
+        // N1 (Hanika 2021): from the smooth surface, when it lies outside the flat one, offset
+        // to the visible side: a light behind the surface is then reached only past its edge
+        // (N3), never through it.
+        let in_front = ng.dot(l) > 0.0;
+        match terminator_origin(v, &ns, b, p, error, ng) {
+            Some((q, q_error, clear)) if in_front || clear => Some((q, q_error, ng)),
+            _ => in_front.then_some((p, error, l)),
+        }
     }
 
     /// The colour of a ray `b` that hit `hit`: the local model with a shadow ray per light,
@@ -617,7 +736,7 @@ impl Tracer {
         let scene = &*self.scene;
         let offset = self.methods().offset;
         let (surface, error) = at.unwrap_or_else(|| self.surface(ray, hit));
-        let (p, n) = (surface.point, surface.normal);
+        let (p, n, ng) = (surface.point, surface.normal, surface.geometric_normal);
         let v = -ray.dir;
         s.rec.hit(&surface, v);
         if b.depth == 0 {
@@ -625,8 +744,14 @@ impl Tracer {
             s.info.hit_t = surface.t;
         }
         let material = scene.material(surface.material);
+        // Texels multiply kd and ka where the material has textures (flat colours otherwise).
+        let kd = texelled(material.diffuse, surface.texel_kd);
+        let ka = texelled(material.ambient, surface.texel_ka);
+        let terms_of = |color: Vec3, l: Vec3| {
+            light_terms_with(scene.render.shading, material, kd, color, n, l, v)
+        };
 
-        let ambient = ambient_term(material, scene.render.ambient_light);
+        let ambient = ka * scene.render.ambient_light;
         let mut diffuse = Vec3::ZERO;
         let mut specular = Vec3::ZERO;
         for (i, light) in scene.lights.iter().enumerate() {
@@ -634,8 +759,12 @@ impl Tracer {
             // are not blocked, so they compute them after the shadow ray (N·L is the same
             // product `light_terms` forms, so the answer is unchanged).
             let mut terms = None;
-            let (l, distance, cast) =
-                self.light_ray::<R>(&surface, error, material, v, light, &mut terms);
+            let LightRay {
+                l,
+                distance,
+                ray: cast,
+                behind_surface,
+            } = self.light_ray::<R>(&surface, hit.prim, error, material, v, light, &mut terms);
             let mut blocked_by = None;
             let mut blocked_at = None;
             if let Some((shadow_ray, length)) = cast {
@@ -652,9 +781,7 @@ impl Tracer {
                     occluded(i, &shadow_ray, length)
                 };
                 if !blocked {
-                    let terms = terms.unwrap_or_else(|| {
-                        light_terms(scene.render.shading, material, light.color, n, l, v)
-                    });
+                    let terms = terms.unwrap_or_else(|| terms_of(light.color, l));
                     diffuse += terms.diffuse;
                     specular += terms.specular;
                 }
@@ -667,6 +794,7 @@ impl Tracer {
                     blocked_by,
                     blocked_at,
                     traced: cast.is_some(),
+                    behind_surface,
                     terms,
                 });
             }
@@ -699,13 +827,23 @@ impl Tracer {
             reflected_weight,
             if refracted.is_some() { kt } else { Vec3::ZERO },
         );
-        // Each child leaves the surface on the side it goes to and carries its weight.
+        // Each child leaves the surface on the side it goes to and carries its weight. About a
+        // shading normal, a direction can cross the geometric plane into the surface it
+        // leaves; the robust method mirrors it back (STABILITY N2).
+        let keep = surface.vertex_normals.is_some()
+            && self.methods().shading_normals == ShadingNormals::Robust;
         let child = |kind, dir: Vec3, k: Vec3, s: &mut Sample<'_, R>| {
-            let ray = Ray::new(offset_ray_origin(offset, p, error, n, dir), dir);
+            let (dir, corrected) = if keep {
+                keep_side(dir, ng, kind == RayKind::Reflected)
+            } else {
+                (dir, false)
+            };
+            let ray = Ray::new(offset_ray_origin(offset, p, error, ng, dir), dir);
             let branch = Branch {
                 kind,
                 depth: b.depth + 1,
                 weight: b.weight * k,
+                corrected,
             };
             k * self.trace_ray(&ray, branch, s)
         };
@@ -738,11 +876,15 @@ impl Tracer {
             return Visits::default();
         };
         let (surface, error) = self.surface(&ray, &hit);
-        // As in `shade`: no shadow ray unless N·L > 0 and the light can add something.
+        // As in `shade`: no shadow ray unless N·L > 0 and the light can add something, and
+        // from where `shade` starts it.
         let material = self.scene.material(surface.material);
         let v = -ray.dir;
-        match self.light_ray::<NoRecord>(&surface, error, material, v, light, &mut None) {
-            (_, _, Some((shadow, length))) => self.accel.occluded_visits(m, &shadow, 0.0, length),
+        match self
+            .light_ray::<NoRecord>(&surface, hit.prim, error, material, v, light, &mut None)
+            .ray
+        {
+            Some((shadow, length)) => self.accel.occluded_visits(m, &shadow, 0.0, length),
             _ => Visits::default(),
         }
     }
@@ -759,7 +901,8 @@ impl Tracer {
     }
 }
 
-/// Whether a light in front of the surface (`N·L > 0`) needs a shadow ray: not when its
+/// Whether a light in front of the surface (`N·L > 0`) needs a shadow ray (`kd` is the
+/// material's diffuse times its texel, where textured): not when its
 /// unshadowed contribution is exactly zero, so the ray could not change the pixel. The diffuse
 /// term is `(C_l ⊙ kd)·N·L` and the specular `(C_l ⊙ ks)·spec`: when `C_l ⊙ kd` has a non-zero
 /// channel the ray is cast; otherwise the terms are formed (into `terms`, when not already
@@ -771,31 +914,52 @@ impl Tracer {
 fn casts_shadow_ray(
     shading: crate::scene::Shading,
     material: &crate::scene::Material,
+    kd: Vec3,
     color: Vec3,
     n: Vec3,
     l: Vec3,
     v: Vec3,
     terms: &mut Option<LightTerms>,
 ) -> bool {
-    if color * material.diffuse != Vec3::ZERO {
+    if color * kd != Vec3::ZERO {
         return true;
     }
-    let t = *terms.get_or_insert_with(|| light_terms(shading, material, color, n, l, v));
+    let t = *terms.get_or_insert_with(|| light_terms_with(shading, material, kd, color, n, l, v));
     t.specular != Vec3::ZERO || t.diffuse != Vec3::ZERO
 }
 
-/// The shadow ray from hit point `p` (error bound `error`, normal `n`) towards the light at
-/// `light` in direction `l`: from the offset origin to the light's centre, and its length.
+/// A material's colour times its texel, where the surface is textured.
+#[inline(always)]
+fn texelled(colour: Vec3, texel: Option<Vec3>) -> Vec3 {
+    match texel {
+        Some(t) => colour * t,
+        None => colour,
+    }
+}
+
+/// One light seen from a hit: the unit vector to it, its distance, the shadow ray and its
+/// length when one is cast, and whether it is behind the geometric surface (STABILITY N3).
+struct LightRay {
+    l: Vec3,
+    distance: f32,
+    ray: Option<(Ray, f32)>,
+    behind_surface: bool,
+}
+
+/// The shadow ray from hit point `p` (error bound `error`, geometric normal `n`) towards the
+/// light at `light`: from the origin offset to the side of the surface `side` points to (the
+/// direction `l` to the light; the visible side for robust shading normals, so the ray never
+/// starts behind the surface, STABILITY N3) to the light's centre, and its length.
 #[inline(always)]
 fn shadow_ray(
     offset: OffsetMethod,
     p: Vec3,
     error: Vec3,
     n: Vec3,
-    l: Vec3,
+    side: Vec3,
     light: Vec3,
 ) -> (Ray, f32) {
-    let origin = offset_ray_origin(offset, p, error, n, l);
+    let origin = offset_ray_origin(offset, p, error, n, side);
     let segment = light - origin;
     let length = segment.length();
     (Ray::new(origin, div3(segment, length)), length)

@@ -403,7 +403,10 @@ fn model_files() -> HashMap<String, String> {
             .expect("name")
             .to_string_lossy()
             .to_string();
-        let text = std::fs::read_to_string(&path).expect("model");
+        // Textures (binary) are not text models.
+        let Ok(text) = std::fs::read_to_string(&path) else {
+            continue;
+        };
         files.insert(format!("../models/{name}"), text.clone());
         files.insert(name, text);
     }

@@ -1,7 +1,8 @@
 //! Coherent rays: camera rays traced in packets (and their shadow rays towards each light) give
 //! the image of the single-ray path bit for bit, with the same ray counts and pixel facts, on
 //! every built-in scene (the stability scenes `acne` and `cracks` among them), with every
-//! accelerator and every intersection and offset method; and the packet queries of the
+//! accelerator and every intersection, offset and shading-normal method (the smooth, textured
+//! `smooth` scene among them); and the packet queries of the
 //! accelerator answer what the single queries answer.
 
 use std::sync::Arc;
@@ -9,7 +10,7 @@ use std::sync::Arc;
 use glam::Vec3;
 use raytree::accel::{Accel, AccelKind, PrimSet};
 use raytree::choice::Choice;
-use raytree::geometry::{Methods, OffsetMethod, Ray, SphereMethod, TriangleMethod};
+use raytree::geometry::{Methods, OffsetMethod, Ray, ShadingNormals, SphereMethod, TriangleMethod};
 use raytree::render::{
     Image, Rect, accumulate_tile, accumulate_tile_single, render, render_with, trace_tile_single,
 };
@@ -70,14 +71,17 @@ fn every_method_and_the_cutoff_are_bit_identical() {
         for &sphere in SphereMethod::ALL {
             for &triangle in TriangleMethod::ALL {
                 for &offset in OffsetMethod::ALL {
-                    variants.push((
-                        Methods {
-                            sphere,
-                            triangle,
-                            offset,
-                        },
-                        0.0,
-                    ));
+                    for &shading_normals in ShadingNormals::ALL {
+                        variants.push((
+                            Methods {
+                                sphere,
+                                triangle,
+                                offset,
+                                shading_normals,
+                            },
+                            0.0,
+                        ));
+                    }
                 }
             }
         }

@@ -22,6 +22,7 @@ fn glass(name: &str, kr: f32, kt: f32) -> Material {
         reflectivity: Vec3::splat(kr),
         transparency: Vec3::splat(kt),
         ior: 1.5,
+        ..Material::default()
     }
 }
 

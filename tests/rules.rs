@@ -9,7 +9,7 @@ use glam::Vec3;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use raytree::scene::builtin::{self, NAMES, load_builtin};
-use raytree::scene::{Light, Scene, load_scene_str_with, rules, scene_to_toml};
+use raytree::scene::{Light, Scene, rules, scene_to_toml};
 
 /// Numbers an edit may bring: ordinary ones, the edges of every rule, and hostile ones.
 const NUMBERS: &[f32] = &[
@@ -193,7 +193,12 @@ fn an_edit_the_viewer_accepts_saves_a_scene_that_loads_and_a_refused_one_does_no
                 apply(&mut scene, e);
             }
             let text = scene_to_toml(&scene);
-            let loaded = load_scene_str_with(&text, name, &builtin::resolve);
+            let loaded = raytree::scene::load_scene_str_with_files(
+                &text,
+                name,
+                &builtin::resolve,
+                &builtin::resolve_bytes,
+            );
             match rules::check_scene(&scene, true) {
                 Ok(()) => {
                     accepted.set(accepted.get() + 1);

@@ -328,6 +328,8 @@ fn mesh_placement_scales_rotates_and_translates() {
             translate: Vec3::new(1.0, 2.0, 3.0),
             rotate_deg: Vec3::new(0.0, 0.0, 90.0),
             scale: Vec3::splat(2.0),
+            normals: raytree::scene::NormalsMode::File,
+            crease_angle_deg: 60.0,
         }
     );
     assert_eq!(names(&scene), ["default"]);
@@ -526,6 +528,7 @@ fn builtin_scenes_load_cleanly() {
         ("quiz", 1, 0, 1, 1, 1),
         ("glass", 4, 1, 128 + 128 + 8, 2, 5),
         ("box", 3, 2, 12, 1, 6),
+        ("smooth", 3, 0, 128 + 2 * 224, 2, 4),
         ("acne", 5, 3, 2, 1, 3),
         ("cracks", 1, 0, 128, 1, 1),
     ];
@@ -560,7 +563,7 @@ fn builtin_scenes_load_cleanly() {
     assert_eq!(
         e,
         "there is no built-in scene \"cornell\"; the built-in scenes are \"default\", \"quiz\", \
-         \"glass\", \"box\", \"acne\" and \"cracks\"."
+         \"glass\", \"box\", \"smooth\", \"acne\" and \"cracks\"."
     );
 }
 
@@ -606,8 +609,13 @@ fn scene_to_toml_round_trips_every_builtin_scene() {
     for name in builtin::NAMES {
         let scene = load_builtin(name).unwrap_or_else(|e| panic!("{e}"));
         let text = scene_to_toml(&scene);
-        let back = load_scene_str_with(&text, name, &builtin::resolve)
-            .unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
+        let back = raytree::scene::load_scene_str_with_files(
+            &text,
+            name,
+            &builtin::resolve,
+            &builtin::resolve_bytes,
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}\n{text}"));
         assert_scene_eq(&scene, &back, name);
         // Meshes are written as meshes, not as their triangles.
         let meshes = scene

@@ -432,3 +432,82 @@ fn cracks_scene_shows_cracks_only_with_the_naive_triangle_tests() {
         assert_scene_shows_failure("cracks", naive, 20);
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Shading normals (N1–N3)
+
+use glam::Vec3;
+use raytree::geometry::ShadingNormals;
+
+/// N1: on low-poly spheres with exact vertex normals the flat hit point shadows itself near the
+/// terminator (naive: a band about one facet wide); the shadow ray from the smooth surface
+/// (Hanika 2021) leaves no band wider than a facet's curvature error, and the image error
+/// against the analytic sphere stays within 2× the shadow-free limit.
+#[test]
+fn n1_shadow_terminator() {
+    let l = Vec3::new(0.3, 0.8, 0.5);
+    for level in [1, 2, 3] {
+        let naive = terminator_cell(ShadingNormals::Naive, level, l, 2000, &mut Pcg::new(5));
+        let robust = terminator_cell(ShadingNormals::Robust, level, l, 2000, &mut Pcg::new(5));
+        // Naive: a dark band near the terminator, a good part of a facet wide.
+        assert!(naive.self_shadowed > 0, "{naive:?}");
+        assert!(naive.band_deg > 0.4 * naive.facet_deg, "{naive:?}");
+        assert!(naive.mean_err > 10.0 * naive.limit_err, "{naive:?}");
+        // Robust: no band wider than a facet, error within 2× the shadow-free limit.
+        assert!(robust.band_deg <= robust.facet_deg, "{robust:?}");
+        assert_eq!(robust.self_shadowed, 0, "{robust:?}");
+        assert!(
+            robust.mean_err <= 2.0 * robust.limit_err + 1e-7,
+            "{robust:?}"
+        );
+    }
+}
+
+/// N2: mirror directions about the shading normal of a 32-triangle sphere cross the geometric
+/// plane at grazing views (a third of them at 80° from the normal); robust: none do, and every
+/// one bent back is marked corrected (the tree's `direction_corrected`).
+#[test]
+fn n2_directions_keep_their_side() {
+    for (view, naive_at_least) in [(0.0f32, 0), (80.0, 20), (89.0, 50)] {
+        let naive = side_cell(
+            ShadingNormals::Naive,
+            1,
+            view,
+            false,
+            2000,
+            &mut Pcg::new(6),
+        );
+        let robust = side_cell(
+            ShadingNormals::Robust,
+            1,
+            view,
+            false,
+            2000,
+            &mut Pcg::new(6),
+        );
+        assert!(
+            naive.wrong_side * 100 >= naive_at_least * naive.children,
+            "{view}°: {naive:?}"
+        );
+        assert_eq!(naive.corrected, 0);
+        assert_eq!(robust.wrong_side, 0, "{view}°: {robust:?}");
+        assert_eq!(robust.corrected, naive.wrong_side, "{view}°");
+    }
+    // Refraction into glass bends towards −N: it never crosses, with either method.
+    let t = side_cell(ShadingNormals::Robust, 1, 89.0, true, 500, &mut Pcg::new(6));
+    assert_eq!(t.wrong_side, 0, "{t:?}");
+}
+
+/// N3: a large wall whose vertex normals lean towards a light behind it: naive lights every
+/// sample whose shading normal faces the light (the light leaks through the wall); robust: none.
+#[test]
+fn n3_no_light_through_the_surface() {
+    for tilt in [5.0f32, 45.0] {
+        for below in [1.0f32, 5.0] {
+            let naive = leak_cell(ShadingNormals::Naive, tilt, below, 1000, &mut Pcg::new(7));
+            let robust = leak_cell(ShadingNormals::Robust, tilt, below, 1000, &mut Pcg::new(7));
+            assert!(naive.facing > 0 && naive.leaks == naive.facing, "{naive:?}");
+            assert_eq!(robust.leaks, 0, "{robust:?}");
+        }
+    }
+}

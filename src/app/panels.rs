@@ -26,6 +26,7 @@ pub mod tips {
     pub const TRIANGLE: &str =
         "How a ray is intersected with a triangle (plane, then inside test).";
     pub const OFFSET: &str = "Secondary rays (shadow, reflected, refracted) start a little off the surface they leave, so they do not hit it again at t ≈ 0 (\"shadow acne\"). This picks how far.";
+    pub const SHADING_NORMALS: &str = "Meshes with vertex normals are shaded as if smooth while their triangles stay flat. Robust keeps the flat geometry from darkening the terminator (shadow rays start on the smooth surface), bends reflected and refracted rays back out of the surface, and lets no light through from behind; naive shows those failures.";
     pub const ACCEL: &str = "The structure that finds which objects a ray can hit without testing them all. Changes the speed, never the image.";
     pub const CUTOFF: &str = "Adaptive depth: a ray whose weight (the product of kr and kt down the tree) is below this is not traced, as it could barely change the pixel. 0 traces every ray down to max depth.";
     pub const THREADS: &str = "CPU threads rendering the image (0: all cores).";
@@ -328,6 +329,12 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
             restart |= combo(ui, "sphere", &mut t.methods.sphere, tips::SPHERE);
             restart |= combo(ui, "triangle", &mut t.methods.triangle, tips::TRIANGLE);
             restart |= combo(ui, "offset", &mut t.methods.offset, tips::OFFSET);
+            restart |= combo(
+                ui,
+                "shading normals",
+                &mut t.methods.shading_normals,
+                tips::SHADING_NORMALS,
+            );
             rebuild |= combo(ui, "accelerator", &mut t.accel, tips::ACCEL);
             ui.horizontal(|ui| {
                 restart |= drag(

@@ -650,6 +650,22 @@ pub fn detail(ui: &mut Ui, tree: &RayTree, path: &[usize]) {
                         format!("({:.4}, {:.4}, {:.4})", b[0], b[1], b[2]),
                     );
                 }
+                if let Some(ng) = hit.geometric_normal {
+                    row(ui, "N geometric", fmt3(ng));
+                }
+                if let Some([u, v]) = hit.uv {
+                    row(ui, "UV", format!("({u:.4}, {v:.4})"));
+                }
+                if let Some(t) = hit.texel {
+                    row(ui, "texel (× kd)", fmt3(t));
+                }
+            }
+            if node.direction_corrected {
+                row(
+                    ui,
+                    "direction",
+                    "corrected: mirrored back across the geometric plane".into(),
+                );
             }
             if let Some(v) = node.view {
                 row(ui, "V", fmt3(v));
@@ -659,6 +675,8 @@ pub fn detail(ui: &mut Ui, tree: &RayTree, path: &[usize]) {
         ui.separator();
         let verdict = if s.facing_away {
             "facing away (N·L <= 0): adds nothing".to_string()
+        } else if s.behind_surface {
+            "behind the geometric surface: adds nothing".to_string()
         } else if s.contributes_nothing {
             "not traced: contributes nothing (kd and ks give zero)".to_string()
         } else if let Some(b) = &s.blocked_by {

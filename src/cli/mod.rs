@@ -6,7 +6,7 @@ use anyhow::Result;
 use clap::Args;
 use raytree::accel::AccelKind;
 use raytree::choice::Choice;
-use raytree::geometry::{Methods, OffsetMethod, SphereMethod, TriangleMethod};
+use raytree::geometry::{Methods, OffsetMethod, ShadingNormals, SphereMethod, TriangleMethod};
 use raytree::scene::{self, Scene, Shading, rules};
 use raytree::trace::TraceSettings;
 
@@ -54,6 +54,10 @@ pub struct SceneOverrides {
     #[arg(long, value_parser = ChoiceParser::<OffsetMethod>::default(),
           default_value = OffsetMethod::default().name())]
     offset: OffsetMethod,
+    /// Where shading and geometric normals disagree (STABILITY N1–N3).
+    #[arg(long, value_parser = ChoiceParser::<ShadingNormals>::default(),
+          default_value = ShadingNormals::default().name())]
+    shading_normals: ShadingNormals,
     /// Skip rays whose weight (product of kr/kt) is below this (adaptive depth); 0 = off,
     /// below 1.
     #[arg(long, default_value_t = 0.0, value_parser = cutoff)]
@@ -153,6 +157,7 @@ pub fn apply_overrides(scene: &mut Scene, o: &SceneOverrides) -> TraceSettings {
             sphere: o.sphere,
             triangle: o.triangle,
             offset: o.offset,
+            shading_normals: o.shading_normals,
         },
         cutoff: o.cutoff,
     }

@@ -3,6 +3,7 @@
 //! fails and what the robust one reaches, judges that against the target, and charts the
 //! failure rate against scale.
 
+use glam::Vec3;
 use serde::Serialize;
 
 use super::chart::{Chart, Series, write_chart};
@@ -11,7 +12,7 @@ use super::rng::Pcg;
 use super::stability::*;
 use crate::accel::AccelKind;
 use crate::export::{ExportError, write_text};
-use crate::geometry::{OffsetMethod, SphereMethod, TriangleMethod};
+use crate::geometry::{OffsetMethod, ShadingNormals, SphereMethod, TriangleMethod};
 
 /// How a row's robust method meets its target.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -73,7 +74,7 @@ impl StabilityOptions {
 /// Every row, in the order of STABILITY.md. `progress` gets each row's id before it runs.
 pub fn rows(opts: &StabilityOptions, progress: &dyn Fn(&str)) -> Vec<Row> {
     type RowFn = fn(&StabilityOptions, &mut Pcg) -> Row;
-    let all: [(&str, RowFn); 13] = [
+    let all: [(&str, RowFn); 16] = [
         ("S1", row_s1),
         ("S2", row_s2),
         ("S3", row_s3),
@@ -87,6 +88,9 @@ pub fn rows(opts: &StabilityOptions, progress: &dyn Fn(&str)) -> Vec<Row> {
         ("A2", row_a2),
         ("A3", row_a3),
         ("R1", row_r1),
+        ("N1", row_n1),
+        ("N2", row_n2),
+        ("N3", row_n3),
     ];
     let mut out: Vec<Row> = all
         .iter()
@@ -1104,6 +1108,216 @@ fn row_r1(o: &StabilityOptions, rng: &mut Pcg) -> Row {
             Verdict::No
         },
         chart: None,
+    }
+}
+
+/// N1–N3 sweep the octasphere from 32 to 8192 triangles (levels 1…5).
+const N_LEVELS: [u32; 5] = [1, 2, 3, 4, 5];
+
+fn row_n1(o: &StabilityOptions, rng: &mut Pcg) -> Row {
+    let lights = [
+        Vec3::new(0.3, 0.8, 0.5),
+        Vec3::new(1.0, 0.1, 0.0),
+        Vec3::new(-0.2, -0.5, 0.9),
+    ];
+    let mut series = Vec::new();
+    let (mut naive_text, mut robust_ok, mut naive_fails) = (Vec::new(), true, true);
+    let (mut worst_band, mut worst_ratio) = (0.0f64, 0.0f64);
+    for (m, name) in [
+        (ShadingNormals::Naive, "naive"),
+        (ShadingNormals::Robust, "robust"),
+    ] {
+        let mut points = Vec::new();
+        for &level in &N_LEVELS {
+            let seed = rng.next_u32();
+            let cells: Vec<TerminatorCell> = lights
+                .iter()
+                .map(|&l| terminator_cell(m, level, l, o.rays, &mut Pcg::new(u64::from(seed))))
+                .collect();
+            let lit: usize = cells.iter().map(|c| c.lit_by_normal).sum();
+            let shadowed: usize = cells.iter().map(|c| c.self_shadowed).sum();
+            let band = cells.iter().map(|c| c.band_deg).fold(0.0, f64::max);
+            let err: f64 = cells.iter().map(|c| c.mean_err).sum::<f64>() / cells.len() as f64;
+            let limit: f64 = cells.iter().map(|c| c.limit_err).sum::<f64>() / cells.len() as f64;
+            let facet = cells[0].facet_deg;
+            let tris = cells[0].triangles;
+            points.push((tris as f64, pct(shadowed, lit)));
+            match m {
+                ShadingNormals::Naive => {
+                    naive_fails &= shadowed > 0;
+                    naive_text.push(format!(
+                        "{tris} tris: {:.1}% self-shadowed, band {band:.1}° (facet {facet:.1}°), error {} vs limit {}",
+                        pct(shadowed, lit),
+                        fmt_g(err),
+                        fmt_g(limit)
+                    ));
+                }
+                ShadingNormals::Robust => {
+                    robust_ok &= band <= facet && err <= 2.0 * limit + 1e-7;
+                    worst_band = worst_band.max(band);
+                    worst_ratio = worst_ratio.max(err / limit.max(1e-12));
+                }
+            }
+        }
+        series.push(Series::new(name, points));
+    }
+    Row {
+        id: "N1",
+        failure: "shadow terminator: the flat triangle shadows what its shading normal lights",
+        naive_method: "shadow ray from the flat hit point",
+        robust_method: "Hanika 2021: from the hit point projected on the vertex tangent planes",
+        sweep: format!(
+            "unit octaspheres of 32…8192 triangles with exact vertex normals, 3 light directions, {} rays each",
+            o.rays
+        ),
+        naive: naive_text.join("; "),
+        robust: format!(
+            "widest self-shadowed band {worst_band:.1}°; error vs the analytic sphere at most {worst_ratio:.2}× the shadow-free limit"
+        ),
+        target: "no self-shadowed band wider than one facet's curvature error; error within 2× the flat-free limit",
+        verdict: yes_if(robust_ok && naive_fails),
+        chart: Some(chart(
+            "N1: lit-by-shading-normal samples shadowed by their own mesh",
+            "triangles",
+            "% self-shadowed",
+            false,
+            series,
+        )),
+    }
+}
+
+fn row_n2(o: &StabilityOptions, rng: &mut Pcg) -> Row {
+    let views = [0.0f32, 30.0, 60.0, 75.0, 85.0, 89.0];
+    let mut series = Vec::new();
+    let mut naive_text = Vec::new();
+    let (mut robust_wrong, mut naive_wrong, mut corrected) = (0usize, 0usize, 0usize);
+    for level in [1u32, 3, 5] {
+        // The same rays for both methods.
+        let seeds: Vec<u64> = views.iter().map(|_| u64::from(rng.next_u32())).collect();
+        for (m, name) in [
+            (ShadingNormals::Naive, "naive"),
+            (ShadingNormals::Robust, "robust"),
+        ] {
+            let mut points = Vec::new();
+            let mut worst = (0.0f64, 0.0f32);
+            for (&view, &seed) in views.iter().zip(&seeds) {
+                let c = side_cell(m, level, view, false, o.rays, &mut Pcg::new(seed));
+                let t = side_cell(m, level, view, true, o.rays / 4, &mut Pcg::new(seed));
+                let wrong = c.wrong_side + t.wrong_side;
+                let all = c.children + t.children;
+                points.push((f64::from(90.0 - view), pct(wrong, all)));
+                if pct(wrong, all) > worst.0 {
+                    worst = (pct(wrong, all), view);
+                }
+                match m {
+                    ShadingNormals::Naive => naive_wrong += wrong,
+                    ShadingNormals::Robust => {
+                        robust_wrong += wrong;
+                        corrected += c.corrected + t.corrected;
+                    }
+                }
+            }
+            if m == ShadingNormals::Naive {
+                naive_text.push(format!(
+                    "{} tris: up to {:.1}% (at {}° from the normal)",
+                    8 << (2 * level),
+                    worst.0,
+                    worst.1
+                ));
+            }
+            series.push(Series::new(
+                format!("{name}, {} tris", 8 << (2 * level)),
+                points,
+            ));
+        }
+    }
+    Row {
+        id: "N2",
+        failure: "reflected/refracted direction crosses into the surface it leaves",
+        naive_method: "R and T about the shading normal, as they come",
+        robust_method: "mirrored back across the geometric plane; the tree marks it",
+        sweep: format!(
+            "octaspheres of 32, 512, 8192 triangles; view 0…89° from the shading normal; mirror ({} rays) and glass ({} rays)",
+            o.rays,
+            o.rays / 4
+        ),
+        naive: format!(
+            "{}; refraction into glass never crosses",
+            naive_text.join(", ")
+        ),
+        robust: format!(
+            "{robust_wrong} on the wrong side; {corrected} bent back and marked corrected (naive: {naive_wrong} wrong)"
+        ),
+        target: "0% after correction; the tree says when a direction was corrected",
+        // Same seeds for both methods: every naive crossing is a marked correction.
+        verdict: yes_if(robust_wrong == 0 && naive_wrong > 0 && corrected == naive_wrong),
+        chart: Some(Chart {
+            x_log: false,
+            ..chart(
+                "N2: secondary directions on the wrong side of the geometric plane",
+                "angle of the view above the surface (°)",
+                "% of R and T",
+                false,
+                series,
+            )
+        }),
+    }
+}
+
+fn row_n3(o: &StabilityOptions, rng: &mut Pcg) -> Row {
+    let mut series = Vec::new();
+    let (mut naive_leaks, mut naive_facing, mut robust_leaks, mut robust_facing) = (0, 0, 0, 0);
+    let belows = [0.5f32, 1.0, 2.0, 5.0, 10.0, 20.0, 40.0];
+    for tilt in [5.0f32, 20.0, 45.0] {
+        for (m, name) in [
+            (ShadingNormals::Naive, "naive"),
+            (ShadingNormals::Robust, "robust"),
+        ] {
+            let mut points = Vec::new();
+            for &below in &belows {
+                let seed = u64::from(rng.next_u32());
+                let c = leak_cell(m, tilt, below, o.rays, &mut Pcg::new(seed));
+                points.push((f64::from(below), pct(c.leaks, c.samples)));
+                match m {
+                    ShadingNormals::Naive => {
+                        naive_leaks += c.leaks;
+                        naive_facing += c.facing;
+                    }
+                    ShadingNormals::Robust => {
+                        robust_leaks += c.leaks;
+                        robust_facing += c.facing;
+                    }
+                }
+            }
+            series.push(Series::new(
+                format!("{name}, normals tilted {tilt}°"),
+                points,
+            ));
+        }
+    }
+    Row {
+        id: "N3",
+        failure: "light leaks: the shading normal faces a light behind the geometric surface",
+        naive_method: "shadow ray offset to the light's side (through the surface)",
+        robust_method: "shadow ray from the visible side (smooth surface), else the light adds nothing",
+        sweep: format!(
+            "a wall with vertex normals tilted 5°, 20°, 45°; light 0.5…40° behind its plane; {} rays each",
+            o.rays
+        ),
+        naive: format!(
+            "{:.1}% of samples lit from behind ({naive_leaks} of the {naive_facing} whose shading normal faces the light)",
+            pct(naive_leaks, o.rays * belows.len() * 3)
+        ),
+        robust: format!("{robust_leaks} of {robust_facing} lit from behind"),
+        target: "0%",
+        verdict: yes_if(robust_leaks == 0 && naive_leaks > 0),
+        chart: Some(chart(
+            "N3: samples lit by a light behind the surface",
+            "light angle below the surface (°)",
+            "% of samples",
+            false,
+            series,
+        )),
     }
 }
 

@@ -20,13 +20,17 @@ use crate::accel::{Accel, AccelKind, PrimSet};
 use crate::geometry::sphere::sphere_roots_f64;
 use crate::geometry::triangle::triangle_hit_f64;
 use crate::geometry::{
-    Methods, OffsetMethod, Ray, SphereMethod, TriangleMethod, intersect_sphere, intersect_triangle,
-    next_float_up, offset_ray_origin, sphere_hit_point, triangle_hit_point,
+    Methods, OffsetMethod, Ray, ShadingNormals, SphereMethod, TriangleMethod, intersect_sphere,
+    intersect_triangle, next_float_up, offset_ray_origin, sphere_hit_point, triangle_hit_point,
 };
 use crate::render::render;
-use crate::scene::{MaterialId, ObjectId};
+use crate::scene::{
+    Light, Material, MaterialId, MeshAttributes, Object, ObjectId, ObjectSource, Scene, Triangle,
+};
 use crate::shade::refract;
-use crate::trace::{TraceSettings, Tracer};
+use crate::trace::{
+    RayCounts, RayKind, Recorder, SampleInfo, ShadowTest, SurfaceHit, TraceSettings, Tracer,
+};
 
 /// The spacing of `f32` values at `|x|`.
 pub fn ulp(x: f32) -> f32 {
@@ -1090,4 +1094,338 @@ pub fn pathological_build(case: Pathology, n: usize, probes: usize, rng: &mut Pc
         depth: bvh.bvh_depth().unwrap_or(0),
         disagreements,
     }
+}
+
+// =============================================================================================
+// N1–N3: shading normals on flat triangles (Hanika 2021 for N1)
+
+/// What the measurements of N1–N3 need from one traced primary ray: its hit's normals, the
+/// first light's shadow test, and the directions (and corrections) of its children. A
+/// [`Recorder`] over the tracer's own code, so the measured behaviour is the renderer's.
+#[derive(Default)]
+struct FirstHit {
+    depth: Vec<u32>,
+    shading: Option<Vec3>,
+    geometric: Option<Vec3>,
+    shadow: Option<ShadowTest>,
+    /// (reflected?, direction, corrected) of each child of the primary hit.
+    children: Vec<(bool, Vec3, bool)>,
+}
+
+impl Recorder for FirstHit {
+    const ENABLED: bool = true;
+    fn enter(&mut self, kind: RayKind, depth: u32, ray: &Ray, _weight: Vec3) {
+        self.depth.push(depth);
+        if depth == 1 {
+            self.children
+                .push((kind == RayKind::Reflected, ray.dir, false));
+        }
+    }
+    fn direction_corrected(&mut self) {
+        if self.depth.last() == Some(&1)
+            && let Some(c) = self.children.last_mut()
+        {
+            c.2 = true;
+        }
+    }
+    fn hit(&mut self, hit: &SurfaceHit, _view: Vec3) {
+        if self.depth.last() == Some(&0) {
+            self.shading = Some(hit.normal);
+            self.geometric = Some(hit.geometric_normal);
+        }
+    }
+    fn shadow(&mut self, test: &ShadowTest) {
+        if self.depth.last() == Some(&0) && self.shadow.is_none() {
+            self.shadow = Some(*test);
+        }
+    }
+    fn leave(&mut self, _color: Vec3) {
+        self.depth.pop();
+    }
+}
+
+/// A scene of one mesh given as vertices, triangles and unit vertex normals (shared by index),
+/// material `material`, lit by white point light `light`, no ambient light, depth `max_depth`.
+pub fn smooth_mesh_scene(
+    verts: &[Vec3],
+    tris: &[[usize; 3]],
+    normals: &[Vec3],
+    material: Material,
+    light: Vec3,
+    max_depth: u32,
+) -> Scene {
+    let mut scene = Scene {
+        materials: vec![material],
+        objects: vec![Object {
+            name: "mesh".into(),
+            source: ObjectSource::Triangle,
+        }],
+        lights: vec![Light {
+            name: "light".into(),
+            position: light,
+            color: Vec3::ONE,
+            radius: 0.0,
+        }],
+        ..Scene::default()
+    };
+    scene.render.ambient_light = Vec3::ZERO;
+    scene.render.max_depth = max_depth;
+    scene.triangles = tris
+        .iter()
+        .map(|t| Triangle {
+            vertices: t.map(|i| verts[i]),
+            material: MaterialId(0),
+            object: ObjectId(0),
+        })
+        .collect();
+    scene.attributes.push(Arc::new(MeshAttributes {
+        first_triangle: 0,
+        triangle_count: tris.len() as u32,
+        normals: normals.to_vec(),
+        normal_indices: tris.iter().map(|t| t.map(|i| i as u32)).collect(),
+        ..MeshAttributes::default()
+    }));
+    scene
+}
+
+fn tracer_for(scene: Scene, shading_normals: ShadingNormals) -> Tracer {
+    let settings = TraceSettings {
+        accel: AccelKind::Bvh,
+        methods: Methods {
+            shading_normals,
+            ..Methods::default()
+        },
+        cutoff: 0.0,
+    };
+    Tracer::new(Arc::new(scene), settings)
+}
+
+fn trace_first(tracer: &Tracer, ray: &Ray) -> (Vec3, FirstHit) {
+    let mut rec = FirstHit::default();
+    let mut counts = RayCounts::default();
+    let mut info = SampleInfo::default();
+    let c = tracer.trace(
+        ray,
+        RayKind::Primary,
+        0,
+        Vec3::ONE,
+        &mut counts,
+        &mut info,
+        &mut rec,
+    );
+    (c, rec)
+}
+
+/// One cell of N1: a unit octasphere of `8·4^level` triangles with exact (radial) vertex
+/// normals, diffuse only, lit by a distant light, sampled at `n` points spread uniformly over
+/// the sphere (each ray aimed at the centre).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct TerminatorCell {
+    pub triangles: usize,
+    /// Samples whose shading normal faces the light (`N·L > 0`).
+    pub lit_by_normal: usize,
+    /// Of those, the ones the mesh shadows itself (blocked by its own triangles, or — robust —
+    /// counted as behind the geometric surface).
+    pub self_shadowed: usize,
+    /// The widest self-shadowed band: the largest `N·L` of a self-shadowed sample, as the angle
+    /// above the terminator in degrees.
+    pub band_deg: f64,
+    /// The angle between neighbouring vertex normals (the facets' curvature error), degrees.
+    pub facet_deg: f64,
+    /// Mean |mesh − analytic sphere| of the diffuse value over all samples.
+    pub mean_err: f64,
+    /// The same for the shadow-free smooth mesh (`max(N·L, 0)`): the flat-free limit.
+    pub limit_err: f64,
+}
+
+/// N1 at one tessellation level and light direction `to_light`.
+pub fn terminator_cell(
+    shading_normals: ShadingNormals,
+    level: u32,
+    to_light: Vec3,
+    n: usize,
+    rng: &mut Pcg,
+) -> TerminatorCell {
+    let (verts, tris) = octasphere(level, 1.0, Vec3::ZERO);
+    let material = Material {
+        ambient: Vec3::ZERO,
+        diffuse: Vec3::ONE,
+        specular: Vec3::ZERO,
+        ..Material::default()
+    };
+    let l = to_light.normalize();
+    let scene = smooth_mesh_scene(&verts, &tris, &verts, material, 1e3 * l, 0);
+    let tracer = tracer_for(scene, shading_normals);
+    let facet_deg = tris.first().map_or(0.0, |t| {
+        verts[t[0]].angle_between(verts[t[1]]).to_degrees() as f64
+    });
+    let mut cell = TerminatorCell {
+        triangles: tris.len(),
+        facet_deg,
+        ..TerminatorCell::default()
+    };
+    let (mut err, mut limit) = (0.0f64, 0.0f64);
+    for _ in 0..n {
+        let q = rng.unit();
+        let ray = Ray::new(3.0 * q, -q);
+        let (c, rec) = trace_first(&tracer, &ray);
+        // The analytic sphere's value where the same ray meets it (at q, normal q).
+        let analytic = q.dot((1e3 * l - q).normalize()).max(0.0);
+        err += f64::from((c.x - analytic).abs());
+        let (Some(ns), Some(test)) = (rec.shading, rec.shadow) else {
+            continue;
+        };
+        let ideal = ns.dot(test.to_light).max(0.0);
+        limit += f64::from((ideal - analytic).abs());
+        if ns.dot(test.to_light) > 0.0 {
+            cell.lit_by_normal += 1;
+            let shadowed = test.behind_surface || test.blocked_by == Some(ObjectId(0));
+            if shadowed {
+                cell.self_shadowed += 1;
+                let above = f64::from(ns.dot(test.to_light))
+                    .clamp(-1.0, 1.0)
+                    .asin()
+                    .to_degrees();
+                cell.band_deg = cell.band_deg.max(above);
+            }
+        }
+    }
+    cell.mean_err = err / n.max(1) as f64;
+    cell.limit_err = limit / n.max(1) as f64;
+    cell
+}
+
+/// One cell of N2: reflected (or refracted) directions about the shading normal of a smooth
+/// octasphere, for rays meeting it at `view_deg` from its (analytic) normal.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct SideCell {
+    pub triangles: usize,
+    pub view_deg: f32,
+    pub children: usize,
+    /// Children on the wrong side of the geometric plane of the surface they leave.
+    pub wrong_side: usize,
+    /// Children the tracer marked as corrected.
+    pub corrected: usize,
+}
+
+/// N2 at one tessellation level and view angle from the shading normal; `refract`: a glass sphere (its refracted
+/// children), else a mirror (its reflected children).
+pub fn side_cell(
+    shading_normals: ShadingNormals,
+    level: u32,
+    view_deg: f32,
+    refract: bool,
+    n: usize,
+    rng: &mut Pcg,
+) -> SideCell {
+    let (verts, tris) = octasphere(level, 1.0, Vec3::ZERO);
+    let material = Material {
+        reflectivity: Vec3::splat(if refract { 0.0 } else { 1.0 }),
+        transparency: Vec3::splat(if refract { 1.0 } else { 0.0 }),
+        ior: 1.5,
+        ..Material::default()
+    };
+    let scene = smooth_mesh_scene(&verts, &tris, &verts, material, Vec3::splat(100.0), 1);
+    let tracer = tracer_for(scene, shading_normals);
+    let mut cell = SideCell {
+        triangles: tris.len(),
+        view_deg,
+        ..SideCell::default()
+    };
+    let theta = view_deg.to_radians();
+    for _ in 0..n {
+        // A point spread over the mesh, and a ray meeting it at `view_deg` from its shading
+        // normal (from outside; a ray coming at the face from behind meets another first).
+        let tri = tris[rng.below(tris.len())];
+        let (mut b1, mut b2) = (rng.f32(), rng.f32());
+        if b1 + b2 > 1.0 {
+            (b1, b2) = (1.0 - b1, 1.0 - b2);
+        }
+        let b = [1.0 - b1 - b2, b1, b2];
+        let p = b[0] * verts[tri[0]] + b[1] * verts[tri[1]] + b[2] * verts[tri[2]];
+        let ns = p.normalize();
+        let t = rng.perpendicular(ns);
+        let d = -(theta.cos() * ns + theta.sin() * t);
+        let ray = Ray::new(p - 3.0 * d, d);
+        let (_, rec) = trace_first(&tracer, &ray);
+        let Some(ng) = rec.geometric else { continue };
+        for &(reflected, dir, corrected) in &rec.children {
+            if reflected == refract {
+                continue;
+            }
+            cell.children += 1;
+            let side = dir.dot(ng);
+            let wrong = if reflected { side <= 0.0 } else { side >= 0.0 };
+            cell.wrong_side += usize::from(wrong);
+            cell.corrected += usize::from(corrected);
+        }
+    }
+    cell
+}
+
+/// One cell of N3: a large flat wall (the plane z = 0, seen from z > 0) whose vertex normals
+/// are tilted by `tilt_deg`, and a light behind it at `below_deg` under its plane; the share
+/// of the wall's samples that the light reaches through it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct LeakCell3 {
+    pub tilt_deg: f32,
+    pub below_deg: f32,
+    pub samples: usize,
+    /// Samples whose shading normal faces the light (the candidates for a leak).
+    pub facing: usize,
+    /// Samples lit by the light behind the wall.
+    pub leaks: usize,
+}
+
+/// N3 at one normal tilt and light angle.
+pub fn leak_cell(
+    shading_normals: ShadingNormals,
+    tilt_deg: f32,
+    below_deg: f32,
+    n: usize,
+    rng: &mut Pcg,
+) -> LeakCell3 {
+    // A 2×2 grid of quads over ±100, so the wall separates the light from every sample.
+    let s = 100.0;
+    let verts: Vec<Vec3> = (0..9)
+        .map(|i| Vec3::new(((i % 3) as f32 - 1.0) * s, ((i / 3) as f32 - 1.0) * s, 0.0))
+        .collect();
+    let mut tris = Vec::new();
+    for (x, y) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+        let a = y * 3 + x;
+        tris.push([a, a + 1, a + 4]);
+        tris.push([a, a + 4, a + 3]);
+    }
+    // Normals tilted towards +x (alternating direction by vertex, as a badly exported file).
+    let tilt = tilt_deg.to_radians();
+    let normals: Vec<Vec3> = (0..9)
+        .map(|i| {
+            let sign = if i % 2 == 0 { 1.0 } else { 0.5 };
+            Vec3::new(sign * tilt.sin(), 0.0, tilt.cos()).normalize()
+        })
+        .collect();
+    let below = below_deg.to_radians();
+    // The light behind the wall, towards +x: the tilted normals face it.
+    let light = Vec3::new(20.0 * below.cos(), 0.0, -20.0 * below.sin());
+    let scene = smooth_mesh_scene(&verts, &tris, &normals, Material::default(), light, 0);
+    let tracer = tracer_for(scene, shading_normals);
+    let mut cell = LeakCell3 {
+        tilt_deg,
+        below_deg,
+        ..LeakCell3::default()
+    };
+    for _ in 0..n {
+        let p = Vec3::new(rng.range(-20.0, 20.0), rng.range(-20.0, 20.0), 0.0);
+        let ray = Ray::new(p + Vec3::new(0.0, 0.0, 5.0), -Vec3::Z);
+        let (_, rec) = trace_first(&tracer, &ray);
+        let Some(test) = rec.shadow else { continue };
+        cell.samples += 1;
+        if test.terms.n_dot_l > 0.0 {
+            cell.facing += 1;
+            if test.blocked_by.is_none() && !test.behind_surface {
+                cell.leaks += 1;
+            }
+        }
+    }
+    cell
 }

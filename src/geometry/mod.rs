@@ -3,6 +3,7 @@
 //! pbrt-v4). Every method is selectable so the speed/accuracy sweeps can compare them.
 
 pub mod offset;
+pub mod shading;
 pub mod sphere;
 pub mod triangle;
 
@@ -10,6 +11,7 @@ use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
 pub use offset::{OffsetMethod, offset_ray_origin};
+pub use shading::{ShadingNormals, interpolate_normal, keep_side, terminator_origin};
 pub use sphere::{SphereMethod, intersect_sphere, sphere_hit_point};
 pub use triangle::{
     Shear, TriHit, TriHits4, TriangleMethod, Triangles4, intersect_triangle, intersect_triangles4,
@@ -39,6 +41,9 @@ pub struct Methods {
     pub sphere: SphereMethod,
     pub triangle: TriangleMethod,
     pub offset: OffsetMethod,
+    /// Where shading and geometric normals disagree (STABILITY N1–N3).
+    #[serde(default)]
+    pub shading_normals: ShadingNormals,
 }
 
 /// `γ(n) = n·u / (1 − n·u)` with `u` the f32 unit roundoff: bounds the relative error of `n`

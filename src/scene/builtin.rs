@@ -2,22 +2,26 @@
 //! `assets/models`, loaded through the same TOML loader with a resolver that reads the
 //! embedded text instead of the disk. `default` is Whitted's classic picture (mirror and glass
 //! spheres over a checkerboard), `quiz` is the lecture's closing quiz, `glass` shows refraction
-//! and total internal reflection, `box` is a closed room with a mirror wall. `acne` and `cracks`
+//! and total internal reflection, `box` is a closed room with a mirror wall, `smooth` a smooth
+//! textured ball beside a faceted copy of itself (SPEC §3b). `acne` and `cracks`
 //! are made to show two failures of the naive methods (`--offset fixed`; `--triangle
 //! moller-trumbore` or `lecture`) that the defaults do not have.
 
 use super::Scene;
 use super::diag::{SceneError, list_and};
-use super::load::load_scene_str_with;
+use super::load::load_scene_str_with_files;
 
 /// The built-in scenes, in the order a menu should show them.
-pub const NAMES: &[&str] = &["default", "quiz", "glass", "box", "acne", "cracks"];
+pub const NAMES: &[&str] = &[
+    "default", "quiz", "glass", "box", "smooth", "acne", "cracks",
+];
 
 const SCENES: &[(&str, &str)] = &[
     ("default", include_str!("../../assets/scenes/default.toml")),
     ("quiz", include_str!("../../assets/scenes/quiz.toml")),
     ("glass", include_str!("../../assets/scenes/glass.toml")),
     ("box", include_str!("../../assets/scenes/box.toml")),
+    ("smooth", include_str!("../../assets/scenes/smooth.toml")),
     ("acne", include_str!("../../assets/scenes/acne.toml")),
     ("cracks", include_str!("../../assets/scenes/cracks.toml")),
 ];
@@ -52,7 +56,21 @@ const MODELS: &[(&str, &str)] = &[
         "assets/models/room.mtl",
         include_str!("../../assets/models/room.mtl"),
     ),
+    (
+        "assets/models/smooth_ball.obj",
+        include_str!("../../assets/models/smooth_ball.obj"),
+    ),
+    (
+        "assets/models/smooth_ball.mtl",
+        include_str!("../../assets/models/smooth_ball.mtl"),
+    ),
 ];
+
+/// Embedded binary files (textures) by their path from the crate root.
+const IMAGES: &[(&str, &[u8])] = &[(
+    "assets/models/checker.png",
+    include_bytes!("../../assets/models/checker.png"),
+)];
 
 /// The TOML text of a built-in scene, e.g. to show it or save it as a starting point.
 pub fn scene_text(name: &str) -> Option<&'static str> {
@@ -68,7 +86,22 @@ pub fn load_builtin(name: &str) -> Result<Scene, SceneError> {
             list_and(&names)
         ))
     })?;
-    load_scene_str_with(text, &format!("builtin/{name}.toml"), &resolve)
+    load_scene_str_with_files(
+        text,
+        &format!("builtin/{name}.toml"),
+        &resolve,
+        &resolve_bytes,
+    )
+}
+
+/// The binary resolver of built-in scenes (textures), as [`resolve`].
+pub fn resolve_bytes(path: &str) -> Result<Vec<u8>, String> {
+    let wanted = normalize(&format!("assets/scenes/{path}"));
+    IMAGES
+        .iter()
+        .find(|(p, _)| Some(*p) == wanted.as_deref())
+        .map(|(_, bytes)| bytes.to_vec())
+        .ok_or_else(|| format!("{path}: not among the images built into raytree"))
 }
 
 /// The resolver of built-in scenes: `path` is relative to `assets/scenes`, as in the scene

@@ -5,8 +5,10 @@
 use std::path::{Path, PathBuf};
 
 use super::diag::{SceneError, short_path};
+use super::load::load_scene_str_with_files;
 use super::rules::{MAX_MESH_FILE_BYTES, MAX_SCENE_FILE_BYTES};
-use super::{Scene, builtin, load::load_scene_str_with, obj};
+use super::texture::fs_bytes_resolver;
+use super::{Scene, builtin, obj};
 
 /// A scene file, OBJ, or built-in scene name, as given on the command line or to the viewer:
 /// a file of that name wins over a built-in scene.
@@ -43,15 +45,16 @@ pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
     let text = read_text(path, max_bytes)
         .map_err(|reason| SceneError(format!("{file}: cannot read the scene file: {reason}.")))?;
     let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let resolve = fs_resolver(folder);
+    let resolve = fs_resolver(folder.clone());
+    let resolve_bytes = fs_bytes_resolver(folder);
     let mut scene = if is_obj {
         let key = path
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_else(|| file.clone());
-        obj::load_obj_scene(&text, &file, &key, &resolve)?
+        obj::load_obj_scene(&text, &file, &key, &resolve, &resolve_bytes)?
     } else {
-        load_scene_str_with(&text, &file, &resolve)?
+        load_scene_str_with_files(&text, &file, &resolve, &resolve_bytes)?
     };
     scene.source = Some(path.to_path_buf());
     Ok(scene)
@@ -60,7 +63,12 @@ pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
 /// Parses scene TOML; `name` stands for the file in messages. Meshes are resolved relative to
 /// the current directory.
 pub fn load_scene_str(text: &str, name: &str) -> Result<Scene, SceneError> {
-    load_scene_str_with(text, name, &fs_resolver(PathBuf::new()))
+    load_scene_str_with_files(
+        text,
+        name,
+        &fs_resolver(PathBuf::new()),
+        &fs_bytes_resolver(PathBuf::new()),
+    )
 }
 
 /// A resolver reading files relative to `folder`.

@@ -17,22 +17,35 @@ use super::obj::{self, MeshPlacement};
 use super::rules;
 use super::toml_reader::{Section, describe, syntax_error};
 use super::{
-    Camera, Light, Material, MaterialId, Object, ObjectId, ObjectSource, RenderParams, ResolveFn,
-    Scene, Shading, Sphere, Triangle,
+    Camera, Light, Material, MaterialId, NormalsMode, Object, ObjectId, ObjectSource, RenderParams,
+    ResolveBytesFn, ResolveFn, Scene, Shading, Sphere, Triangle,
 };
 use crate::choice::Choice;
 
-/// Parses scene TOML, reading meshes and material libraries through `resolve`.
+/// Parses scene TOML, reading meshes and material libraries through `resolve` (textures are
+/// not read: each is a missing-texture warning).
 pub fn load_scene_str_with(
     text: &str,
     name: &str,
     resolve: &ResolveFn<'_>,
+) -> Result<Scene, SceneError> {
+    load_scene_str_with_files(text, name, resolve, &super::no_binary_files)
+}
+
+/// Parses scene TOML, reading meshes and material libraries through `resolve` and textures
+/// through `resolve_bytes`.
+pub fn load_scene_str_with_files(
+    text: &str,
+    name: &str,
+    resolve: &ResolveFn<'_>,
+    resolve_bytes: &ResolveBytesFn<'_>,
 ) -> Result<Scene, SceneError> {
     let src = Src { file: name, text };
     let root = DeTable::parse(text).map_err(|e| syntax_error(&src, &e))?;
     SceneBuilder {
         src: &src,
         resolve,
+        resolve_bytes,
         scene: Scene::default(),
         user_materials: HashMap::new(),
     }
@@ -65,7 +78,16 @@ const MATERIAL_KEYS: &[&str] = &[
 ];
 const SPHERE_KEYS: &[&str] = &["name", "center", "radius", "material"];
 const TRIANGLE_KEYS: &[&str] = &["name", "vertices", "material"];
-const MESH_KEYS: &[&str] = &["name", "file", "material", "translate", "rotate", "scale"];
+const MESH_KEYS: &[&str] = &[
+    "name",
+    "file",
+    "material",
+    "translate",
+    "rotate",
+    "scale",
+    "normals",
+    "crease_angle",
+];
 
 /// `[section]` or `[[section]]`, as written in the format.
 fn section_syntax(name: &str) -> String {
@@ -96,6 +118,7 @@ impl Kind {
 struct SceneBuilder<'a> {
     src: &'a Src<'a>,
     resolve: &'a ResolveFn<'a>,
+    resolve_bytes: &'a ResolveBytesFn<'a>,
     scene: Scene,
     /// The `[[material]]` entries by name (MTL materials are not referable by name).
     user_materials: HashMap<String, MaterialId>,
@@ -392,6 +415,9 @@ impl SceneBuilder<'_> {
         };
         rules::check_placement(placement.translate, placement.rotate_deg, placement.scale)
             .map_err(|v| s.verdict(&v))?;
+        let normals = choice::<NormalsMode>(s, "normals")?.unwrap_or_default();
+        let crease_angle_deg = s.f32("crease_angle", super::DEFAULT_CREASE_ANGLE_DEG)?;
+        rules::check_mesh_normals(crease_angle_deg).map_err(|v| s.verdict(&v))?;
         let cannot =
             |problem: String| s.error(&file_span, "file", format!("cannot be loaded: {problem}"));
         let text = (self.resolve)(&file).map_err(cannot)?;
@@ -403,6 +429,8 @@ impl SceneBuilder<'_> {
                 translate: placement.translate,
                 rotate_deg: placement.rotate_deg,
                 scale: placement.scale,
+                normals,
+                crease_angle_deg,
             },
         });
         let loaded = obj::add_mesh(
@@ -414,8 +442,11 @@ impl SceneBuilder<'_> {
                 key: &file,
                 text: &text,
                 resolve: self.resolve,
+                resolve_bytes: self.resolve_bytes,
                 material_override,
                 placement: &placement,
+                normals,
+                crease_angle_deg,
             },
         )
         .map_err(|p| cannot(format!("{}{}", short_path(&file), p.with_line())))?;
@@ -482,24 +513,24 @@ impl Names {
     }
 }
 
+/// A named choice (`shading`, `normals`), or `None` when the key is absent.
+fn choice<T: Choice>(s: &Section, key: &str) -> Result<Option<T>, SceneError> {
+    let Some(v) = s.get(key) else {
+        return Ok(None);
+    };
+    let named = match v.get_ref() {
+        DeValue::String(text) => T::from_name(text),
+        _ => None,
+    };
+    named.map(Some).ok_or_else(|| {
+        let names: Vec<String> = T::ALL.iter().map(|c| format!("\"{}\"", c.name())).collect();
+        s.type_error(key, v, &names.join(" or "))
+    })
+}
+
 fn parse_render(s: &Section) -> Result<RenderParams, SceneError> {
     let d = RenderParams::default();
-    let shading = match s.get("shading") {
-        None => d.shading,
-        Some(v) => {
-            let named = match v.get_ref() {
-                DeValue::String(text) => Shading::from_name(text),
-                _ => None,
-            };
-            named.ok_or_else(|| {
-                let names: Vec<String> = Shading::ALL
-                    .iter()
-                    .map(|c| format!("\"{}\"", c.name()))
-                    .collect();
-                s.type_error("shading", v, &names.join(" or "))
-            })?
-        }
-    };
+    let shading = choice::<Shading>(s, "shading")?.unwrap_or(d.shading);
     let render = RenderParams {
         width: s.uint("width", d.width, &rules::IMAGE_SIZE)?,
         height: s.uint("height", d.height, &rules::IMAGE_SIZE)?,
@@ -556,6 +587,8 @@ fn parse_material(s: &Section, name: String) -> Result<Material, SceneError> {
         reflectivity: s.color("reflectivity", d.reflectivity)?,
         transparency: s.color("transparency", d.transparency)?,
         ior: s.f32("ior", d.ior)?,
+        diffuse_map: None,
+        ambient_map: None,
     };
     rules::check_material(&material).map_err(|v| s.verdict(&v))?;
     Ok(material)

@@ -15,23 +15,33 @@ pub mod procedural;
 pub mod rules;
 pub mod sampling;
 pub mod save;
+pub mod texture;
 pub mod toml_reader;
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
 pub use builtin::load_builtin;
 pub use camera::{Camera, CameraFrame, primary_ray};
 pub use diag::SceneError;
 pub use files::{fs_resolver, load_scene_file, load_scene_str, open_scene_arg};
-pub use load::load_scene_str_with;
+pub use load::{load_scene_str_with, load_scene_str_with_files};
 
 /// Returns the text of a mesh or material library, given its path as written in the scene
 /// (relative to the scene file's folder), or the reason it cannot, as a short phrase. Built-in
 /// scenes resolve from strings compiled into the binary, files from the scene's folder.
 pub type ResolveFn<'a> = dyn Fn(&str) -> Result<String, String> + 'a;
+
+/// As [`ResolveFn`], for binary files (textures).
+pub type ResolveBytesFn<'a> = dyn Fn(&str) -> Result<Vec<u8>, String> + 'a;
+
+/// The binary resolver of scenes loaded without one: every texture is missing (a warning).
+pub fn no_binary_files(path: &str) -> Result<Vec<u8>, String> {
+    Err(format!("{path}: textures are not read for this scene"))
+}
 pub use save::scene_to_toml;
 
 /// Index into [`Scene::materials`].
@@ -118,6 +128,10 @@ pub struct Material {
     pub transparency: Vec3,
     /// Index of refraction of the solid's inside (outside is air, 1).
     pub ior: f32,
+    /// MTL `map_Kd`: a texture (index into [`Scene::textures`]) whose texel multiplies `kd`.
+    pub diffuse_map: Option<TextureId>,
+    /// MTL `map_Ka`: a texture whose texel multiplies `ka`.
+    pub ambient_map: Option<TextureId>,
 }
 
 impl Default for Material {
@@ -131,6 +145,8 @@ impl Default for Material {
             reflectivity: Vec3::ZERO,
             transparency: Vec3::ZERO,
             ior: 1.5,
+            diffuse_map: None,
+            ambient_map: None,
         }
     }
 }
@@ -152,6 +168,134 @@ pub struct Triangle {
     pub object: ObjectId,
 }
 
+/// Index into [`Scene::textures`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct TextureId(pub u32);
+
+/// An image texture, decoded once from sRGB to linear RGB, looked up with wrapping (repeat) and
+/// bilinear filtering.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    /// The path as the MTL gave it, for messages and the tree.
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    /// Row-major, top row first, linear RGB.
+    pub texels: Vec<[f32; 3]>,
+}
+
+impl Texture {
+    /// Bytes its texels take.
+    pub fn bytes(width: u32, height: u32) -> u64 {
+        u64::from(width) * u64::from(height) * std::mem::size_of::<[f32; 3]>() as u64
+    }
+
+    /// The bilinear texel at texture coordinate `uv` (OBJ convention: `v` = 0 at the bottom
+    /// row), wrapping in both directions.
+    pub fn sample(&self, uv: Vec2) -> Vec3 {
+        let (w, h) = (self.width as usize, self.height as usize);
+        if w == 0 || h == 0 || self.texels.len() < w * h || !uv.is_finite() {
+            return Vec3::ONE;
+        }
+        // Texel centres at half-integers; `v` flipped so row 0 is the top of the image.
+        let x = uv.x.rem_euclid(1.0) * w as f32 - 0.5;
+        let y = (1.0 - uv.y.rem_euclid(1.0)) * h as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let wrap = |i: f32, n: usize| (i as i64).rem_euclid(n as i64) as usize;
+        let (xa, xb) = (wrap(x0, w), wrap(x0 + 1.0, w));
+        let (ya, yb) = (wrap(y0, h), wrap(y0 + 1.0, h));
+        let at = |x: usize, y: usize| Vec3::from_array(self.texels[y * w + x]);
+        let top = at(xa, ya).lerp(at(xb, ya), fx);
+        let bottom = at(xa, yb).lerp(at(xb, yb), fx);
+        top.lerp(bottom, fy)
+    }
+}
+
+/// Where a mesh's shading normals come from (SPEC §3b, `[[mesh]]` `normals`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum NormalsMode {
+    /// The OBJ's `vn` where its faces give them; flat elsewhere.
+    #[default]
+    File,
+    /// Every triangle flat, whatever the file says.
+    Flat,
+    /// Area-weighted vertex normals computed from the triangles, split where neighbouring faces
+    /// meet at more than `crease_angle` degrees.
+    Smooth,
+}
+
+crate::choice::choice!(NormalsMode {
+    File => ("file", "the OBJ's vn where present, flat elsewhere"),
+    Flat => ("flat", "every triangle flat: its own normal"),
+    Smooth => ("smooth", "area-weighted vertex normals, split at crease_angle degrees"),
+});
+
+/// `[[mesh]]` `crease_angle` when not given, in degrees.
+pub const DEFAULT_CREASE_ANGLE_DEG: f32 = 60.0;
+
+/// "No normal (or texture coordinate) at this corner": the triangle is flat (untextured).
+pub const NO_INDEX: u32 = u32::MAX;
+
+/// Per-vertex shading normals and texture coordinates of one mesh, for the contiguous run of
+/// [`Scene::triangles`] it made. Only meshes that have them carry them: a flat, untextured mesh
+/// costs nothing here.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MeshAttributes {
+    /// Index in [`Scene::triangles`] of the mesh's first triangle.
+    pub first_triangle: u32,
+    /// How many triangles follow it.
+    pub triangle_count: u32,
+    /// Unit vertex normals in world space.
+    pub normals: Vec<Vec3>,
+    /// One entry per triangle (corner order as in [`Triangle::vertices`]), or empty when no
+    /// triangle has normals; a triangle with [`NO_INDEX`] is flat.
+    pub normal_indices: Vec<[u32; 3]>,
+    /// Texture coordinates (`vt`).
+    pub uvs: Vec<Vec2>,
+    /// As `normal_indices`, for `uvs`.
+    pub uv_indices: Vec<[u32; 3]>,
+}
+
+impl MeshAttributes {
+    /// The vertex normals of triangle `local` (counted from `first_triangle`), if it has them.
+    #[inline]
+    pub fn normals_of(&self, local: usize) -> Option<[Vec3; 3]> {
+        let idx = self.normal_indices.get(local)?;
+        if idx[0] == NO_INDEX {
+            return None;
+        }
+        Some([
+            *self.normals.get(idx[0] as usize)?,
+            *self.normals.get(idx[1] as usize)?,
+            *self.normals.get(idx[2] as usize)?,
+        ])
+    }
+
+    /// The texture coordinates of triangle `local`, if it has them.
+    #[inline]
+    pub fn uvs_of(&self, local: usize) -> Option<[Vec2; 3]> {
+        let idx = self.uv_indices.get(local)?;
+        if idx[0] == NO_INDEX {
+            return None;
+        }
+        Some([
+            *self.uvs.get(idx[0] as usize)?,
+            *self.uvs.get(idx[1] as usize)?,
+            *self.uvs.get(idx[2] as usize)?,
+        ])
+    }
+
+    /// Bytes the arrays take (for the memory budget).
+    pub fn bytes(&self) -> u64 {
+        (self.normals.len() * 12
+            + self.normal_indices.len() * 12
+            + self.uvs.len() * 8
+            + self.uv_indices.len() * 12) as u64
+    }
+}
+
 /// Where a named object came from, kept so the scene can be saved again as it was written.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ObjectSource {
@@ -166,6 +310,10 @@ pub enum ObjectSource {
         /// Euler angles in degrees, applied X then Y then Z.
         rotate_deg: Vec3,
         scale: Vec3,
+        /// `normals`: where the shading normals come from.
+        normals: NormalsMode,
+        /// `crease_angle` in degrees, for `normals = "smooth"`.
+        crease_angle_deg: f32,
     },
 }
 
@@ -187,6 +335,11 @@ pub struct Scene {
     pub objects: Vec<Object>,
     pub spheres: Vec<Sphere>,
     pub triangles: Vec<Triangle>,
+    /// Vertex normals and texture coordinates of the meshes that have them, in the order of
+    /// their triangles (so a triangle's are found by binary search).
+    pub attributes: Vec<Arc<MeshAttributes>>,
+    /// The textures materials use, each loaded once.
+    pub textures: Vec<Arc<Texture>>,
     /// Non-fatal findings of the loader (dropped degenerate triangles, MTL fallbacks), one
     /// sentence each.
     pub warnings: Vec<String>,
@@ -207,6 +360,25 @@ impl Scene {
 
     pub fn material(&self, id: MaterialId) -> &Material {
         &self.materials[id.0 as usize]
+    }
+
+    /// The attributes of the mesh triangle `index` (into [`Scene::triangles`]) belongs to, and
+    /// its index within that mesh; `None` for a triangle without any.
+    #[inline]
+    pub fn attributes_of(&self, index: usize) -> Option<(&MeshAttributes, usize)> {
+        if self.attributes.is_empty() {
+            return None;
+        }
+        let i = self
+            .attributes
+            .partition_point(|a| (a.first_triangle as usize) <= index);
+        let a = &**self.attributes.get(i.checked_sub(1)?)?;
+        let local = index - a.first_triangle as usize;
+        (local < a.triangle_count as usize).then_some((a, local))
+    }
+
+    pub fn texture(&self, id: TextureId) -> Option<&Texture> {
+        self.textures.get(id.0 as usize).map(|t| &**t)
     }
 
     pub fn object(&self, id: ObjectId) -> &Object {

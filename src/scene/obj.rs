@@ -12,13 +12,19 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
 use std::sync::Once;
 
-use glam::{Mat3, Vec3};
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use glam::{Mat3, Vec2, Vec3};
 
 use super::budget::{MemoryLimit, memory_limit, mesh_memory_estimate};
 use super::diag::{SceneError, list_and, short, short_path};
 use super::rules::{MAX_COORDINATE, check_camera, is_visible_triangle};
+use super::texture::decode_texture;
 use super::{
-    Camera, Light, Material, MaterialId, Object, ObjectId, ObjectSource, ResolveFn, Scene, Triangle,
+    Camera, DEFAULT_CREASE_ANGLE_DEG, Light, Material, MaterialId, MeshAttributes, NO_INDEX,
+    NormalsMode, Object, ObjectId, ObjectSource, ResolveBytesFn, ResolveFn, Scene, Texture,
+    TextureId, Triangle,
 };
 
 /// Where a mesh goes: `scale` first, then the rotation (degrees about X, then Y, then Z), then
@@ -114,9 +120,15 @@ pub(crate) struct MeshRequest<'a> {
     pub key: &'a str,
     pub text: &'a str,
     pub resolve: &'a ResolveFn<'a>,
+    /// Reads textures (binary), relative to the same folder as `resolve`.
+    pub resolve_bytes: &'a ResolveBytesFn<'a>,
     /// A scene material for every face instead of the MTL's.
     pub material_override: Option<MaterialId>,
     pub placement: &'a MeshPlacement,
+    /// Where shading normals come from.
+    pub normals: NormalsMode,
+    /// Faces meeting at more than this (degrees) keep apart normals, for `Smooth`.
+    pub crease_angle_deg: f32,
 }
 
 fn load_options() -> tobj::LoadOptions {
@@ -280,6 +292,35 @@ pub(crate) fn obj_counts(text: &str) -> (u64, u64) {
     (vertices, triangles)
 }
 
+/// Bytes the per-vertex normals and texture coordinates of an OBJ may keep (SPEC §3b): the
+/// file's `vn` and `vt` and an index triple per triangle for each, or computed normals (three
+/// per triangle) for `normals = "smooth"`; 0 for a flat mesh without `vt`.
+pub(crate) fn attribute_memory_estimate(text: &str, normals: NormalsMode) -> u64 {
+    let (mut vn, mut vt, mut faces) = (0u64, 0u64, 0u64);
+    for line in text.lines() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("vn") => vn += 1,
+            Some("vt") => vt += 1,
+            Some("f") => faces += (words.count() as u64).saturating_sub(2).max(1),
+            _ => {}
+        }
+    }
+    let per_triangle_index = 12u64;
+    let normal_bytes = match normals {
+        NormalsMode::Flat => 0,
+        NormalsMode::File if vn == 0 => 0,
+        NormalsMode::File => vn * 12 + faces * per_triangle_index,
+        NormalsMode::Smooth => faces * (36 + per_triangle_index),
+    };
+    let uv_bytes = if vt == 0 {
+        0
+    } else {
+        vt * 8 + faces * per_triangle_index
+    };
+    normal_bytes.saturating_add(uv_bytes)
+}
+
 /// Refuses an OBJ whose reading (with the triangles the scene already has) would exceed
 /// `limit`, before tobj allocates anything for it.
 pub(crate) fn check_mesh_memory(
@@ -337,7 +378,28 @@ fn error_line(text: &str) -> Option<usize> {
 pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, ObjProblem> {
     check_mesh_memory(scene, req.text, &memory_limit())
         .map_err(|reason| ObjProblem { line: None, reason })?;
+    let attributes = attribute_memory_estimate(req.text, req.normals);
+    if attributes > 0 {
+        let (_, triangles) = obj_counts(req.text);
+        let all = mesh_memory_estimate(
+            req.text.len() as u64,
+            obj_counts(req.text).0,
+            triangles.saturating_add(scene.triangles.len() as u64),
+        )
+        .saturating_add(attributes);
+        memory_limit()
+            .check(
+                format!("its {triangles} triangles with their normals and texture coordinates"),
+                all,
+            )
+            .map_err(|e| ObjProblem {
+                line: None,
+                reason: e.to_string(),
+            })?;
+    }
     let mtl_warnings = RefCell::new(Vec::new());
+    // The libraries as read, so that a texture's warning can name its line.
+    let mtl_texts: RefCell<Vec<(String, String)>> = RefCell::new(Vec::new());
     let load_mtl = |path: &Path| -> tobj::MTLLoadResult {
         if req.material_override.is_some() {
             return Ok(Default::default());
@@ -350,6 +412,7 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
             ));
             tobj::LoadError::OpenFileFailed
         })?;
+        mtl_texts.borrow_mut().push((name.clone(), text.clone()));
         let text = mtl_for_tobj(&text).map_err(|(line, reason)| {
             mtl_warnings.borrow_mut().push(format!(
                 "{}: cannot read the material library `{name}` (line {line}: {reason}); its faces use the default material.",
@@ -377,6 +440,7 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     };
     let mtl_materials = mtl_materials.unwrap_or_default();
     let mut warnings = mtl_warnings.into_inner();
+    let mtl_texts = mtl_texts.into_inner();
     if polylines > 0 {
         let s = if polylines == 1 { "" } else { "s" };
         warnings.push(format!(
@@ -389,9 +453,19 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     }
 
     let linear = req.placement.linear();
+    // Normals go through the inverse transpose, which keeps them perpendicular to the placed
+    // surface (and on its outside when a mirroring scale swaps the corners).
+    let normal_matrix = linear.inverse().transpose();
     let mirrors = req.placement.mirrors();
     let mut mtl_ids: Vec<Option<MaterialId>> = vec![None; mtl_materials.len()];
     let (mut added, mut dropped, mut too_far) = (0usize, 0usize, 0usize);
+    let first_triangle = scene.triangles.len();
+    let file_normals = req.normals == NormalsMode::File;
+    let mut attrs = MeshAttributes {
+        first_triangle: first_triangle as u32,
+        ..MeshAttributes::default()
+    };
+    let mut corners = Corners::default();
     for model in &models {
         let mesh = &model.mesh;
         let mut material = None;
@@ -401,11 +475,69 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
                 .get(i..i + 3)
                 .map_or(Vec3::NAN, |p| Vec3::new(p[0], p[1], p[2]))
         };
-        for face in mesh.indices.chunks_exact(3) {
+        // Per-face normal and texture indices exist only when every face gives them.
+        let normal_base = attrs.normals.len() as u32;
+        let has_normals = file_normals
+            && !mesh.normals.is_empty()
+            && mesh.normal_indices.len() == mesh.indices.len();
+        if has_normals {
+            attrs.normals.extend(
+                mesh.normals
+                    .chunks_exact(3)
+                    .map(|n| (normal_matrix * Vec3::new(n[0], n[1], n[2])).normalize_or_zero()),
+            );
+        }
+        let n_normals = attrs.normals.len() as u32 - normal_base;
+        let uv_base = attrs.uvs.len() as u32;
+        let has_uvs =
+            !mesh.texcoords.is_empty() && mesh.texcoord_indices.len() == mesh.indices.len();
+        if has_uvs {
+            attrs.uvs.extend(
+                mesh.texcoords
+                    .chunks_exact(2)
+                    .map(|t| Vec2::new(t[0], t[1])),
+            );
+        }
+        let n_uvs = attrs.uvs.len() as u32 - uv_base;
+        for (k, face) in mesh.indices.chunks_exact(3).enumerate() {
             let mut v =
                 [face[0], face[1], face[2]].map(|i| linear * corner(i) + req.placement.translate);
+            let lookup = |indices: &[u32], base: u32, count: u32, ok: &dyn Fn(u32) -> bool| {
+                let idx = indices.get(3 * k..3 * k + 3)?;
+                let idx = [idx[0], idx[1], idx[2]];
+                idx.iter()
+                    .all(|&i| i < count && ok(base + i))
+                    .then(|| idx.map(|i| base + i))
+            };
+            let mut ni = if has_normals {
+                let normals = &attrs.normals;
+                let usable = |i: u32| {
+                    let n = normals[i as usize];
+                    n.is_finite() && n != Vec3::ZERO
+                };
+                let found = lookup(&mesh.normal_indices, normal_base, n_normals, &usable);
+                corners.bad_normals += usize::from(found.is_none());
+                found
+            } else {
+                None
+            };
+            let mut ti = if has_uvs {
+                let uvs = &attrs.uvs;
+                let usable = |i: u32| uvs[i as usize].is_finite();
+                let found = lookup(&mesh.texcoord_indices, uv_base, n_uvs, &usable);
+                corners.bad_uvs += usize::from(found.is_none());
+                found
+            } else {
+                None
+            };
             if mirrors {
                 v.swap(1, 2);
+                if let Some(n) = ni.as_mut() {
+                    n.swap(1, 2);
+                }
+                if let Some(t) = ti.as_mut() {
+                    t.swap(1, 2);
+                }
             }
             if !is_visible_triangle(&v) {
                 dropped += 1;
@@ -421,7 +553,7 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
                     (Some(id), _) => id,
                     (None, Some(i)) if i < mtl_materials.len() => {
                         *mtl_ids[i].get_or_insert_with(|| {
-                            mtl_material(scene, req, &mtl_materials[i], &mut warnings)
+                            mtl_material(scene, req, &mtl_materials[i], &mtl_texts, &mut warnings)
                         })
                     }
                     (None, _) => scene.default_material(),
@@ -431,9 +563,16 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
                 material: id,
                 object: req.object,
             });
+            corners.normals.push(ni.unwrap_or([NO_INDEX; 3]));
+            corners.uvs.push(ti.unwrap_or([NO_INDEX; 3]));
             added += 1;
         }
     }
+    let textured = scene.triangles[first_triangle..].iter().any(|t| {
+        scene.material(t.material).diffuse_map.is_some()
+            || scene.material(t.material).ambient_map.is_some()
+    });
+    finish_attributes(scene, req, attrs, corners, textured, &mut warnings);
     if dropped > 0 {
         let s = if dropped == 1 { "" } else { "s" };
         warnings.push(format!(
@@ -450,6 +589,138 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     }
     scene.warnings.extend(warnings);
     Ok(added)
+}
+
+/// The normal and texture-coordinate indices of a mesh's kept triangles, while it loads.
+#[derive(Default)]
+struct Corners {
+    normals: Vec<[u32; 3]>,
+    uvs: Vec<[u32; 3]>,
+    /// Faces whose `vn` indices are out of range or name a zero or non-finite normal.
+    bad_normals: usize,
+    /// Faces whose `vt` indices are out of range or name non-finite coordinates.
+    bad_uvs: usize,
+}
+
+/// Keeps the mesh's normals (from the file, or computed for `normals = "smooth"`) and, when a
+/// material of it has a texture, its texture coordinates; adds them to the scene only if there
+/// are any, so flat untextured meshes cost nothing. Warns about unusable `vn`/`vt` once each.
+fn finish_attributes(
+    scene: &mut Scene,
+    req: &MeshRequest,
+    mut attrs: MeshAttributes,
+    corners: Corners,
+    textured: bool,
+    warnings: &mut Vec<String>,
+) {
+    let first = attrs.first_triangle as usize;
+    let count = scene.triangles.len() - first;
+    attrs.triangle_count = count as u32;
+    let plural = |n: usize| if n == 1 { "" } else { "s" };
+    if corners.bad_normals > 0 {
+        let n = corners.bad_normals;
+        warnings.push(format!(
+            "{}: {n} face{} name normals (`vn`) that are out of range, zero or not finite; they are shaded flat.",
+            req.label,
+            plural(n)
+        ));
+    }
+    if corners.bad_uvs > 0 && textured {
+        let n = corners.bad_uvs;
+        warnings.push(format!(
+            "{}: {n} face{} name texture coordinates (`vt`) that are out of range or not finite; they are not textured.",
+            req.label,
+            plural(n)
+        ));
+    }
+    match req.normals {
+        NormalsMode::Flat => attrs.normals.clear(),
+        NormalsMode::File => {
+            if corners.normals.iter().any(|n| n[0] != NO_INDEX) {
+                attrs.normal_indices = corners.normals;
+            } else {
+                attrs.normals.clear();
+            }
+        }
+        NormalsMode::Smooth => {
+            let (normals, indices) =
+                smooth_normals(&scene.triangles[first..], req.crease_angle_deg);
+            attrs.normals = normals;
+            attrs.normal_indices = indices;
+        }
+    }
+    if textured && corners.uvs.iter().any(|t| t[0] != NO_INDEX) {
+        attrs.uv_indices = corners.uvs;
+    } else {
+        attrs.uvs.clear();
+    }
+    attrs.normals.shrink_to_fit();
+    attrs.uvs.shrink_to_fit();
+    if count > 0 && (!attrs.normal_indices.is_empty() || !attrs.uv_indices.is_empty()) {
+        scene.attributes.push(Arc::new(attrs));
+    }
+}
+
+/// Area-weighted vertex normals for `triangles` (SPEC §3b `normals = "smooth"`): at each corner,
+/// the sum of the cross products (twice the area times the unit normal) of the triangles that
+/// share the corner's position and whose normal is within `crease_angle_deg` of this
+/// triangle's, normalised. Corners are shared by position, so a mesh split into groups or
+/// materials is still smooth across them. Returns the normals and each triangle's indices.
+pub fn smooth_normals(triangles: &[Triangle], crease_angle_deg: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let key = |p: Vec3| p.to_array().map(|x| (x + 0.0).to_bits());
+    let mut ids: HashMap<[u32; 3], u32> = HashMap::with_capacity(triangles.len());
+    let corner_ids: Vec<[u32; 3]> = triangles
+        .iter()
+        .map(|t| {
+            t.vertices.map(|p| {
+                let next = ids.len() as u32;
+                *ids.entry(key(p)).or_insert(next)
+            })
+        })
+        .collect();
+    // The triangles around each position, as one flat list with offsets.
+    let mut start = vec![0u32; ids.len() + 1];
+    for c in corner_ids.iter().flatten() {
+        start[*c as usize + 1] += 1;
+    }
+    for i in 0..ids.len() {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start.clone();
+    let mut around = vec![0u32; 3 * triangles.len()];
+    for (k, c) in corner_ids.iter().enumerate() {
+        for &id in c {
+            around[fill[id as usize] as usize] = k as u32;
+            fill[id as usize] += 1;
+        }
+    }
+    let weighted: Vec<Vec3> = triangles
+        .iter()
+        .map(|t| (t.vertices[1] - t.vertices[0]).cross(t.vertices[2] - t.vertices[0]))
+        .collect();
+    let unit: Vec<Vec3> = weighted.iter().map(|w| w.normalize_or_zero()).collect();
+    let cos_crease = crease_angle_deg.to_radians().cos();
+    let mut normals = Vec::with_capacity(3 * triangles.len());
+    let mut indices = Vec::with_capacity(triangles.len());
+    for (k, c) in corner_ids.iter().enumerate() {
+        let mut idx = [0u32; 3];
+        for (slot, &id) in idx.iter_mut().zip(c) {
+            let (a, b) = (start[id as usize] as usize, start[id as usize + 1] as usize);
+            let mut sum = Vec3::ZERO;
+            for &other in &around[a..b] {
+                if unit[k].dot(unit[other as usize]) >= cos_crease {
+                    sum += weighted[other as usize];
+                }
+            }
+            // The triangle itself is always in its own sum, so this has a direction unless
+            // the sum overflowed.
+            let n = sum.normalize_or_zero();
+            *slot = normals.len() as u32;
+            normals.push(if n == Vec3::ZERO { unit[k] } else { n });
+        }
+        indices.push(idx);
+    }
+    (normals, indices)
 }
 
 /// `usemtl` names that no loaded library defines: tobj silently gives those faces no material.
@@ -486,15 +757,100 @@ fn mtl_material(
     scene: &mut Scene,
     req: &MeshRequest,
     m: &tobj::Material,
+    mtl_texts: &[(String, String)],
     warnings: &mut Vec<String>,
 ) -> MaterialId {
     let name = format!("{}/{}", req.object_name, m.name);
-    if let Some(i) = scene.materials.iter().position(|x| x.name == name) {
-        return MaterialId(i as u32);
+    let id = match scene.materials.iter().position(|x| x.name == name) {
+        Some(i) => MaterialId(i as u32),
+        None => {
+            let material = material_from_mtl(m, name, req.label, warnings);
+            scene.materials.push(material);
+            MaterialId(scene.materials.len() as u32 - 1)
+        }
+    };
+    // Textures come from the MTL even when a `[[material]]` of this name overrides its
+    // colours (a scene file has no texture keys, so a saved scene keeps its textures).
+    let mut texture = |key: &str, file: &Option<String>| {
+        let file = file.as_deref()?;
+        load_texture(scene, req, &m.name, key, file, mtl_texts, warnings)
+    };
+    let diffuse = texture("map_Kd", &m.diffuse_texture);
+    let ambient = texture("map_Ka", &m.ambient_texture);
+    let material = &mut scene.materials[id.0 as usize];
+    material.diffuse_map = material.diffuse_map.or(diffuse);
+    material.ambient_map = material.ambient_map.or(ambient);
+    id
+}
+
+/// The file a `map_Kd` value names: the value, or its last word when it starts with options
+/// (`-s 2 2 1 wood.png`).
+fn texture_file(value: &str) -> &str {
+    let value = value.trim();
+    if value.starts_with('-') {
+        value.split_whitespace().last().unwrap_or(value)
+    } else {
+        value
     }
-    let material = material_from_mtl(m, name, req.label, warnings);
-    scene.materials.push(material);
-    MaterialId(scene.materials.len() as u32 - 1)
+}
+
+/// The texture `value` of MTL statement `key` of material `material`, loaded once per scene
+/// (materials that share a file share the texture); `None` with one warning naming the file
+/// and the MTL line when it cannot be read, decoded, or fit in the memory budget.
+fn load_texture(
+    scene: &mut Scene,
+    req: &MeshRequest,
+    material: &str,
+    key: &str,
+    value: &str,
+    mtl_texts: &[(String, String)],
+    warnings: &mut Vec<String>,
+) -> Option<TextureId> {
+    let file = texture_file(value);
+    let path = sibling(req.key, file);
+    if let Some(i) = scene.textures.iter().position(|t| t.name == path) {
+        return Some(TextureId(i as u32));
+    }
+    let place = mtl_texts
+        .iter()
+        .find_map(|(mtl, text)| {
+            text.lines()
+                .position(|l| {
+                    let l = l.trim_start();
+                    l.starts_with(key) && l.contains(file)
+                })
+                .map(|i| format!("`{mtl}` line {}", i + 1))
+        })
+        .unwrap_or_else(|| "its material library".into());
+    let limit = memory_limit();
+    let used: u64 = scene
+        .textures
+        .iter()
+        .map(|t| Texture::bytes(t.width, t.height))
+        .sum();
+    let left = MemoryLimit {
+        bytes: limit.bytes.saturating_sub(used),
+        source: limit.source,
+    };
+    let loaded = (req.resolve_bytes)(&path).and_then(|bytes| {
+        quietly(|| decode_texture(&path, &bytes, &left))
+            .unwrap_or_else(|()| Err("the image reader failed on it".into()))
+    });
+    match loaded {
+        Ok(texture) => {
+            scene.textures.push(Arc::new(texture));
+            Some(TextureId(scene.textures.len() as u32 - 1))
+        }
+        Err(reason) => {
+            warnings.push(format!(
+                "{}: material `{}` ({place}): cannot use the texture `{}` of `{key}` ({reason}); its flat colour stays.",
+                req.label,
+                short(material),
+                short_path(file)
+            ));
+            None
+        }
+    }
 }
 
 /// Maps an MTL material to the Phong material: Ka→ambient, Kd→diffuse, Ks→specular,
@@ -569,6 +925,8 @@ pub fn material_from_mtl(
         reflectivity: if mirror { specular } else { Vec3::ZERO },
         transparency: Vec3::splat(transparency),
         ior,
+        diffuse_map: None,
+        ambient_map: None,
     }
 }
 
@@ -580,6 +938,7 @@ pub(crate) fn load_obj_scene(
     label: &str,
     key: &str,
     resolve: &ResolveFn<'_>,
+    resolve_bytes: &ResolveBytesFn<'_>,
 ) -> Result<Scene, SceneError> {
     let name = file_stem(key).unwrap_or_else(|| "mesh".into());
     let placement = MeshPlacement::default();
@@ -592,6 +951,8 @@ pub(crate) fn load_obj_scene(
             translate: placement.translate,
             rotate_deg: placement.rotate_deg,
             scale: placement.scale,
+            normals: NormalsMode::default(),
+            crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG,
         },
     });
     let request = MeshRequest {
@@ -601,8 +962,11 @@ pub(crate) fn load_obj_scene(
         key,
         text,
         resolve,
+        resolve_bytes,
         material_override: None,
         placement: &placement,
+        normals: NormalsMode::default(),
+        crease_angle_deg: DEFAULT_CREASE_ANGLE_DEG,
     };
     let added = add_mesh(&mut scene, &request).map_err(|p| {
         let at = p.line.map(|l| format!(":{l}")).unwrap_or_default();

@@ -111,6 +111,7 @@ pub fn bench_scene_frame() -> Scene {
             reflectivity: Vec3::splat(0.08),
             transparency: Vec3::splat(0.9),
             ior: 1.5,
+            ..Material::default()
         },
     ];
     let object = |name: &str, source: ObjectSource| Object {
@@ -126,6 +127,8 @@ pub fn bench_scene_frame() -> Scene {
                 translate: Vec3::ZERO,
                 rotate_deg: Vec3::ZERO,
                 scale: Vec3::ONE,
+                normals: Default::default(),
+                crease_angle_deg: super::DEFAULT_CREASE_ANGLE_DEG,
             },
         ),
         object("floor a", ObjectSource::Triangle),

@@ -61,6 +61,10 @@ pub const LIGHT_RADIUS: Rule = |x| match NON_NEGATIVE(x) {
 pub const FOV: Rule =
     |x| (x <= 0.0 || x >= 180.0).then_some("must be between 0 and 180 degrees (both excluded)");
 
+/// `[[mesh]]` `crease_angle`, degrees: faces meeting at more than this keep their own normals.
+pub const CREASE_ANGLE: Rule =
+    |x| (!(0.0..=180.0).contains(&x)).then_some("must be between 0 and 180 degrees");
+
 /// Worker threads a render or a sweep may ask for (0: every core).
 pub const MAX_THREADS: usize = 1024;
 
@@ -239,6 +243,11 @@ pub fn check_placement(translate: Vec3, rotate_deg: Vec3, scale: Vec3) -> Result
     vector("scale", scale, NON_ZERO)
 }
 
+/// `[[mesh]]` `crease_angle` (degrees).
+pub fn check_mesh_normals(crease_angle_deg: f32) -> Result<(), Violation> {
+    number("crease_angle", 0, crease_angle_deg, CREASE_ANGLE)
+}
+
 /// `what field `key` phrase[, got value]`: the words the loader uses, for checks of scenes that
 /// come from elsewhere (the viewer's edits), where there is no file to point into.
 pub fn describe(what: &str, v: &Violation) -> String {
@@ -268,6 +277,15 @@ pub fn check_scene(s: &Scene, geometry: bool) -> Result<(), String> {
         {
             check_sphere(*center, *radius)
                 .map_err(|v| describe(&format!("sphere \"{}\"", s.object(*object).name), &v))?;
+        }
+        for o in &s.objects {
+            if let super::ObjectSource::Mesh {
+                crease_angle_deg, ..
+            } = &o.source
+            {
+                check_mesh_normals(*crease_angle_deg)
+                    .map_err(|v| describe(&format!("mesh \"{}\"", o.name), &v))?;
+            }
         }
         for t in &s.triangles {
             check_triangle(&t.vertices)

@@ -97,6 +97,8 @@ pub fn scene_to_toml(scene: &Scene) -> String {
                 translate,
                 rotate_deg,
                 scale,
+                normals,
+                crease_angle_deg,
             } => {
                 out += "\n[[mesh]]\n";
                 line(&mut out, "name", string(&object.name));
@@ -107,6 +109,8 @@ pub fn scene_to_toml(scene: &Scene) -> String {
                 line(&mut out, "translate", vec3(*translate));
                 line(&mut out, "rotate", vec3(*rotate_deg));
                 line(&mut out, "scale", color(*scale));
+                line(&mut out, "normals", string(normals.name()));
+                line(&mut out, "crease_angle", float(*crease_angle_deg));
             }
         }
     }

@@ -146,6 +146,7 @@ pub fn mat(name: &str, ka: Vec3, kd: Vec3, ks: f32, n: f32, kr: f32) -> Material
         reflectivity: Vec3::splat(kr),
         transparency: Vec3::ZERO,
         ior: 1.5,
+        ..Material::default()
     }
 }
 

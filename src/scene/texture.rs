@@ -1,0 +1,184 @@
+//! Image textures for MTL `map_Kd` and `map_Ka` (SPEC §3b): PNG and JPEG through the `image`
+//! crate, decoded once from sRGB to linear RGB, checked against the memory budget from the
+//! image's header before any texel is decoded. Sampling (bilinear, wrapping) is
+//! [`super::Texture::sample`].
+
+use std::io::Cursor;
+
+use super::Texture;
+use super::budget::{MemoryLimit, format_bytes};
+
+/// Largest texture file read (a 16k × 16k JPEG is well under it).
+pub const MAX_TEXTURE_FILE_BYTES: u64 = 256 << 20;
+
+/// The sRGB transfer function inverted: the linear value of an 8-bit sRGB code.
+fn srgb_to_linear(code: u8) -> f32 {
+    let c = f32::from(code) / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Decodes PNG or JPEG `bytes` into a linear texture named `name`, or says why not in a phrase
+/// ("it is not a PNG or JPEG image", "its 40000x40000 texels would need ..."). `limit` is the
+/// memory still available: a texture larger than it is refused before it is decoded.
+pub fn decode_texture(name: &str, bytes: &[u8], limit: &MemoryLimit) -> Result<Texture, String> {
+    let reader = image::ImageReader::new(Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| format!("cannot read it ({e})"))?;
+    match reader.format() {
+        Some(image::ImageFormat::Png | image::ImageFormat::Jpeg) => {}
+        _ => return Err("it is not a PNG or JPEG image".into()),
+    }
+    let (width, height) = reader
+        .into_dimensions()
+        .map_err(|e| format!("cannot read its size ({e})"))?;
+    if width == 0 || height == 0 {
+        return Err(format!("it has no texels ({width}x{height})"));
+    }
+    let linear_bytes = Texture::bytes(width, height);
+    // The decoder's 8-bit copy comes on top of the linear texels while both exist.
+    let peak = linear_bytes.saturating_add(u64::from(width) * u64::from(height) * 4);
+    limit
+        .check(format!("its {width}x{height} texels"), peak)
+        .map_err(|e| e.to_string())?;
+    let mut reader = image::ImageReader::new(Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| format!("cannot read it ({e})"))?;
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(peak.max(1 << 20));
+    reader.limits(limits);
+    let decoded = reader
+        .decode()
+        .map_err(|e| format!("cannot decode it ({e})"))?;
+    let rgb = decoded.to_rgb8();
+    let lut: Vec<f32> = (0..=255u8).map(srgb_to_linear).collect();
+    let texels = rgb
+        .pixels()
+        .map(|p| p.0.map(|c| lut[usize::from(c)]))
+        .collect();
+    Ok(Texture {
+        name: name.to_string(),
+        width,
+        height,
+        texels,
+    })
+}
+
+/// A resolver of binary files (textures) relative to `folder`: regular files only (a folder,
+/// a device such as `/dev/zero` or a pipe is refused with a phrase), at most
+/// [`MAX_TEXTURE_FILE_BYTES`].
+pub fn fs_bytes_resolver(folder: std::path::PathBuf) -> impl Fn(&str) -> Result<Vec<u8>, String> {
+    move |path: &str| read_bytes(&folder.join(path), MAX_TEXTURE_FILE_BYTES)
+}
+
+fn read_bytes(path: &std::path::Path, max_bytes: u64) -> Result<Vec<u8>, String> {
+    use std::io::Read;
+    let reason = |e: std::io::Error| {
+        let text = e.to_string();
+        match text.find(" (os error") {
+            Some(i) => text[..i].to_string(),
+            None => text,
+        }
+    };
+    let meta = std::fs::metadata(path).map_err(reason)?;
+    if meta.is_dir() {
+        return Err("it is a folder, not a file".into());
+    }
+    if !meta.is_file() {
+        return Err("it is not a regular file (a device, a pipe or a socket)".into());
+    }
+    let too_big = format!(
+        "it is more than the {} a texture file may have",
+        format_bytes(max_bytes)
+    );
+    if meta.len() > max_bytes {
+        return Err(too_big);
+    }
+    let file = std::fs::File::open(path).map_err(reason)?;
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(max_bytes + 1)
+        .read_to_end(&mut bytes)
+        .map_err(reason)?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(too_big);
+    }
+    Ok(bytes)
+}
+
+/// "`name` (1.2 MiB)": for messages about a texture's memory.
+pub fn describe_size(texture: &Texture) -> String {
+    format!(
+        "`{}` ({})",
+        texture.name,
+        format_bytes(Texture::bytes(texture.width, texture.height))
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn png(width: u32, height: u32, rgb: &[u8]) -> Vec<u8> {
+        let mut out = Vec::new();
+        let mut enc = png::Encoder::new(&mut out, width, height);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut w = enc.write_header().expect("header");
+        w.write_image_data(rgb).expect("data");
+        drop(w);
+        out
+    }
+
+    fn roomy() -> MemoryLimit {
+        MemoryLimit {
+            bytes: 1 << 30,
+            source: "a test".into(),
+        }
+    }
+
+    #[test]
+    fn pngs_decode_to_linear_and_sample_bilinearly_with_wrapping() {
+        let bytes = png(2, 1, &[255, 0, 0, 0, 0, 255]);
+        let t = decode_texture("t.png", &bytes, &roomy()).expect("decodes");
+        assert_eq!((t.width, t.height), (2, 1));
+        assert_eq!(t.texels, vec![[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]);
+        // Texel centres at u = 0.25 and 0.75; halfway between, an even mix; u = 0 wraps to
+        // halfway between the last and the first texel.
+        let mid = t.sample(glam::Vec2::new(0.5, 0.5));
+        assert!(
+            (mid - glam::Vec3::new(0.5, 0.0, 0.5)).length() < 1e-6,
+            "{mid}"
+        );
+        let edge = t.sample(glam::Vec2::new(0.0, 0.5));
+        assert!(
+            (edge - glam::Vec3::new(0.5, 0.0, 0.5)).length() < 1e-6,
+            "{edge}"
+        );
+        let at = t.sample(glam::Vec2::new(1.25, 7.5));
+        assert!((at - glam::Vec3::X).length() < 1e-6, "{at}");
+        assert!((srgb_to_linear(128) - 0.2158605).abs() < 1e-6);
+    }
+
+    #[test]
+    fn bad_images_get_a_phrase() {
+        let limit = roomy();
+        assert_eq!(
+            decode_texture("x", b"not an image", &limit)
+                .err()
+                .as_deref(),
+            Some("it is not a PNG or JPEG image")
+        );
+        let bytes = png(4, 4, &[7; 48]);
+        let e = decode_texture("x", &bytes[..bytes.len() / 2], &limit).expect_err("truncated");
+        assert!(e.starts_with("cannot decode it"), "{e}");
+        let small = MemoryLimit {
+            bytes: 100,
+            source: "a test".into(),
+        };
+        let e = decode_texture("x", &bytes, &small).expect_err("over budget");
+        assert!(e.contains("its 4x4 texels would need about"), "{e}");
+    }
+}

@@ -1,0 +1,270 @@
+//! Shading normals and textures from OBJ files (SPEC §3b): `vn` interpolated at the hit, the
+//! `[[mesh]]` keys `normals` and `crease_angle` (held to scene::rules, saved and loaded back),
+//! `vt` and `map_Kd` textures, and the sentences for broken `vn`, `vt` and texture files.
+
+use std::sync::Arc;
+
+use glam::Vec3;
+use raytree::ray_tree::pixel_tree;
+use raytree::scene::{
+    NormalsMode, ObjectSource, Scene, load_scene_file, load_scene_str_with,
+    load_scene_str_with_files, scene_to_toml,
+};
+use raytree::trace::{TraceSettings, Tracer};
+
+/// One triangle facing +z with three different vertex normals, and a texture coordinate each.
+const TRI: &str = "v -1 -1 0\nv 1 -1 0\nv 0 1 0\n\
+vn -0.5 0 1\nvn 0.5 0 1\nvn 0 0.5 1\n\
+vt 0 0\nvt 1 0\nvt 0 1\n\
+f 1/1/1 2/2/2 3/3/3\n";
+
+/// An octahedron (faces meet at 109.5°, their normals 70.5° apart), no `vn`.
+const OCTA: &str = "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n\
+f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n";
+
+fn files(list: &'static [(&'static str, &'static str)]) -> impl Fn(&str) -> Result<String, String> {
+    move |path: &str| {
+        list.iter()
+            .find(|(p, _)| *p == path)
+            .map(|(_, t)| (*t).to_string())
+            .ok_or_else(|| format!("{path}: no such test file"))
+    }
+}
+
+fn load(toml: &str, list: &'static [(&'static str, &'static str)]) -> Scene {
+    load_scene_str_with(toml, "t.toml", &files(list)).unwrap_or_else(|e| panic!("{e}"))
+}
+
+const CAMERA: &str = "[render]\nwidth = 9\nheight = 9\nambient_light = 0\n\
+[camera]\nposition = [0, 0, 3]\nlook_at = [0, 0, 0]\nfov_y = 10\n\
+[[light]]\nposition = [0, 0, 5]\n";
+
+#[test]
+fn vertex_normals_are_interpolated_and_the_tree_shows_both_normals() {
+    let scene = load(
+        &format!("{CAMERA}[[mesh]]\nfile = \"tri.obj\"\n"),
+        &[("tri.obj", TRI)],
+    );
+    assert_eq!(scene.attributes.len(), 1);
+    let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());
+    let tree = pixel_tree(&tracer, 4, 4).expect("centre pixel");
+    let hit = tree.root.hit.as_ref().expect("hits the triangle");
+    let b = hit.barycentric.expect("a triangle");
+    let n = [
+        Vec3::new(-0.5, 0.0, 1.0).normalize(),
+        Vec3::new(0.5, 0.0, 1.0).normalize(),
+        Vec3::new(0.0, 0.5, 1.0).normalize(),
+    ];
+    let want = (b[0] * n[0] + b[1] * n[1] + b[2] * n[2]).normalize();
+    assert!(
+        (hit.normal - want).length() < 1e-5,
+        "{} vs {want}",
+        hit.normal
+    );
+    assert_eq!(hit.geometric_normal, Some(Vec3::Z));
+    // No texture: no uv shown.
+    assert_eq!(hit.uv, None);
+    let json = serde_json::to_string(&tree).expect("json");
+    assert!(json.contains("\"geometric_normal\""), "{json}");
+}
+
+#[test]
+fn flat_ignores_vn_and_smooth_splits_at_the_crease_angle() {
+    let flat = load(
+        &format!("{CAMERA}[[mesh]]\nfile = \"tri.obj\"\nnormals = \"flat\"\n"),
+        &[("tri.obj", TRI)],
+    );
+    assert!(flat.attributes.is_empty(), "flat meshes carry nothing");
+    // Neighbouring faces' normals are 70.5° apart, opposite ones 109.5°: the default 60° keeps
+    // every face flat, 120° smooths all four around a corner.
+    for (crease, smooth) in [(60.0, false), (120.0, true)] {
+        let s = load(
+            &format!(
+                "{CAMERA}[[mesh]]\nfile = \"o.obj\"\nnormals = \"smooth\"\ncrease_angle = {crease}\n"
+            ),
+            &[("o.obj", OCTA)],
+        );
+        let a = &s.attributes[0];
+        let n = a.normals_of(0).expect("normals");
+        let face = Vec3::ONE.normalize();
+        if smooth {
+            // The corner at (1, 0, 0) averages its four faces: the normal is +x.
+            assert!((n[0] - Vec3::X).length() < 1e-6, "{n:?}");
+        } else {
+            assert!(n.iter().all(|v| (*v - face).length() < 1e-6), "{n:?}");
+        }
+    }
+    // A file without vn under the default "file": flat, nothing kept.
+    let plain = load(
+        &format!("{CAMERA}[[mesh]]\nfile = \"o.obj\"\n"),
+        &[("o.obj", OCTA)],
+    );
+    assert!(plain.attributes.is_empty());
+}
+
+#[test]
+fn normals_keys_are_checked_saved_and_loaded_back() {
+    let list: &'static [(&str, &str)] = &[("o.obj", OCTA)];
+    let bad = load_scene_str_with(
+        "[[mesh]]\nfile = \"o.obj\"\ncrease_angle = 200\n",
+        "t.toml",
+        &files(list),
+    )
+    .expect_err("crease above 180")
+    .to_string();
+    assert!(
+        bad.starts_with("t.toml:3:")
+            && bad.contains("`crease_angle` must be between 0 and 180 degrees"),
+        "{bad}"
+    );
+    let bad = load_scene_str_with(
+        "[[mesh]]\nfile = \"o.obj\"\nnormals = \"bumpy\"\n",
+        "t.toml",
+        &files(list),
+    )
+    .expect_err("unknown mode")
+    .to_string();
+    assert!(bad.contains("\"file\" or \"flat\" or \"smooth\""), "{bad}");
+    let scene = load(
+        "[[mesh]]\nfile = \"o.obj\"\nnormals = \"smooth\"\ncrease_angle = 75.5\n",
+        list,
+    );
+    let text = scene_to_toml(&scene);
+    assert!(
+        text.contains("normals = \"smooth\"\ncrease_angle = 75.5\n"),
+        "{text}"
+    );
+    let back = load(&text, list);
+    assert_eq!(back.objects, scene.objects);
+    assert_eq!(back.attributes, scene.attributes);
+    assert!(matches!(
+        back.objects[0].source,
+        ObjectSource::Mesh {
+            normals: NormalsMode::Smooth,
+            ..
+        }
+    ));
+}
+
+#[test]
+fn broken_vn_faces_are_flat_with_one_warning() {
+    // Face 1: a normal too long for f32 (its length overflows); face 2: a zero normal; face 3
+    // fine.
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n\
+vn 0 0 1\nvn 3e38 3e38 0\nvn 0 0 0\n\
+f 2//2 4//1 3//1\nf 2//3 4//1 3//1\nf 1//1 2//1 3//1\n";
+    let list: &'static [(&str, &str)] = Box::leak(Box::new([("b.obj", obj)]));
+    let scene = load("[[mesh]]\nfile = \"b.obj\"\n", list);
+    assert_eq!(scene.triangles.len(), 3);
+    assert_eq!(
+        scene.warnings,
+        [
+            "b.obj: 2 faces name normals (`vn`) that are out of range, zero or not finite; they are shaded flat."
+        ]
+    );
+    let a = &scene.attributes[0];
+    let has: Vec<bool> = (0..3).map(|i| a.normals_of(i).is_some()).collect();
+    assert_eq!(has, [false, false, true]);
+    // A vn index out of range: the OBJ reader refuses the file, naming the line.
+    let bad: &'static [(&str, &str)] = &[(
+        "c.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//9 3//1\n",
+    )];
+    let e = load_scene_str_with("[[mesh]]\nfile = \"c.obj\"\n", "t.toml", &files(bad))
+        .expect_err("index out of range")
+        .to_string();
+    assert_eq!(
+        e,
+        "t.toml:2:8: mesh 1 field `file` cannot be loaded: c.obj:5: face normal index out of bounds."
+    );
+}
+
+fn png_bytes(w: u32, h: u32, rgb: &[u8]) -> Vec<u8> {
+    let mut out = Vec::new();
+    let mut enc = png::Encoder::new(&mut out, w, h);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let mut writer = enc.write_header().expect("header");
+    writer.write_image_data(rgb).expect("data");
+    drop(writer);
+    out
+}
+
+#[test]
+fn map_kd_multiplies_kd_and_the_tree_shows_uv_and_texel() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    std::fs::write(
+        dir.path().join("tri.obj"),
+        format!("mtllib t.mtl\nusemtl t\n{TRI}"),
+    )
+    .expect("obj");
+    std::fs::write(
+        dir.path().join("t.mtl"),
+        "newmtl t\nKd 0.5 0.5 0.5\nmap_Kd red.png\n",
+    )
+    .expect("mtl");
+    std::fs::write(dir.path().join("red.png"), png_bytes(1, 1, &[255, 0, 0])).expect("png");
+    let scene_file = dir.path().join("s.toml");
+    std::fs::write(
+        &scene_file,
+        format!("{CAMERA}[[mesh]]\nfile = \"tri.obj\"\n"),
+    )
+    .expect("toml");
+    let scene = load_scene_file(&scene_file).unwrap_or_else(|e| panic!("{e}"));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert_eq!(scene.textures.len(), 1);
+    let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());
+    let tree = pixel_tree(&tracer, 4, 4).expect("centre pixel");
+    let hit = tree.root.hit.as_ref().expect("hit");
+    assert_eq!(hit.texel, Some(Vec3::X));
+    assert!(hit.uv.is_some());
+    // Red texel × kd 0.5: no green or blue diffuse at all.
+    let local = tree.root.local.expect("shaded");
+    assert!(
+        local.diffuse.x > 0.0 && local.diffuse.y == 0.0 && local.diffuse.z == 0.0,
+        "{local:?}"
+    );
+
+    // A missing texture, a folder and /dev/zero: one warning each naming the file and the
+    // MTL line; the flat colour stays.
+    for (what, target) in [
+        ("missing", "nope.png"),
+        ("folder", "sub"),
+        ("device", "/dev/zero"),
+        ("not an image", "t.mtl"),
+    ] {
+        std::fs::create_dir_all(dir.path().join("sub")).expect("folder");
+        std::fs::write(
+            dir.path().join("t.mtl"),
+            format!("newmtl t\nKd 0.5 0.5 0.5\nmap_Kd {target}\n"),
+        )
+        .expect("mtl");
+        let scene = load_scene_file(&scene_file).unwrap_or_else(|e| panic!("{what}: {e}"));
+        assert_eq!(scene.warnings.len(), 1, "{what}: {:?}", scene.warnings);
+        let w = &scene.warnings[0];
+        assert!(
+            w.contains("`t.mtl` line 3") && w.contains("its flat colour stays"),
+            "{what}: {w}"
+        );
+        assert!(scene.textures.is_empty());
+    }
+}
+
+#[test]
+fn built_in_textures_are_read_from_the_binary() {
+    let scene = load_scene_str_with_files(
+        raytree::scene::builtin::scene_text("smooth").expect("smooth"),
+        "smooth.toml",
+        &raytree::scene::builtin::resolve,
+        &raytree::scene::builtin::resolve_bytes,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    // Two meshes share one texture.
+    assert_eq!(scene.textures.len(), 1);
+    assert_eq!(scene.attributes.len(), 2);
+    assert!(
+        scene.attributes[1].normal_indices.is_empty(),
+        "the faceted copy has no normals"
+    );
+}
