@@ -911,6 +911,7 @@ impl Tracer {
 /// decide here, so a light the tree marks "not traced: contributes nothing" is one the image
 /// did not trace.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn casts_shadow_ray(
     shading: crate::scene::Shading,
     material: &crate::scene::Material,

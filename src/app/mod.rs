@@ -1080,7 +1080,7 @@ impl eframe::App for ViewerApp {
         panels::help_window(&ctx, &mut self.show_help);
         panels::export_window(self, &ctx);
         if self.sweep.open
-            && let Some(point) = self.sweep.show(&ctx, &self.scene, &self.settings.trace)
+            && let Some(point) = self.sweep.show(&ctx, &self.edit, &self.settings.trace)
         {
             // A clicked point: its settings become the viewer's; say what changed.
             if let Some(text) = self.sweep.applied.clone() {

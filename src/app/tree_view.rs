@@ -352,7 +352,9 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
         view.fit = true;
     }
     let mut export = false;
-    ui.horizontal(|ui| {
+    // Wrapped: a toolbar wider than a narrow pane must not widen the pane's space, or the
+    // fitted tree would be centred in a part of it that is not shown.
+    ui.horizontal_wrapped(|ui| {
         if ui
             .button("Fit")
             .on_hover_text("show the whole tree in the pane")
@@ -377,7 +379,9 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
         }
         ui.weak("Ctrl+wheel zooms, drag pans");
     });
-    let size = ui.available_size().max(Vec2::new(120.0, 80.0));
+    // The space left that is shown (never wider than the pane's clip rectangle).
+    let shown = ui.available_rect_before_wrap().intersect(ui.clip_rect());
+    let size = shown.size().max(Vec2::new(120.0, 80.0));
     let (rect, response) = ui.allocate_exact_size(size, Sense::click_and_drag());
     response.widget_info(|| {
         egui::WidgetInfo::labeled(
