@@ -275,10 +275,39 @@ pub fn render_with(
     tile: &TileFn<'_>,
 ) -> Result<(Image, RenderStats), RenderError> {
     let (width, height) = (tracer.scene.render.width, tracer.scene.render.height);
-    memory_limit().check(
-        format!("a {width}x{height} render"),
-        batch_memory_estimate(width, height),
-    )?;
+    render_part_with(
+        tracer,
+        region::full(width, height),
+        samples,
+        threads,
+        progress,
+        tile,
+    )
+}
+
+/// [`render_with`] of the pixels of `region` only (inside the tracer's `[render]` size): an
+/// image of the region's size whose pixels equal, bit for bit, the same pixels of the full
+/// image, as the camera frame is the full image's and each pixel's samples are keyed by its
+/// coordinates in it. `progress` gets (pixels done, pixels in the region); the statistics'
+/// width and height are the region's.
+pub(crate) fn render_part_with(
+    tracer: &Tracer,
+    region: Rect,
+    samples: u32,
+    threads: usize,
+    progress: &(dyn Fn(u64, u64) + Sync),
+    tile: &TileFn<'_>,
+) -> Result<(Image, RenderStats), RenderError> {
+    let (width, height) = (tracer.scene.render.width, tracer.scene.render.height);
+    let what = if region == region::full(width, height) {
+        format!("a {width}x{height} render")
+    } else {
+        format!(
+            "a {}x{} region of a {width}x{height} render",
+            region.width, region.height
+        )
+    };
+    memory_limit().check(what, batch_memory_estimate(region.width, region.height))?;
     let frame = CameraFrame::new(&tracer.scene.camera, width, height);
     // The pool we are on (rayon's global one, which the CLI sizes by `--threads`) when it has
     // the size asked for; a pool of our own otherwise.
@@ -295,8 +324,16 @@ pub fn render_with(
                 })?,
         )
     };
-    let tiles = tiles(width, height, TILE_SIZE);
-    let total = width as u64 * height as u64;
+    // The region's tiles, in the full image's coordinates.
+    let tiles: Vec<Rect> = tiles(region.width, region.height, TILE_SIZE)
+        .into_iter()
+        .map(|r| Rect {
+            x: region.x + r.x,
+            y: region.y + r.y,
+            ..r
+        })
+        .collect();
+    let total = region.width as u64 * region.height as u64;
     // One buffer for every tile's sums, tile after tile: no allocation per tile.
     let mut sums = vec![Vec3::ZERO; total as usize];
     let mut parts: Vec<&mut [Vec3]> = Vec::with_capacity(tiles.len());
@@ -331,7 +368,7 @@ pub fn render_with(
         None => (work(), rayon::current_num_threads()),
     };
     let render_secs = start.elapsed().as_secs_f64();
-    let mut image = Image::new(width, height);
+    let mut image = Image::new(region.width, region.height);
     let mut rays = RayCounts::default();
     let mut offset = 0;
     for (rect, result) in tiles.iter().zip(results) {
@@ -341,13 +378,14 @@ pub fn render_with(
         for j in 0..rect.height {
             for i in 0..rect.width {
                 let sum = tile_sums[(j * rect.width + i) as usize];
-                image.pixels[((rect.y + j) * width + rect.x + i) as usize] = sum / samples as f32;
+                let at = (rect.y - region.y + j) * region.width + rect.x - region.x + i;
+                image.pixels[at as usize] = sum / samples as f32;
             }
         }
     }
     let stats = RenderStats {
-        width,
-        height,
+        width: region.width,
+        height: region.height,
         samples,
         threads: used_threads,
         accel: Some(tracer.accel.kind()),

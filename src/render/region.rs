@@ -6,17 +6,8 @@
 //! full image's, [`crate::scene::primary_ray`] takes global x and y), so a pixel rendered in a
 //! part is bit for bit the same pixel of the full render.
 
-use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::Instant;
-
-use glam::Vec3;
-use rayon::prelude::*;
-
-use super::{Image, Rect, RenderError, RenderStats, TILE_SIZE, panic_message, tiles, trace_tile};
-use crate::scene::CameraFrame;
-use crate::scene::budget::{batch_memory_estimate, memory_limit};
-use crate::trace::{RayCounts, Tracer};
+use super::{Image, Rect, RenderError, RenderStats, trace_tile};
+use crate::trace::Tracer;
 
 /// A region or tile that does not fit the image: one sentence.
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
@@ -92,91 +83,7 @@ pub fn render_region(
     threads: usize,
     progress: &(dyn Fn(u64, u64) + Sync),
 ) -> Result<(Image, RenderStats), RenderError> {
-    let (width, height) = (tracer.scene.render.width, tracer.scene.render.height);
-    memory_limit().check(
-        format!(
-            "a {}x{} region of a {width}x{height} render",
-            region.width, region.height
-        ),
-        batch_memory_estimate(region.width, region.height),
-    )?;
-    // The full image's camera frame: rays (and sample offsets) by global pixel coordinates.
-    let frame = CameraFrame::new(&tracer.scene.camera, width, height);
-    let own_pool = if threads == 0 || threads == rayon::current_num_threads() {
-        None
-    } else {
-        Some(
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .map_err(|e| RenderError::Threads {
-                    threads,
-                    message: e.to_string(),
-                })?,
-        )
-    };
-    // The region's tiles, in global coordinates.
-    let rects: Vec<Rect> = tiles(region.width, region.height, TILE_SIZE)
-        .into_iter()
-        .map(|r| Rect {
-            x: region.x + r.x,
-            y: region.y + r.y,
-            ..r
-        })
-        .collect();
-    let total = u64::from(region.width) * u64::from(region.height);
-    let done = AtomicU64::new(0);
-    let start = Instant::now();
-    let work = || -> Vec<Result<(Vec<Vec3>, RayCounts), RenderError>> {
-        rects
-            .par_iter()
-            .map(|&rect| {
-                let n = rect.width as usize * rect.height as usize;
-                let outcome = catch_unwind(AssertUnwindSafe(|| {
-                    let mut sums = vec![Vec3::ZERO; n];
-                    let counts = trace_tile(tracer, &frame, rect, 0..samples, &mut sums);
-                    (sums, counts)
-                }));
-                progress(
-                    done.fetch_add(n as u64, Ordering::Relaxed) + n as u64,
-                    total,
-                );
-                outcome.map_err(|panic| RenderError::WorkerPanicked {
-                    x: rect.x,
-                    y: rect.y,
-                    message: panic_message(panic.as_ref()),
-                })
-            })
-            .collect()
-    };
-    let (results, used_threads) = match &own_pool {
-        Some(pool) => (pool.install(work), pool.current_num_threads()),
-        None => (work(), rayon::current_num_threads()),
-    };
-    let render_secs = start.elapsed().as_secs_f64();
-    let mut image = Image::new(region.width, region.height);
-    let mut rays = RayCounts::default();
-    for (rect, result) in rects.iter().zip(results) {
-        let (sums, counts) = result?;
-        rays.add(&counts);
-        for j in 0..rect.height {
-            for i in 0..rect.width {
-                let at = (rect.y - region.y + j) * region.width + rect.x - region.x + i;
-                image.pixels[at as usize] = sums[(j * rect.width + i) as usize] / samples as f32;
-            }
-        }
-    }
-    let stats = RenderStats {
-        width: region.width,
-        height: region.height,
-        samples,
-        threads: used_threads,
-        accel: Some(tracer.accel.kind()),
-        rays,
-        build_secs: tracer.build_secs,
-        render_secs,
-    };
-    Ok((image, stats))
+    super::render_part_with(tracer, region, samples, threads, progress, &trace_tile)
 }
 
 #[cfg(test)]
