@@ -160,7 +160,7 @@ pub struct ShadowTest {
     /// Distance along the shadow ray (from its offset origin) to the blocker.
     pub blocked_at: Option<f32>,
     /// Whether the shadow ray was cast: not when the light is behind the surface (`N·L ≤ 0`)
-    /// nor when its unshadowed contribution is exactly zero (see [`casts_shadow_ray`]).
+    /// nor when its unshadowed contribution is exactly zero (see `casts_shadow_ray`).
     pub traced: bool,
     /// The shading normal faces the light but the light is behind the geometric surface and
     /// the smooth surface does not reach above it (STABILITY N3): the light adds nothing, and

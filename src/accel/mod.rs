@@ -459,7 +459,7 @@ impl Accel {
 
     /// [`Accel::closest_hit`] in `(0, ∞)` of each ray of a packet whose bit is set in
     /// `active` (bit `i` for `rays[i]`), into `out[i]`; the other entries of `out` are left
-    /// alone. The BVH walks the rays together ([`Bvh::walk_packet`](bvh::Bvh)); every answer
+    /// alone. The BVH walks the rays together (`Bvh::walk_packet`); every answer
     /// is the single query's, bit for bit.
     pub fn closest_hits<const K: usize>(
         &self,
