@@ -53,6 +53,9 @@ pub struct SceneView {
     drawn: Vec<Drawn>,
     /// Whether the camera has been framed on a scene yet.
     framed: bool,
+    /// The image size the camera was framed for, and that camera: while the camera is still
+    /// the framed one, a new size (a pane resized, the first real layout) frames it again.
+    framed_view: Option<((u32, u32), Camera)>,
     /// Whether the current render reached its samples.
     finished: bool,
     /// Draw the boxes the selected ray's traversal entered.
@@ -75,6 +78,7 @@ impl SceneView {
             speed: 1.5,
             drawn: Vec::new(),
             framed: false,
+            framed_view: None,
             finished: false,
             show_visits: true,
             bvh_level: None,
@@ -99,8 +103,20 @@ impl SceneView {
             up,
             ..scene.camera.clone()
         };
-        self.camera = base.framing(lo, hi, direction);
+        let mut camera = base.framing(lo, hi, direction);
+        // `framing` fits the vertical field; a pane narrower than tall has the narrower field
+        // across, so the camera moves back until the bounding sphere fits that one too.
+        let (w, h) = self.size;
+        let aspect = w as f32 / h.max(1) as f32;
+        if aspect < 1.0 {
+            let half_y = (0.5 * camera.fov_y_deg).to_radians();
+            let half_x = (aspect * half_y.tan()).atan();
+            let farther = half_y.sin() / half_x.sin().max(1e-3);
+            camera.position = camera.look_at + (camera.position - camera.look_at) * farther;
+        }
+        self.camera = camera;
         self.framed = true;
+        self.framed_view = Some((self.size, self.camera.clone()));
     }
 
     /// Frames the next scene when it is rendered (another scene was opened).
@@ -120,7 +136,9 @@ impl SceneView {
 
     /// Renders the scene of `tracer` from this view's camera, reusing its accelerator.
     pub fn restart(&mut self, tracer: &Tracer) {
-        if !self.framed {
+        let resized = matches!(&self.framed_view,
+            Some((size, camera)) if *size != self.size && *camera == self.camera);
+        if !self.framed || resized {
             self.frame(&tracer.scene);
         }
         let mut scene = (*tracer.scene).clone();
