@@ -6,8 +6,8 @@ use glam::Vec3;
 
 use super::modes::{ImageMode, mode_color};
 use super::viewport::DisplayState;
-use crate::render::Image;
 use crate::render::session::TileUpdate;
+use crate::render::{Image, Rect};
 use crate::scene_view::occlusion::DepthImage;
 use crate::trace::SampleInfo;
 
@@ -67,6 +67,12 @@ impl Film {
         }
     }
 
+    /// Whether `rect` lies inside the film (a tile of a render at another size does not).
+    pub fn holds(&self, rect: Rect) -> bool {
+        u64::from(rect.x) + u64::from(rect.width) <= u64::from(self.width)
+            && u64::from(rect.y) + u64::from(rect.height) <= u64::from(self.height)
+    }
+
     /// Writes `tile` into the film (its facts only when it carries them) and its rectangle of
     /// `display` in `mode`'s colours, marking that rectangle for upload.
     pub fn write_tile(
@@ -114,7 +120,6 @@ impl Film {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::Rect;
     use crate::render::session::Pass;
 
     /// A 2×1 tile at (1, 1): colours (1, 2, 3) and (4, 5, 6), facts of depth 1 and 2.

@@ -654,16 +654,30 @@ impl ViewerApp {
         }
         self.scene_view.poll();
         let budget = Instant::now();
-        let mut display = self.display.lock().unwrap_or_else(|p| p.into_inner());
+        let shared = self.display.clone();
+        let mut display = shared.lock().unwrap_or_else(|p| p.into_inner());
         let mode = self.prefs.mode;
-        let max_depth = self.scene.render.max_depth;
         while let Some(event) =
             self.session
                 .next_within(self.generation, budget, Duration::from_millis(8))
         {
             match event {
                 SessionEvent::Tile(tile) => {
-                    self.film.write_tile(&tile, mode, max_depth, &mut display);
+                    // The build finished after `take_built` above was asked: its tracer (and
+                    // the film at its size) comes before its first tile.
+                    if self.pending_build.is_some() {
+                        drop(display);
+                        if let Some(tracer) = self.session.take_built() {
+                            let scene_view = self.pending_build.take().unwrap_or(true);
+                            self.install_tracer(tracer, scene_view);
+                            self.progress.pass_label = "preview".into();
+                        }
+                        display = shared.lock().unwrap_or_else(|p| p.into_inner());
+                    }
+                    if self.film.holds(tile.rect) {
+                        let max_depth = self.scene.render.max_depth;
+                        self.film.write_tile(&tile, mode, max_depth, &mut display);
+                    }
                 }
                 SessionEvent::PassDone { pass, .. } => match pass {
                     Pass::Preview => {
