@@ -27,32 +27,20 @@ pub fn drag_light(
             .project(p)
             .map(|(x, y)| rect.min + egui::vec2(x / w * rect.width(), y / h * rect.height()))
     };
-    if response.drag_started_by(egui::PointerButton::Primary)
-        && let Some(origin) = ui.input(|i| i.pointer.press_origin())
-    {
-        let grabbed = app
-            .edit
+    let i = match held(ui, response, key, || {
+        let origin = ui.input(|i| i.pointer.press_origin())?;
+        app.edit
             .lights
             .iter()
             .enumerate()
             .filter_map(|(i, l)| to_screen(l.position).map(|s| (i, s.distance(origin))))
             .filter(|(_, d)| *d <= LIGHT_GRAB_RADIUS)
             .min_by(|a, b| a.1.total_cmp(&b.1))
-            .map(|(i, _)| i);
-        ui.data_mut(|d| match grabbed {
-            Some(i) => {
-                d.insert_temp(key, i);
-            }
-            None => d.remove::<usize>(key),
-        });
-    }
-    let Some(i) = ui.data(|d| d.get_temp::<usize>(key)) else {
-        return false;
+            .map(|(i, _)| i)
+    }) {
+        Ok(i) => i,
+        Err(ours) => return ours,
     };
-    if !response.dragged_by(egui::PointerButton::Primary) {
-        ui.data_mut(|d| d.remove::<usize>(key));
-        return response.drag_stopped();
-    }
     let delta = response.drag_delta();
     if let Some(light) = app.edit.lights.get_mut(i)
         && delta != egui::Vec2::ZERO
@@ -106,26 +94,15 @@ pub fn drag_sphere(
     rect: egui::Rect,
 ) -> bool {
     let key = response.id.with("dragged sphere");
-    if response.drag_started_by(egui::PointerButton::Primary) {
+    let i = match held(ui, response, key, || {
         let shift = ui.input(|i| i.modifiers.shift);
-        let grabbed = ui
-            .input(|i| i.pointer.press_origin())
+        ui.input(|i| i.pointer.press_origin())
             .filter(|_| shift)
-            .and_then(|origin| sphere_at(&app.edit.spheres, camera, rect, origin));
-        ui.data_mut(|d| match grabbed {
-            Some(i) => {
-                d.insert_temp(key, i);
-            }
-            None => d.remove::<usize>(key),
-        });
-    }
-    let Some(i) = ui.data(|d| d.get_temp::<usize>(key)) else {
-        return false;
+            .and_then(|origin| sphere_at(&app.edit.spheres, camera, rect, origin))
+    }) {
+        Ok(i) => i,
+        Err(ours) => return ours,
     };
-    if !response.dragged_by(egui::PointerButton::Primary) {
-        ui.data_mut(|d| d.remove::<usize>(key));
-        return response.drag_stopped();
-    }
     let delta = response.drag_delta();
     if let Some(sphere) = app.edit.spheres.get_mut(i)
         && delta != egui::Vec2::ZERO
@@ -134,6 +111,34 @@ pub fn drag_sphere(
         app.pending.push(Command::Rebuild);
     }
     true
+}
+
+/// The item a primary drag holds, kept under `key` from the frame the drag starts (`grab`
+/// picks it, or nothing) until it ends: `Ok(index)` while the drag goes on, else `Err` of
+/// whether this frame's input was the item's (the frame its drag stopped).
+fn held(
+    ui: &egui::Ui,
+    response: &egui::Response,
+    key: egui::Id,
+    grab: impl FnOnce() -> Option<usize>,
+) -> Result<usize, bool> {
+    if response.drag_started_by(egui::PointerButton::Primary) {
+        let grabbed = grab();
+        ui.data_mut(|d| match grabbed {
+            Some(i) => {
+                d.insert_temp(key, i);
+            }
+            None => d.remove::<usize>(key),
+        });
+    }
+    let Some(i) = ui.data(|d| d.get_temp::<usize>(key)) else {
+        return Err(false);
+    };
+    if !response.dragged_by(egui::PointerButton::Primary) {
+        ui.data_mut(|d| d.remove::<usize>(key));
+        return Err(response.drag_stopped());
+    }
+    Ok(i)
 }
 
 /// The world move of a point at `p` dragged by `delta` points in a view `height` points tall
