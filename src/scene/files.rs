@@ -8,7 +8,7 @@ use super::diag::{SceneError, short_path};
 use super::load::load_scene_str_with_files;
 use super::rules::{MAX_MESH_FILE_BYTES, MAX_SCENE_FILE_BYTES};
 use super::texture::fs_bytes_resolver;
-use super::{Scene, builtin, obj};
+use super::{Scene, builtin, first_look};
 
 /// A scene file, OBJ, or built-in scene name, as given on the command line or to the viewer:
 /// a file of that name wins over a built-in scene.
@@ -52,7 +52,7 @@ pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_else(|| file.clone());
-        obj::load_obj_scene(&text, &file, &key, &resolve, &resolve_bytes)?
+        first_look::load_obj_scene(&text, &file, &key, &resolve, &resolve_bytes)?
     } else {
         load_scene_str_with_files(&text, &file, &resolve, &resolve_bytes)?
     };

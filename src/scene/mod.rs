@@ -8,6 +8,7 @@ pub mod builtin;
 pub mod camera;
 pub mod diag;
 pub mod files;
+pub mod first_look;
 pub mod load;
 pub mod obj;
 pub mod obj_parse;
