@@ -1,9 +1,10 @@
-//! OBJ meshes and their MTL materials (SPEC §3, §3b): positions, and the `vn` normals and `vt`
-//! coordinates a scene uses (read by [`super::obj_parse`], tobj for the unusual), faces triangulated, the Phong material mapped from
-//! `Ka`/`Kd`/`Ks`/`Ns`/`Ni`/`d`/`Tr`/`illum`, and the mesh placed by scale, rotation (X then Y
-//! then Z, in degrees) and translation. Degenerate triangles are dropped here, at load time,
-//! and counted in one warning, so the tracer never meets them. A bare `.obj` opened as a
-//! whole scene is in [`super::first_look`].
+//! OBJ meshes and their MTL materials (SPEC §3, §3b): positions, and the `vn` normals and
+//! `vt` coordinates a scene uses (read by [`super::obj_parse`], tobj for the unusual), faces
+//! triangulated, the Phong material mapped from `Ka`/`Kd`/`Ks`/`Ns`/`Ni`/`d`/`Tr`/`illum`,
+//! and the mesh placed by scale, rotation (X then Y then Z, in degrees) and translation.
+//! Degenerate triangles are dropped here, at load time, and counted in one warning, so the
+//! tracer never meets them. A bare `.obj` opened as a whole scene is in
+//! [`super::first_look`].
 
 use std::borrow::Cow;
 use std::cell::{Cell, RefCell};
