@@ -497,20 +497,35 @@ fn bare_obj_is_framed_and_lit() {
         from_center.z > 0.0 && from_center.y > 0.0,
         "+z side, above: {from_center}"
     );
-    // The bounding sphere fits the vertical field of view.
-    let radius = 0.5 * (hi - lo).length();
-    let half_fov = (0.5 * c.fov_y_deg).to_radians();
-    assert!(from_center.length() * half_fov.sin() >= radius);
-    assert!(
-        from_center.length() * half_fov.sin() < 1.5 * radius,
-        "not absurdly far"
-    );
+    // The whole model is in view, and fills it (issue 14's first looks: the bounding
+    // sphere left long models a third of the image wide).
+    let forward = -from_center.normalize();
+    let right = forward.cross(c.up).normalize();
+    let up = right.cross(forward);
+    let tan_v = (0.5 * c.fov_y_deg).to_radians().tan();
+    let tan_h = tan_v * scene.render.width as f32 / scene.render.height as f32;
+    let mut fill = 0.0f32;
+    for i in 0..8 {
+        let pick = |bit: usize, l: f32, h: f32| if i & bit != 0 { h } else { l };
+        let corner = Vec3::new(
+            pick(1, lo.x, hi.x),
+            pick(2, lo.y, hi.y),
+            pick(4, lo.z, hi.z),
+        );
+        let d = corner - c.position;
+        let z = d.dot(forward);
+        assert!(z > 0.0, "corner {corner} behind the camera");
+        let f = (d.dot(right).abs() / (z * tan_h)).max(d.dot(up).abs() / (z * tan_v));
+        assert!(f <= 1.0, "corner {corner} out of view ({f})");
+        fill = fill.max(f);
+    }
+    assert!(fill > 0.6, "not absurdly far: {fill}");
 
     assert_eq!(scene.lights.len(), 2);
     let key = &scene.lights[0];
     assert_eq!(
         (key.name.as_str(), key.color, key.radius),
-        ("key", Vec3::splat(0.8), 0.0)
+        ("key", Vec3::splat(0.65), 0.0)
     );
     assert!(key.position.y > c.position.y, "above the camera");
     let head = &scene.lights[1];

@@ -76,21 +76,15 @@ pub(crate) fn load_obj_scene(
         ));
     }
     let (lo, hi) = scene.bounds().unwrap_or((Vec3::ZERO, Vec3::ZERO));
-    let center = 0.5 * (lo + hi);
-    let half = 0.5 * (hi - lo);
-    let room = encloses(&scene.triangles, center);
-    let camera = if room {
-        // Inside a closed model (a room): stand at eye height near the +z wall, looking in.
-        Camera {
-            position: center + Vec3::new(0.0, 0.0, 0.7 * half.z),
-            look_at: center - Vec3::new(0.0, 0.0, half.z),
-            fov_y_deg: 60.0,
-            ..Camera::default()
-        }
-    } else {
-        // From the +z side, slightly above, the whole model in view.
-        Camera::default().framing(lo, hi, Vec3::new(0.0, 0.3, 1.0).normalize())
-    };
+    let up = up_axis(&scene.triangles, lo, hi);
+    if up == Vec3::Z {
+        scene.warnings.push(format!(
+            "{label}: the model stands on a flat base at its lowest z and is tallest in z: +z is taken as up."
+        ));
+    }
+    let aspect = scene.render.width.max(1) as f32 / scene.render.height.max(1) as f32;
+    let look = first_view(&scene.triangles, lo, hi, up, aspect);
+    let camera = look.camera;
     if check_camera(&camera).is_err() {
         return Err(SceneError(format!(
             "{label}: cannot frame a camera on the OBJ: its bounds {lo} to {hi} are too large (the camera would stand beyond ±1e15, raytree's limit on scene size) or too small to look at in f32."
@@ -98,30 +92,35 @@ pub(crate) fn load_obj_scene(
     }
     let forward = (camera.look_at - camera.position).normalize();
     let distance = camera.position.distance(camera.look_at);
-    let key = if room {
-        // Under the ceiling, above the middle of the room.
-        center + Vec3::new(0.0, 0.8 * half.y, 0.0)
-    } else {
+    let key = match look.room {
+        // Under the ceiling, above the middle of the room (lower when that spot is inside
+        // something, a lamp for example).
+        Some(room) => room.light,
         // Above the camera and a little in front of it, so the side we see is lit and
         // shadows fall behind and below the model.
-        camera.position + Vec3::Y * (0.5 * distance) + forward * (0.2 * distance)
+        None => camera.position + up * (0.5 * distance) + forward * (0.2 * distance),
     };
     scene.lights.push(Light {
         name: "key".into(),
         position: key,
-        color: Vec3::splat(0.8),
+        color: Vec3::splat(KEY),
         radius: 0.0,
     });
     // A headlight at the camera, as model viewers have: what the camera sees is lit.
     scene.lights.push(Light {
         name: "headlight".into(),
         position: camera.position,
-        color: Vec3::splat(0.35),
+        color: Vec3::splat(HEADLIGHT),
         radius: 0.0,
     });
-    if room {
+    if let Some(room) = look.room {
         scene.warnings.push(format!(
-            "{label}: the model is closed around its centre (a room): the camera starts inside it."
+            "{label}: the model is closed around its middle (a room): {}.",
+            if room.open_side {
+                "it is open on one side, so the camera looks in through the opening"
+            } else {
+                "the camera starts inside it"
+            }
         ));
     }
     scene.camera = camera;
@@ -131,50 +130,407 @@ pub(crate) fn load_obj_scene(
 /// The ambient light of a bare OBJ.
 pub const BARE_OBJ_AMBIENT: f32 = 0.1;
 
-/// True when the model is a room around `point`: rays from it in 14 directions (the axes and
-/// the diagonals) all meet a triangle, and at least 10 of the nearest ones face `point` (the
-/// walls face inwards). A closed solid such as a statue also surrounds its middle, but from
-/// inside its triangles are seen from the back. Brute force in parallel (a million triangles:
-/// 14 million tests, a few tens of milliseconds).
-fn encloses(triangles: &[Triangle], point: Vec3) -> bool {
+/// The key light's and the headlight's grey levels: with the ambient light they add up to 1,
+/// so a white diffuse surface (`Kd 1`, common in real files) facing both is white, not
+/// clipped.
+const KEY: f32 = 0.65;
+const HEADLIGHT: f32 = 0.25;
+
+/// The up axis of a bare OBJ: +y (the OBJ convention, and what Blender, Maya and SketchUp
+/// write) unless the model clearly stands on z: a flat base at its lowest z (faces facing
+/// along z within 2 % of the depth there cover at least a fifth of the bounds' xy area), none
+/// at its lowest y, and z its longest extent (scanned busts and bottles from CAD tools).
+fn up_axis(triangles: &[Triangle], lo: Vec3, hi: Vec3) -> Vec3 {
     use rayon::prelude::*;
-    let mut dirs: Vec<Vec3> = vec![Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
-    for x in [-1.0f32, 1.0] {
-        for y in [-1.0f32, 1.0] {
-            for z in [-1.0f32, 1.0] {
-                dirs.push(Vec3::new(x, y, z).normalize());
-            }
+    let extent = hi - lo;
+    if !(extent.z > extent.x && extent.z > extent.y) {
+        return Vec3::Y;
+    }
+    // The area of the flat faces at the bottom along `axis`, as a fraction of the bounds'
+    // cross-section there.
+    let base = |axis: usize| -> f32 {
+        let band = lo[axis] + 0.02 * extent[axis];
+        let area: f32 = triangles
+            .par_iter()
+            .map(|t| {
+                let [a, b, c] = t.vertices;
+                if a[axis] > band || b[axis] > band || c[axis] > band {
+                    return 0.0;
+                }
+                let n = (b - a).cross(c - a);
+                let len = n.length();
+                if len > 0.0 && n[axis].abs() > 0.95 * len {
+                    0.5 * len
+                } else {
+                    0.0
+                }
+            })
+            .sum();
+        let (u, v) = if axis == 1 { (0, 2) } else { (0, 1) };
+        let section = extent[u] * extent[v];
+        if section > 0.0 { area / section } else { 0.0 }
+    };
+    if base(2) >= 0.2 && base(1) < 0.05 {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    }
+}
+
+/// Where the first look stands and, inside a room, where the key light hangs.
+struct FirstView {
+    camera: Camera,
+    room: Option<Room>,
+}
+
+#[derive(Clone, Copy)]
+struct Room {
+    /// The key light's position, under the ceiling and not inside anything.
+    light: Vec3,
+    /// The room has no wall on one side (a Cornell box, a stage set): the camera stands in
+    /// the opening.
+    open_side: bool,
+}
+
+/// How many directions each probe point sends rays in.
+const PROBE_DIRS: usize = 48;
+
+/// What the rays from one point met.
+#[derive(Clone, Debug, Default)]
+struct Probe {
+    /// Rays that met a triangle facing the point (a wall seen from inside the room).
+    front: usize,
+    /// Rays whose first triangle faces away (the point is inside a closed solid).
+    back: usize,
+    /// The sum of the directions of the rays that met nothing (where the room is open).
+    open: Vec3,
+    /// Per direction, whether its ray met anything.
+    met: Vec<bool>,
+}
+
+impl Probe {
+    fn hits(&self) -> usize {
+        self.front + self.back
+    }
+    /// Walls on most sides, seen from inside: most rays meet something, and most of what
+    /// they meet faces the point.
+    fn in_room(&self) -> bool {
+        5 * self.hits() >= 3 * PROBE_DIRS && 4 * self.front >= 3 * self.hits()
+    }
+    /// How many of the rays within 60° of `up` met nothing (no ceiling).
+    fn open_up(&self, dirs: &[Vec3], up: Vec3) -> usize {
+        dirs.iter()
+            .zip(&self.met)
+            .filter(|(d, m)| d.dot(up) > 0.5 && !**m)
+            .count()
+    }
+    /// Not inside a closed solid (a cabinet, a lamp): no more faces seen from behind than
+    /// from the front.
+    fn free(&self) -> bool {
+        self.back <= self.front
+    }
+}
+
+/// The first view of a model whose bounds are `lo..hi`, `up` being its up axis: inside it when
+/// it is a room (walls and a ceiling around a point near its middle), else from the front and
+/// a little above (higher for a room without a ceiling), as close as the whole model allows.
+fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32) -> FirstView {
+    let center = 0.5 * (lo + hi);
+    let half = 0.5 * (hi - lo);
+    // The horizontal axes, and the model's "front": +z for y-up OBJ files, -y for z-up ones.
+    let (side, front) = if up == Vec3::Z {
+        (Vec3::X, -Vec3::Y)
+    } else {
+        (Vec3::X, Vec3::Z)
+    };
+    let extent = |axis: Vec3| (half * axis).length();
+    let dirs = directions(PROBE_DIRS);
+    // Probe points: the centre, and halfway to each horizontal wall (the middle of a room is
+    // often a table or a bed).
+    let mut points = vec![center];
+    for axis in [side, front] {
+        for sign in [1.0, -1.0] {
+            points.push(center + axis * (sign * 0.5 * extent(axis)));
         }
     }
-    // For each direction: nothing met, or whether the nearest triangle faces `point`.
-    let nearest = |d: Vec3| -> Option<bool> {
-        let mut best: Option<(f32, bool)> = None;
-        for t in triangles {
-            // Möller–Trumbore, both sides.
-            let [a, b, c] = t.vertices;
-            let (e1, e2) = (b - a, c - a);
-            let p = d.cross(e2);
-            let det = e1.dot(p);
-            if det.abs() < 1e-12 {
-                continue;
-            }
-            let inv = 1.0 / det;
-            let s = point - a;
-            let u = s.dot(p) * inv;
-            let q = s.cross(e1);
-            let v = d.dot(q) * inv;
-            let dist = e2.dot(q) * inv;
-            if u >= 0.0
-                && v >= 0.0
-                && u + v <= 1.0
-                && dist > 0.0
-                && best.is_none_or(|(b, _)| dist < b)
-            {
-                best = Some((dist, e1.cross(e2).dot(d) < 0.0));
-            }
-        }
-        best.map(|(_, facing)| facing)
+    let probes = probe_points(triangles, &points, &dirs);
+    let room_probe = probes.iter().find(|p| p.in_room());
+    let Some(room_probe) = room_probe else {
+        return FirstView {
+            camera: frame_outside(triangles, center, up, front, 0.3, aspect),
+            room: None,
+        };
     };
-    let hits: Vec<Option<bool>> = dirs.par_iter().map(|&d| nearest(d)).collect();
-    hits.iter().all(Option::is_some) && hits.iter().filter(|h| **h == Some(true)).count() >= 10
+    // Open above (walls without a ceiling, a stage set): seen from outside and higher up, so
+    // the key light above shines in and the inside shows.
+    let skyward = dirs.iter().filter(|d| d.dot(up) > 0.5).count();
+    let sky = probes
+        .iter()
+        .filter(|p| p.in_room())
+        .map(|p| p.open_up(&dirs, up))
+        .min()
+        .unwrap_or(0);
+    if 2 * sky > skyward {
+        return FirstView {
+            camera: frame_outside(triangles, center, up, front, 0.8, aspect),
+            room: None,
+        };
+    }
+    // Which wall the camera stands at: the open side if there is one (the sum of the escaping
+    // directions points mostly one horizontal way), else the far end of the longer
+    // horizontal axis, looking along it.
+    let walls = [side, -side, front, -front];
+    let open = room_probe.open - up * room_probe.open.dot(up);
+    let escaped = PROBE_DIRS - room_probe.hits();
+    let open_wall = (escaped >= 3 && open.length() >= 0.3 * escaped as f32).then(|| {
+        walls
+            .into_iter()
+            .max_by(|a, b| a.dot(open).total_cmp(&b.dot(open)))
+            .unwrap_or(front)
+    });
+    let long = if extent(front) >= extent(side) {
+        front
+    } else {
+        side
+    };
+    let order: Vec<Vec3> = match open_wall {
+        Some(w) => vec![w, -w, long, -long],
+        None => vec![long, -long, long.cross(up), -long.cross(up)],
+    };
+    // Camera candidates, best first: in the opening (or near the wall), then closer in. Each
+    // must be free (not inside furniture) and see across the room: its view towards the
+    // opposite wall runs at least half the room before meeting anything.
+    let fractions = [0.85f32, 0.6, 0.35];
+    let mut candidates = Vec::new();
+    for f in fractions {
+        for &wall in &order {
+            candidates.push((center + wall * (f * extent(wall)), -wall));
+        }
+    }
+    // Key light candidates: under the ceiling, then lower.
+    let lights: Vec<Vec3> = [0.8f32, 0.6, 0.4, 0.2]
+        .iter()
+        .map(|f| center + up * (f * extent(up)))
+        .collect();
+    let mut points: Vec<Vec3> = candidates.iter().map(|c| c.0).collect();
+    points.extend(&lights);
+    let free = probe_points(triangles, &points, &dirs);
+    let light = lights
+        .iter()
+        .zip(&free[candidates.len()..])
+        .find(|(_, p)| p.free())
+        .map(|(l, _)| *l)
+        .unwrap_or(center);
+    if let Some(wall) = open_wall {
+        // Open on one side (a Cornell box, a stage set): seen through the opening, level, the
+        // whole room in view, as the Cornell box's own camera does.
+        return FirstView {
+            camera: frame_outside(triangles, center, up, wall, 0.0, aspect),
+            room: Some(Room {
+                light,
+                open_side: true,
+            }),
+        };
+    }
+    let views: Vec<(Vec3, Vec3)> = candidates.clone();
+    let ahead = nearest(triangles, &views);
+    // The first free candidate that sees a quarter of the room ahead, else the free one that
+    // sees farthest.
+    let usable = candidates.iter().zip(&free).zip(&ahead);
+    let camera = usable
+        .clone()
+        .find(|((c, p), a)| p.free() && a.0 >= 0.5 * extent(c.1))
+        .or_else(|| {
+            usable
+                .filter(|((_, p), _)| p.free())
+                .max_by(|x, y| x.1.0.total_cmp(&y.1.0))
+        })
+        .map(|((c, _), _)| *c)
+        .unwrap_or((center, -order[0]));
+    let (position, toward) = camera;
+    FirstView {
+        camera: Camera {
+            position,
+            look_at: position + toward * extent(toward).max(1e-6),
+            up,
+            fov_y_deg: 60.0,
+        },
+        room: Some(Room {
+            light,
+            open_side: false,
+        }),
+    }
+}
+
+/// The camera in front of the model (from `front`, raised by `elevation`: 0.3 is about 17°), aimed at the bounds'
+/// centre, as close as keeps every vertex inside the image with a 5 % margin on each side.
+fn frame_outside(
+    triangles: &[Triangle],
+    center: Vec3,
+    up: Vec3,
+    front: Vec3,
+    elevation: f32,
+    aspect: f32,
+) -> Camera {
+    use rayon::prelude::*;
+    let fov_y_deg = Camera::default().fov_y_deg;
+    let back = (front + elevation * up).normalize();
+    let right = up.cross(back).normalize();
+    let cam_up = back.cross(right);
+    let tan_v = 0.9 * (0.5 * fov_y_deg).to_radians().tan();
+    let tan_h = tan_v * aspect.max(0.1);
+    // The distance from the centre that puts a point at the image's edge: its sideways
+    // offset over the tangent, less how far it stands towards the camera.
+    let needed = |p: Vec3| -> f32 {
+        let d = p - center;
+        let toward = d.dot(back);
+        let fit = (d.dot(right).abs() / tan_h).max(d.dot(cam_up).abs() / tan_v);
+        fit + toward
+    };
+    let distance = triangles
+        .par_iter()
+        .map(|t| t.vertices.iter().map(|&v| needed(v)).fold(0.0f32, f32::max))
+        .reduce(|| 0.0, f32::max);
+    // Never on the model's centre: a flat or point-like model still gets some distance.
+    let distance = if distance > 0.0 && distance.is_finite() {
+        distance
+    } else {
+        1.0
+    };
+    Camera {
+        position: center + back * distance,
+        look_at: center,
+        up,
+        fov_y_deg,
+    }
+}
+
+/// `n` directions spread evenly over the sphere (a Fibonacci spiral: none along an axis or a
+/// box diagonal, so rays never run exactly into a box's edges or corners).
+fn directions(n: usize) -> Vec<Vec3> {
+    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+    (0..n)
+        .map(|i| {
+            let z = 1.0 - (2.0 * i as f32 + 1.0) / n as f32;
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let phi = golden * i as f32;
+            Vec3::new(r * phi.cos(), z, r * phi.sin())
+        })
+        .collect()
+}
+
+/// Rays from each of `points` in each of `dirs`: what each point's rays met first.
+fn probe_points(triangles: &[Triangle], points: &[Vec3], dirs: &[Vec3]) -> Vec<Probe> {
+    let rays: Vec<(Vec3, Vec3)> = points
+        .iter()
+        .flat_map(|&p| dirs.iter().map(move |&d| (p, d)))
+        .collect();
+    nearest(triangles, &rays)
+        .chunks(dirs.len())
+        .map(|per_point| {
+            let mut probe = Probe::default();
+            for (&(dist, facing), &d) in per_point.iter().zip(dirs) {
+                probe.met.push(dist.is_finite());
+                if !dist.is_finite() {
+                    probe.open += d;
+                } else if facing {
+                    probe.front += 1;
+                } else {
+                    probe.back += 1;
+                }
+            }
+            probe
+        })
+        .collect()
+}
+
+/// For each ray (origin, unit direction): the distance to the first triangle it meets
+/// (infinite when none) and whether that triangle faces the origin. Brute force in parallel
+/// over runs of 64 triangles sorted along a Morton curve, each run skipped as a whole when the
+/// ray misses its box: a million triangles cost tens of milliseconds.
+fn nearest(triangles: &[Triangle], rays: &[(Vec3, Vec3)]) -> Vec<(f32, bool)> {
+    use rayon::prelude::*;
+    const RUN: usize = 64;
+    let rays: Vec<(Vec3, Vec3, Vec3)> = rays.iter().map(|&(o, d)| (o, d, d.recip())).collect();
+    let order = morton_order(triangles);
+    let none = || vec![(f32::INFINITY, false); rays.len()];
+    order
+        .par_chunks(RUN)
+        .fold(none, |mut best, run| {
+            let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+            for &i in run {
+                for v in triangles[i as usize].vertices {
+                    lo = lo.min(v);
+                    hi = hi.max(v);
+                }
+            }
+            for (k, &(o, d, inv)) in rays.iter().enumerate() {
+                // Slab test against the run's box, up to the nearest hit so far.
+                let (t0, t1) = ((lo - o) * inv, (hi - o) * inv);
+                let near = t0.min(t1).max_element().max(0.0);
+                let far = t0.max(t1).min_element().min(best[k].0);
+                if near > far || far.is_nan() {
+                    continue;
+                }
+                for &i in run {
+                    // Möller–Trumbore, both sides.
+                    let [a, b, c] = triangles[i as usize].vertices;
+                    let (e1, e2) = (b - a, c - a);
+                    let p = d.cross(e2);
+                    let det = e1.dot(p);
+                    if det.abs() < 1e-12 {
+                        continue;
+                    }
+                    let inv_det = 1.0 / det;
+                    let s = o - a;
+                    let u = s.dot(p) * inv_det;
+                    let q = s.cross(e1);
+                    let v = d.dot(q) * inv_det;
+                    let dist = e2.dot(q) * inv_det;
+                    if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && dist > 0.0 && dist < best[k].0 {
+                        best[k] = (dist, e1.cross(e2).dot(d) < 0.0);
+                    }
+                }
+            }
+            best
+        })
+        .reduce(none, |a, b| {
+            a.into_iter()
+                .zip(b)
+                .map(|(x, y)| if y.0 < x.0 { y } else { x })
+                .collect()
+        })
+}
+
+/// The triangles' indices sorted by the Morton code of their centroids (10 bits an axis in
+/// the bounds), so that consecutive ones lie close together.
+fn morton_order(triangles: &[Triangle]) -> Vec<u32> {
+    use rayon::prelude::*;
+    let centroid = |t: &Triangle| (t.vertices[0] + t.vertices[1] + t.vertices[2]) / 3.0;
+    let (lo, hi) = triangles
+        .par_iter()
+        .map(|t| (centroid(t), centroid(t)))
+        .reduce(
+            || (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |a, b| (a.0.min(b.0), a.1.max(b.1)),
+        );
+    let scale = Vec3::splat(1023.0) / (hi - lo).max(Vec3::splat(f32::MIN_POSITIVE));
+    let spread = |x: u32| -> u64 {
+        let mut out = 0u64;
+        for bit in 0..10 {
+            out |= u64::from((x >> bit) & 1) << (3 * bit);
+        }
+        out
+    };
+    let mut keyed: Vec<(u64, u32)> = triangles
+        .par_iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let q = ((centroid(t) - lo) * scale).clamp(Vec3::ZERO, Vec3::splat(1023.0));
+            let code = spread(q.x as u32) | (spread(q.y as u32) << 1) | (spread(q.z as u32) << 2);
+            (code, i as u32)
+        })
+        .collect();
+    keyed.par_sort_unstable();
+    keyed.into_iter().map(|(_, i)| i).collect()
 }

@@ -902,14 +902,26 @@ pub fn material_from_mtl(
     let shininess = scalar(m.shininess, "Ns", |x| x >= 0.0, d.shininess).unwrap_or(d.shininess);
     let ior = scalar(m.optical_density, "Ni", |x| x > 0.0, d.ior).unwrap_or(d.ior);
     let in_unit = |x: f32| (0.0..=1.0).contains(&x);
+    let glass = matches!(m.illumination_model, Some(4 | 6 | 7));
+    let mut tr_opaque = false;
     let dissolve = scalar(m.dissolve, "d", in_unit, 1.0).or_else(|| {
         let tr = m
             .unknown_param
             .get("Tr")
             .and_then(|t| t.trim().parse::<f32>().ok());
-        scalar(tr, "Tr", in_unit, 0.0).map(|tr| 1.0 - tr)
+        // `Tr 1` without `d` on a material that is not glass: MeshLab and others write it
+        // meaning opaque (Tr as opacity); an invisible material is never what is meant.
+        scalar(tr, "Tr", in_unit, 0.0).map(|tr| {
+            tr_opaque = tr == 1.0 && !glass;
+            if tr_opaque { 1.0 } else { 1.0 - tr }
+        })
     });
-    let glass = matches!(m.illumination_model, Some(4 | 6 | 7));
+    if tr_opaque {
+        warnings.push(format!(
+            "{label}: material `{}` has `Tr 1` (fully transparent) but is not glass; taken as opaque, as MeshLab means it.",
+            short(&m.name)
+        ));
+    }
     let mirror = glass || matches!(m.illumination_model, Some(3 | 5));
     let transparency = match dissolve {
         Some(dissolve) => 1.0 - dissolve,
