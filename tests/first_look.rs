@@ -410,9 +410,9 @@ fn a_bust_standing_on_z_is_seen_upright_and_a_y_up_one_keeps_y() {
 }
 
 #[test]
-fn meshlab_tr_1_on_a_material_that_is_not_glass_is_opaque() {
+fn meshlab_tr_1_is_opaque_and_ns_0_no_wash_of_specular() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let mtl = "newmtl material_0\nKa 0.2 0.2 0.2\nKd 1 1 1\nKs 0 0 0\nTr 1.000000\nillum 2\nNs 0\n\nnewmtl glass\nKd 1 1 1\nKs 1 1 1\nTr 1.000000\nillum 4\n";
+    let mtl = "newmtl material_0\nKa 0.2 0.2 0.2\nKd 1 1 1\nKs 1 1 1\nTr 1.000000\nillum 2\nNs 0\n\nnewmtl glass\nKd 1 1 1\nKs 1 1 1\nTr 1.000000\nillum 4\n";
     std::fs::write(dir.path().join("bottle.mtl"), mtl).expect("write");
     let text = "mtllib bottle.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nv 3 0 0\nv 2 1 0\nusemtl material_0\nf 1 2 3\nusemtl glass\nf 4 5 6\n";
     let scene = load(dir.path(), "bottle.obj", text);
@@ -424,6 +424,15 @@ fn meshlab_tr_1_on_a_material_that_is_not_glass_is_opaque() {
             .expect("material")
     };
     assert_eq!(m("/material_0").transparency, Vec3::ZERO);
+    // Its `Ns 0` (exponent 0: all of `Ks` wherever light falls) shows no highlight.
+    assert_eq!(m("/material_0").specular, Vec3::ZERO);
+    assert_eq!(m("/glass").specular, Vec3::ONE, "no `Ns`: kept");
+    assert!(
+        scene
+            .warnings
+            .iter()
+            .any(|w| w.contains("`Ns 0` in `material_0`"))
+    );
     assert_eq!(m("/glass").transparency, Vec3::ONE, "glass keeps `Tr 1`");
     assert!(
         scene
