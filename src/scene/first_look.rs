@@ -261,6 +261,7 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
     };
     let extent = |axis: Vec3| (half * axis).length();
     let dirs = directions(PROBE_DIRS);
+    let curve = morton_order(triangles);
     // Probe points: the centre, and halfway to each horizontal wall (the middle of a room is
     // often a table or a bed).
     let mut points = vec![center];
@@ -269,7 +270,7 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
             points.push(center + axis * (sign * 0.5 * extent(axis)));
         }
     }
-    let probes = probe_points(triangles, &points, &dirs);
+    let probes = probe_points(triangles, &curve, &points, &dirs);
     let room_probe = probes.iter().find(|p| p.in_room());
     let Some(room_probe) = room_probe else {
         return FirstView {
@@ -330,7 +331,7 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
         .collect();
     let mut points: Vec<Vec3> = candidates.iter().map(|c| c.0).collect();
     points.extend(&lights);
-    let free = probe_points(triangles, &points, &dirs);
+    let free = probe_points(triangles, &curve, &points, &dirs);
     let light = lights
         .iter()
         .zip(&free[candidates.len()..])
@@ -349,7 +350,7 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
         };
     }
     let views: Vec<(Vec3, Vec3)> = candidates.clone();
-    let ahead = nearest(triangles, &views);
+    let ahead = nearest(triangles, &curve, &views);
     // The first free candidate that sees a quarter of the room ahead, else the free one that
     // sees farthest.
     let usable = candidates.iter().zip(&free).zip(&ahead);
@@ -436,12 +437,17 @@ fn directions(n: usize) -> Vec<Vec3> {
 }
 
 /// Rays from each of `points` in each of `dirs`: what each point's rays met first.
-fn probe_points(triangles: &[Triangle], points: &[Vec3], dirs: &[Vec3]) -> Vec<Probe> {
+fn probe_points(
+    triangles: &[Triangle],
+    order: &[u32],
+    points: &[Vec3],
+    dirs: &[Vec3],
+) -> Vec<Probe> {
     let rays: Vec<(Vec3, Vec3)> = points
         .iter()
         .flat_map(|&p| dirs.iter().map(move |&d| (p, d)))
         .collect();
-    nearest(triangles, &rays)
+    nearest(triangles, order, &rays)
         .chunks(dirs.len())
         .map(|per_point| {
             let mut probe = Probe::default();
@@ -462,13 +468,12 @@ fn probe_points(triangles: &[Triangle], points: &[Vec3], dirs: &[Vec3]) -> Vec<P
 
 /// For each ray (origin, unit direction): the distance to the first triangle it meets
 /// (infinite when none) and whether that triangle faces the origin. Brute force in parallel
-/// over runs of 64 triangles sorted along a Morton curve, each run skipped as a whole when the
+/// over runs of 64 triangles in `order` (a Morton curve), each run skipped as a whole when the
 /// ray misses its box: a million triangles cost tens of milliseconds.
-fn nearest(triangles: &[Triangle], rays: &[(Vec3, Vec3)]) -> Vec<(f32, bool)> {
+fn nearest(triangles: &[Triangle], order: &[u32], rays: &[(Vec3, Vec3)]) -> Vec<(f32, bool)> {
     use rayon::prelude::*;
     const RUN: usize = 64;
     let rays: Vec<(Vec3, Vec3, Vec3)> = rays.iter().map(|&(o, d)| (o, d, d.recip())).collect();
-    let order = morton_order(triangles);
     let none = || vec![(f32::INFINITY, false); rays.len()];
     order
         .par_chunks(RUN)
@@ -531,22 +536,24 @@ fn morton_order(triangles: &[Triangle]) -> Vec<u32> {
             |a, b| (a.0.min(b.0), a.1.max(b.1)),
         );
     let scale = Vec3::splat(1023.0) / (hi - lo).max(Vec3::splat(f32::MIN_POSITIVE));
+    // Two zero bits after each of the 10 bits of `x`.
     let spread = |x: u32| -> u64 {
-        let mut out = 0u64;
-        for bit in 0..10 {
-            out |= u64::from((x >> bit) & 1) << (3 * bit);
-        }
-        out
+        let mut x = u64::from(x & 0x3ff);
+        x = (x | (x << 16)) & 0x0300_00ff;
+        x = (x | (x << 8)) & 0x0300_f00f;
+        x = (x | (x << 4)) & 0x030c_30c3;
+        (x | (x << 2)) & 0x0924_9249
     };
-    let mut keyed: Vec<(u64, u32)> = triangles
+    // The code in the high bits, the index in the low 32: one u64 to sort.
+    let mut keyed: Vec<u64> = triangles
         .par_iter()
         .enumerate()
         .map(|(i, t)| {
             let q = ((centroid(t) - lo) * scale).clamp(Vec3::ZERO, Vec3::splat(1023.0));
             let code = spread(q.x as u32) | (spread(q.y as u32) << 1) | (spread(q.z as u32) << 2);
-            (code, i as u32)
+            (code << 32) | i as u64
         })
         .collect();
     keyed.par_sort_unstable();
-    keyed.into_iter().map(|(_, i)| i).collect()
+    keyed.into_iter().map(|k| k as u32).collect()
 }
