@@ -561,13 +561,13 @@ fn huge_texture_headers_are_refused_before_decoding() {
             format!(
                 "warning: {label}: material `png` (`huge.mtl` line 2): cannot use the texture \
                  `huge_header.png` of `map_Kd` (its 100000x100000 texels would need about \
-                 149.0 GiB, more than the memory limit of 512.0 MiB (set by \
+                 167.6 GiB, more than the memory limit of 512.0 MiB (set by \
                  RAYTREE_MEMORY_LIMIT=512)); its flat colour stays."
             ),
             format!(
                 "warning: {label}: material `jpg` (`huge.mtl` line 4): cannot use the texture \
                  `huge_header.jpg` of `map_Kd` (its 65535x65535 texels would need about \
-                 64.0 GiB, more than the memory limit of 512.0 MiB (set by \
+                 72.0 GiB, more than the memory limit of 512.0 MiB (set by \
                  RAYTREE_MEMORY_LIMIT=512)); its flat colour stays."
             ),
         ]
