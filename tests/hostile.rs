@@ -9,6 +9,7 @@
 //! `INSTA_UPDATE=always cargo test --release --test hostile`
 
 mod hostile_support;
+mod obj_compare;
 
 use std::path::{Path, PathBuf};
 use std::process::Output;
@@ -640,5 +641,58 @@ fn a_fifo_anywhere_is_refused_without_a_hang() {
     assert_eq!(
         e.to_string(),
         format!("{shown}: cannot read the scene file: {not_regular}.")
+    );
+}
+
+/// The corpus's OBJs with hostile normals and texture coordinates go through raytree's fast OBJ
+/// reader as well as through tobj, and both read them alike (bit for bit, or the fast reader
+/// leaves the file to tobj, which then gives the sentence): the checks of `vn`, `vt` and face
+/// corners behind the readers see the same data whichever read it.
+#[test]
+fn the_fast_reader_and_tobj_read_the_hostile_models_alike() {
+    let mtl = |p: &Path| -> tobj::MTLLoadResult {
+        let path = Path::new(CORPUS).join(p);
+        match std::fs::metadata(&path) {
+            Ok(m) if m.is_file() => {
+                let text =
+                    std::fs::read_to_string(path).map_err(|_| tobj::LoadError::OpenFileFailed)?;
+                tobj::load_mtl_buf(&mut text.as_bytes())
+            }
+            _ => Err(tobj::LoadError::OpenFileFailed),
+        }
+    };
+    let mut taken = Vec::new();
+    for path in corpus() {
+        let name = path
+            .file_name()
+            .expect("name")
+            .to_string_lossy()
+            .to_string();
+        let is_model =
+            name.starts_with("vn_") || name.starts_with("vt_") || name == "textures_hostile.obj";
+        if !is_model {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).expect("a text OBJ");
+        if obj_compare::check(&text, &mtl) {
+            taken.push(name);
+        }
+    }
+    // Files with valid indices are read by the fast reader; those with indices of 0, negative
+    // or out of range are left to tobj.
+    assert_eq!(
+        taken,
+        [
+            "textures_hostile.obj",
+            "vn_inf.obj",
+            "vn_nan.obj",
+            "vn_on_some_corners.obj",
+            "vn_on_some_faces.obj",
+            "vn_opposite.obj",
+            "vn_zero.obj",
+            "vt_nan.obj",
+            "vt_on_some_corners.obj",
+            "vt_on_some_faces.obj",
+        ]
     );
 }

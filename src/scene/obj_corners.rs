@@ -170,8 +170,8 @@ fn read_line<'a>(
             if all(0) {
                 flags |= ALL_UVS;
             }
-            for list in 0..2 {
-                part.partial[list] += usize::from(given[list] > 0 && given[list] < corners);
+            for (partial, given) in part.partial.iter_mut().zip(given) {
+                *partial += usize::from(given > 0 && given < corners);
             }
             let triangles = if corners >= 4 { corners - 2 } else { 1 };
             part.triangles.extend(std::iter::repeat_n(
