@@ -5,8 +5,14 @@
 //!   numbers replaced by huge, tiny, NaN and infinite ones, values swapped between keys, lines
 //!   inserted with random keys and values, deleted, duplicated);
 //! - OBJ and MTL text, generated line by line (faces of 0 to 8 corners, indices out of range,
-//!   zero, negative or huge, NaN and infinite coordinates, `w` and colour columns, garbage),
-//!   loaded both as a `[[mesh]]` of a scene and as a bare `.obj`;
+//!   zero, negative or huge, NaN and infinite coordinates, `w` and colour columns, garbage;
+//!   `vn` and `vt` that are NaN, infinite, zero or tiny, and faces that give them at every
+//!   corner, some or none, with their indices out of range, zero or negative; `map_Kd` and
+//!   `map_Ka` naming good, truncated, huge-headed, empty, missing and device textures; the
+//!   `[[mesh]]` keys `normals` and `crease_angle` with hostile values), loaded both as a
+//!   `[[mesh]]` of a scene and as a bare `.obj`;
+//! - texture files: PNG and JPEG bytes mutated (bytes flipped, cut short, header sizes
+//!   patched), decoded against a small memory budget;
 //! - command lines of the real `raytree` binary (a bounded number of processes).
 //!
 //! The property: nothing panics (a panic caught inside the loader counts as a failure too);
@@ -31,13 +37,16 @@ use std::time::{Duration, Instant};
 use hostile_support::{check_invariants, is_one_line, render_tiny};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
+use raytree::scene::budget::MemoryLimit;
 use raytree::scene::builtin::{NAMES, scene_text};
-use raytree::scene::{load_scene_file, load_scene_str_with};
+use raytree::scene::texture::decode_texture;
+use raytree::scene::{load_scene_file, load_scene_str_with, load_scene_str_with_files};
 
 /// Cases per target in the short run.
 const SHORT_TOML_CASES: u32 = 20000;
 const SHORT_OBJ_CASES: u32 = 20000;
 const SHORT_CLI_CASES: u32 = 200;
+const SHORT_TEXTURE_CASES: u32 = 3000;
 
 fn cases(short: u32, scale: u32) -> u32 {
     std::env::var("RAYTREE_FUZZ_CASES")
@@ -180,6 +189,10 @@ const VALUES: &[&str] = &[
     "\"\"",
     "\" \"",
     "\"phong\"",
+    "\"smooth\"",
+    "\"flat\"",
+    "\"file\"",
+    "\"bogus\"",
     "\"blinn-phong\"",
     "\"m.obj\"",
     "\"M.OBJ\"",
@@ -224,6 +237,8 @@ const KEYS: &[&str] = &[
     "translate",
     "rotate",
     "scale",
+    "normals",
+    "crease_angle",
     "radus",
     "colour",
     "x",
@@ -517,11 +532,43 @@ fn mtl_line() -> impl Strategy<Value = String> {
             .prop_map(|(k, v)| format!("{k} {}", v.join(" "))),
         3 => (scalar_key, c()).prop_map(|(k, v)| format!("{k} {v}")),
         1 => (0..12i32).prop_map(|i| format!("illum {i}")),
-        1 => proptest::sample::select(&["map_Kd", "map_Kd tex.png", "bump", "# c", ""][..])
+        2 => (proptest::sample::select(&["map_Kd", "map_Ka"][..]), proptest::sample::select(TEXTURE_NAMES))
+            .prop_map(|(k, t)| format!("{k} {t}")),
+        1 => proptest::sample::select(&["map_Kd", "map_Kd -s 1 1 1 good.png", "bump", "# c", ""][..])
             .prop_map(str::to_string),
         1 => proptest::collection::vec(any::<u8>(), 0..24)
             .prop_map(|b| String::from_utf8_lossy(&b).replace(['\n', '\r'], " ")),
     ]
+}
+
+/// The textures an MTL of the OBJ target may name (files of the hostile corpus, written next
+/// to the OBJ), and names that are missing, a folder or a device.
+const TEXTURE_NAMES: &[&str] = &[
+    "good.png",
+    "good.png",
+    "truncated.png",
+    "truncated.jpg",
+    "huge_header.png",
+    "huge_header.jpg",
+    "zero_size.png",
+    "empty.png",
+    "not_an_image.png",
+    "missing.png",
+    "folder.png",
+    "/dev/zero",
+    "m.obj",
+];
+
+/// The texture files of the hostile corpus, by the names of [`TEXTURE_NAMES`].
+fn texture_files() -> HashMap<String, Vec<u8>> {
+    let corpus = Path::new("tests/fixtures/hostile/textures");
+    TEXTURE_NAMES
+        .iter()
+        .filter_map(|name| {
+            let bytes = std::fs::read(corpus.join(name)).ok()?;
+            Some((name.to_string(), bytes))
+        })
+        .collect()
 }
 
 #[derive(Clone, Debug)]
@@ -546,6 +593,15 @@ fn mesh_case() -> impl Strategy<Value = MeshCase> {
             "scale = 3e38\n",
             "translate = [3e38, 0, 0]\n",
             "material = \"default\"\n",
+            "normals = \"smooth\"\n",
+            "normals = \"smooth\"\ncrease_angle = 0\n",
+            "normals = \"smooth\"\ncrease_angle = 180\n",
+            "normals = \"flat\"\n",
+            "normals = \"file\"\nscale = [1, -1, 1e-20]\n",
+            "normals = \"bogus\"\n",
+            "crease_angle = nan\n",
+            "crease_angle = -1\n",
+            "normals = \"smooth\"\ncrease_angle = 1e39\n",
         ][..],
     );
     let mostly_numbers = || {
@@ -557,17 +613,50 @@ fn mesh_case() -> impl Strategy<Value = MeshCase> {
     };
     let vertex = (mostly_numbers(), mostly_numbers(), mostly_numbers())
         .prop_map(|(x, y, z)| format!("v {x} {y} {z}"));
-    // Faces index the vertices there are, mostly: `n` is known when the faces are drawn.
-    let faces = |n: i64| {
-        let index = prop_oneof![
-            10 => (1..=n).prop_map(|i| i.to_string()),
-            2 => (-n..0).prop_map(|i| i.to_string()),
-            1 => corner(),
-        ];
-        proptest::collection::vec(
-            proptest::collection::vec(index, 1..8).prop_map(|c| format!("f {}", c.join(" "))),
-            0..16,
+    // Normals and texture coordinates: mostly usable, some NaN, infinite, zero or tiny.
+    let hostile_number = || {
+        prop_oneof![
+            8 => mostly_numbers(),
+            1 => proptest::sample::select(&["nan", "inf", "-inf", "0", "1e-45", "3e38"][..])
+                .prop_map(str::to_string),
+        ]
+    };
+    let normal = (hostile_number(), hostile_number(), hostile_number())
+        .prop_map(|(x, y, z)| format!("vn {x} {y} {z}"));
+    let uv = (hostile_number(), hostile_number()).prop_map(|(u, v)| format!("vt {u} {v}"));
+    // Faces index the vertices, normals and texture coordinates there are, mostly (the counts
+    // are known when the faces are drawn); a corner names a `vt`, a `vn`, both or neither.
+    let faces = |n: i64, normals: i64, uvs: i64| {
+        let index = |n: i64| {
+            // Rarely out of range: one such index refuses the whole file, and most files
+            // should get past the reader to the checks behind it.
+            prop_oneof![
+                150 => (1..=n.max(1)).prop_map(|i| i.to_string()),
+                25 => (-n.max(1)..0).prop_map(|i| i.to_string()),
+                1 => proptest::sample::select(&["0", "-99", "99"][..]).prop_map(str::to_string),
+                1 => corner(),
+            ]
+        };
+        let form = |(v, t, m): (String, String, String), form: u8| match form {
+            0 | 1 => v,
+            2 => format!("{v}/{t}"),
+            3 => format!("{v}//{m}"),
+            _ => format!("{v}/{t}/{m}"),
+        };
+        // Most faces use one form at every corner; some mix them.
+        let face = (
+            proptest::collection::vec((index(n), index(uvs), index(normals), 0..6u8), 1..8),
+            0..6u8,
+            proptest::bool::weighted(0.2),
         )
+            .prop_map(move |(corners, face_form, mixed)| {
+                let corners: Vec<String> = corners
+                    .into_iter()
+                    .map(|(v, t, m, f)| form((v, t, m), if mixed { f } else { face_form }))
+                    .collect();
+                format!("f {}", corners.join(" "))
+            });
+        proptest::collection::vec(face, 0..16)
     };
     let colour = (
         proptest::sample::select(&["Ka", "Kd", "Ks"][..]),
@@ -576,34 +665,49 @@ fn mesh_case() -> impl Strategy<Value = MeshCase> {
         mostly_numbers(),
     )
         .prop_map(|(k, r, g, b)| format!("{k} {r} {g} {b}"));
-    let geometry = (1i64..12).prop_flat_map(move |n| {
+    let geometry = (1i64..12, 0i64..6, 0i64..6).prop_flat_map(move |(n, normals, uvs)| {
         (
             proptest::collection::vec(vertex.clone(), n as usize),
-            faces(n),
+            proptest::collection::vec(normal.clone(), normals as usize),
+            proptest::collection::vec(uv.clone(), uvs as usize),
+            faces(n, normals, uvs),
         )
     });
     (
         geometry,
         proptest::collection::vec((any::<usize>(), obj_line()), 0..2),
         proptest::collection::vec(colour, 0..4),
-        proptest::collection::vec(mtl_line(), 0..3),
+        (
+            proptest::collection::vec(mtl_line(), 0..3),
+            proptest::option::of(proptest::sample::select(TEXTURE_NAMES)),
+        ),
         any::<bool>(),
         placement,
     )
         .prop_map(
-            |((vertices, faces), hostile, colours, mtl_extra, use_mtl, placement)| {
+            |(
+                (vertices, normals, uvs, faces),
+                hostile,
+                colours,
+                (mtl_extra, texture),
+                use_mtl,
+                placement,
+            )| {
                 let mut obj = Vec::new();
                 if use_mtl {
                     obj.push("mtllib m.mtl".to_string());
                     obj.push("usemtl red".to_string());
                 }
                 obj.extend(vertices);
+                obj.extend(normals);
+                obj.extend(uvs);
                 obj.extend(faces);
                 for (at, line) in hostile {
                     obj.insert(at % (obj.len() + 1), line);
                 }
                 let mut mtl = vec!["newmtl red".to_string()];
                 mtl.extend(colours);
+                mtl.extend(texture.map(|t| format!("map_Kd {t}")));
                 mtl.extend(mtl_extra);
                 MeshCase {
                     obj: obj.join("\n") + "\n",
@@ -626,7 +730,25 @@ fn fuzz_obj_and_mtl() {
     .expect("temp dir");
     let obj_path = dir.path().join("m.obj");
     let obj_file = obj_path.display().to_string();
+    let textures = texture_files();
+    assert!(
+        textures.len() >= 8,
+        "the corpus textures: {:?}",
+        textures.keys()
+    );
+    for (name, bytes) in &textures {
+        std::fs::write(dir.path().join(name), bytes).expect("write texture");
+    }
+    std::fs::create_dir(dir.path().join("folder.png")).expect("a folder named like a texture");
+    let resolve_bytes = |path: &str| {
+        textures
+            .get(path)
+            .cloned()
+            .ok_or_else(|| format!("{path}: no such file"))
+    };
     let (as_mesh, bare) = (AtomicU32::new(0), AtomicU32::new(0));
+    // Loaded scenes that kept normals or texture coordinates, and that have a texture.
+    let (with_attributes, textured) = (AtomicU32::new(0), AtomicU32::new(0));
     run(
         "OBJ and MTL",
         cases(SHORT_OBJ_CASES, 1),
@@ -640,20 +762,28 @@ fn fuzz_obj_and_mtl() {
                 other => Err(format!("{other}: no such file")),
             };
             let toml = format!("[[mesh]]\nfile = \"m.obj\"\n{}", case.placement);
-            match load_scene_str_with(&toml, "fuzz.toml", &resolve) {
+            match load_scene_str_with_files(&toml, "fuzz.toml", &resolve, &resolve_bytes) {
                 Err(e) => {
                     let e = e.to_string();
                     check_toml_error(&e, "fuzz.toml");
                     let rest = e
                         .strip_prefix("fuzz.toml:2:8: mesh 1 field `file` cannot be loaded: m.obj");
-                    let placement = e.starts_with("fuzz.toml:3:");
+                    // The placement and normals keys are on lines 3 and 4.
+                    let placement = e.starts_with("fuzz.toml:3:") || e.starts_with("fuzz.toml:4:");
                     assert!(rest.is_some() || placement, "{e}");
                 }
                 Ok(scene) => {
                     if let Err(rule) = check_invariants(&scene) {
                         panic!("loaded, but breaks the rule: {rule}");
                     }
+                    check_warnings(&scene.warnings);
                     render_tiny(&scene);
+                    if !scene.attributes.is_empty() {
+                        with_attributes.fetch_add(1, Ordering::Relaxed);
+                    }
+                    if !scene.textures.is_empty() {
+                        textured.fetch_add(1, Ordering::Relaxed);
+                    }
                     if !scene.triangles.is_empty() {
                         as_mesh.fetch_add(1, Ordering::Relaxed);
                     }
@@ -674,6 +804,7 @@ fn fuzz_obj_and_mtl() {
                     if let Err(rule) = check_invariants(&scene) {
                         panic!("loaded, but breaks the rule: {rule}");
                     }
+                    check_warnings(&scene.warnings);
                     render_tiny(&scene);
                     bare.fetch_add(1, Ordering::Relaxed);
                 }
@@ -681,10 +812,27 @@ fn fuzz_obj_and_mtl() {
         },
     );
     eprintln!(
-        "  {} loaded with triangles as a mesh, {} as a bare OBJ",
-        as_mesh.into_inner(),
+        "  {} loaded with triangles as a mesh ({} with normals or texture coordinates, {} \
+         textured), {} as a bare OBJ",
+        as_mesh.load(Ordering::Relaxed),
+        with_attributes.load(Ordering::Relaxed),
+        textured.load(Ordering::Relaxed),
         bare.into_inner()
     );
+    // The cases reach the normals and textures, not only the reader's refusals.
+    let n = cases(SHORT_OBJ_CASES, 1);
+    assert!(
+        with_attributes.into_inner() > n / 50 && textured.into_inner() > n / 400,
+        "too few cases reach normals and textures"
+    );
+}
+
+/// Warnings are sentences, and none says a panic was caught in a reader or decoder.
+fn check_warnings(warnings: &[String]) {
+    for w in warnings {
+        assert!(is_one_line(w) && w.ends_with('.'), "{w:?}");
+        assert!(!w.contains("reader failed"), "a caught panic: {w}");
+    }
 }
 
 /// raytree's parallel OBJ reader against tobj on the same random OBJs (well-formed meshes with
@@ -760,6 +908,131 @@ fn fuzz_fast_obj_reader_equals_tobj() {
         taken > cases(SHORT_OBJ_CASES / 2, 1) / 4,
         "the fast path is exercised"
     );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Texture files.
+
+#[derive(Clone, Debug)]
+enum ByteEdit {
+    Flip(usize, u8),
+    Truncate(usize),
+    /// A 32-bit big-endian number (PNG's width and height) written at a byte.
+    Word(usize, u32),
+    /// A 16-bit big-endian number (JPEG's sizes and segment lengths) written at a byte.
+    Half(usize, u16),
+    Insert(usize, Vec<u8>),
+}
+
+fn byte_edit() -> impl Strategy<Value = ByteEdit> {
+    let near_the_start = 0..64usize;
+    prop_oneof![
+        4 => (any::<usize>(), any::<u8>()).prop_map(|(a, b)| ByteEdit::Flip(a, b)),
+        2 => (near_the_start.clone(), any::<u8>()).prop_map(|(a, b)| ByteEdit::Flip(a, b)),
+        2 => any::<usize>().prop_map(ByteEdit::Truncate),
+        2 => (
+            near_the_start.clone(),
+            prop_oneof![Just(0u32), Just(1), Just(65535), Just(100_000), Just(u32::MAX), any::<u32>()],
+        )
+            .prop_map(|(a, w)| ByteEdit::Word(a, w)),
+        2 => (any::<usize>(), prop_oneof![Just(0u16), Just(1), Just(65535), any::<u16>()])
+            .prop_map(|(a, h)| ByteEdit::Half(a, h)),
+        1 => (any::<usize>(), proptest::collection::vec(any::<u8>(), 1..16))
+            .prop_map(|(a, b)| ByteEdit::Insert(a, b)),
+    ]
+}
+
+fn edit_bytes(mut bytes: Vec<u8>, edits: &[ByteEdit]) -> Vec<u8> {
+    for e in edits {
+        let n = bytes.len();
+        match e {
+            ByteEdit::Flip(at, b) if n > 0 => bytes[at % n] = *b,
+            ByteEdit::Truncate(at) => bytes.truncate(at % (n + 1)),
+            ByteEdit::Word(at, w) if n >= 4 => {
+                let at = at % (n - 3);
+                bytes[at..at + 4].copy_from_slice(&w.to_be_bytes());
+            }
+            ByteEdit::Half(at, h) if n >= 2 => {
+                let at = at % (n - 1);
+                bytes[at..at + 2].copy_from_slice(&h.to_be_bytes());
+            }
+            ByteEdit::Insert(at, b) => {
+                let at = at % (n + 1);
+                bytes.splice(at..at, b.iter().copied());
+            }
+            _ => {}
+        }
+    }
+    bytes
+}
+
+/// PNG and JPEG files (the corpus's good, truncated and huge-headed ones, and larger ones made
+/// here) with bytes flipped, cut, inserted and sizes patched, decoded against a 64 MiB budget:
+/// never a panic; a texture has the texels its size says, all finite in [0, 1]; a refusal is
+/// one phrase.
+#[test]
+fn fuzz_textures() {
+    let corpus = Path::new("tests/fixtures/hostile/textures");
+    let mut seeds: Vec<Vec<u8>> = [
+        "good.png",
+        "truncated.png",
+        "truncated.jpg",
+        "huge_header.png",
+        "huge_header.jpg",
+    ]
+    .iter()
+    .map(|n| std::fs::read(corpus.join(n)).expect("a corpus texture"))
+    .collect();
+    let gradient = image::RgbaImage::from_fn(24, 16, |x, y| {
+        image::Rgba([x as u8 * 10, y as u8 * 15, 99, 200])
+    });
+    for format in [image::ImageFormat::Png, image::ImageFormat::Jpeg] {
+        let mut bytes = Vec::new();
+        let img = image::DynamicImage::ImageRgba8(gradient.clone());
+        let img = if format == image::ImageFormat::Jpeg {
+            image::DynamicImage::ImageRgb8(img.to_rgb8())
+        } else {
+            img
+        };
+        img.write_to(&mut std::io::Cursor::new(&mut bytes), format)
+            .expect("encodes");
+        seeds.push(bytes);
+    }
+    let limit = MemoryLimit {
+        bytes: 64 << 20,
+        source: "the fuzz target".into(),
+    };
+    let decoded = AtomicU32::new(0);
+    let strategy = (0..seeds.len(), proptest::collection::vec(byte_edit(), 0..4));
+    run(
+        "textures",
+        cases(SHORT_TEXTURE_CASES, 10),
+        5,
+        strategy,
+        |(seed, edits)| {
+            let bytes = edit_bytes(seeds[seed].clone(), &edits);
+            match decode_texture("t", &bytes, &limit) {
+                Ok(t) => {
+                    assert_eq!(
+                        t.texels.len() as u64,
+                        u64::from(t.width) * u64::from(t.height)
+                    );
+                    assert!(t.width > 0 && t.height > 0);
+                    assert!(
+                        t.texels
+                            .iter()
+                            .flatten()
+                            .all(|c| c.is_finite() && (0.0..=1.0).contains(c))
+                    );
+                    decoded.fetch_add(1, Ordering::Relaxed);
+                }
+                Err(phrase) => assert!(is_one_line(&phrase), "{phrase:?}"),
+            }
+        },
+    );
+    let decoded = decoded.into_inner();
+    eprintln!("  {decoded} of the mutated textures decoded");
+    assert!(decoded > 0, "some mutated textures still decode");
 }
 
 // ---------------------------------------------------------------------------------------------

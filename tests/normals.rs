@@ -268,3 +268,99 @@ fn built_in_textures_are_read_from_the_binary() {
         "the faceted copy has no normals"
     );
 }
+
+/// Faces that give `vn` (`vt`) at some corners or none, in a file whose other faces give them:
+/// flat (untextured), not shaded with a neighbour's normal as the OBJ reader fills them in;
+/// a face that gives them at some corners only is named in one warning. An index of 0, or a
+/// relative one before the first entry, is refused with its line like any index out of range.
+#[test]
+fn faces_without_normals_at_every_corner_are_flat() {
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\n\
+vn 0.3 0 1\nvn 0 0.3 1\n\
+f 1//1 2//2 3//1\nf 2 4 3\nf 2//1 5 4//2\nf 1//2 2//2 3//2 4//1\n";
+    let list: &'static [(&str, &str)] = Box::leak(Box::new([("m.obj", obj)]));
+    let scene = load("[[mesh]]\nfile = \"m.obj\"\n", list);
+    assert_eq!(scene.triangles.len(), 5);
+    let a = &scene.attributes[0];
+    let has: Vec<bool> = (0..5).map(|i| a.normals_of(i).is_some()).collect();
+    // The quad's two triangles keep their normals; the face without and the one with `vn` at
+    // two corners of three are flat.
+    assert_eq!(has, [true, false, false, true, true]);
+    assert_eq!(
+        scene.warnings,
+        ["m.obj: 1 face gives normals (`vn`) at some corners only; they are shaded flat."]
+    );
+    // The same under `normals = "flat"` and `"smooth"`: no warning about the file's `vn`.
+    for mode in ["flat", "smooth"] {
+        let s = load(
+            &format!("[[mesh]]\nfile = \"m.obj\"\nnormals = \"{mode}\"\n"),
+            list,
+        );
+        assert!(s.warnings.is_empty(), "{mode}: {:?}", s.warnings);
+    }
+
+    for (what, face, line) in [
+        (
+            "vn zero",
+            "f 1//1 2//0 3//1",
+            "face normal index out of bounds",
+        ),
+        (
+            "vn before the first",
+            "f 1//-3 2//1 3//1",
+            "face normal index out of bounds",
+        ),
+        (
+            "vt zero",
+            "f 1/0 2/1 3/1",
+            "face texcoord index out of bounds",
+        ),
+        (
+            "vt before the first",
+            "f 1/1 2/-2 3/1",
+            "face texcoord index out of bounds",
+        ),
+    ] {
+        let text = format!("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 0 1\nvt 0 0\n{face}\n");
+        let list: &'static [(&str, &str)] = Box::leak(Box::new([("z.obj", &*text.leak())]));
+        let e = load_scene_str_with("[[mesh]]\nfile = \"z.obj\"\n", "t.toml", &files(list))
+            .expect_err(what)
+            .to_string();
+        assert_eq!(
+            e,
+            format!("t.toml:2:8: mesh 1 field `file` cannot be loaded: z.obj:7: {line}."),
+            "{what}"
+        );
+    }
+}
+
+/// The same for texture coordinates: a textured face without `vt` at every corner shows the
+/// flat colour, not a neighbour's texel.
+#[test]
+fn faces_without_texture_coordinates_at_every_corner_are_untextured() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    std::fs::write(
+        dir.path().join("t.mtl"),
+        "newmtl t\nKd 1 1 1\nmap_Kd red.png\n",
+    )
+    .expect("mtl");
+    std::fs::write(dir.path().join("red.png"), png_bytes(1, 1, &[255, 0, 0])).expect("png");
+    std::fs::write(
+        dir.path().join("m.obj"),
+        "mtllib t.mtl\nusemtl t\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n\
+vt 0 0\nvt 1 0\nvt 0 1\n\
+f 1/1 2/2 3/3\nf 2 4 3\nf 2/2 4 3/3\n",
+    )
+    .expect("obj");
+    let scene = load_scene_file(&dir.path().join("m.obj")).unwrap_or_else(|e| panic!("{e}"));
+    let a = &scene.attributes[0];
+    let has: Vec<bool> = (0..3).map(|i| a.uvs_of(i).is_some()).collect();
+    assert_eq!(has, [true, false, false]);
+    let label = dir.path().join("m.obj").display().to_string();
+    assert_eq!(
+        scene.warnings,
+        [format!(
+            "{label}: 1 face gives texture coordinates (`vt`) at some corners only; they are not textured."
+        )]
+    );
+}

@@ -1,7 +1,9 @@
 //! One validation: the rules the viewer holds its edits to (`scene::rules::check_scene`) are
 //! the rules the loader holds files to. Property test (proptest, seeded, deterministic): any
 //! edit the viewer accepts saves a scene that loads back equal; any edit it refuses saves a
-//! scene the loader refuses too, naming the same field.
+//! scene the loader refuses too, naming the same field. The edits reach every field a scene
+//! file has: render, camera, each light's name, position, colour and radius, materials,
+//! spheres, and each mesh's `normals` and `crease_angle`.
 
 use std::cell::Cell;
 
@@ -9,7 +11,7 @@ use glam::Vec3;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use raytree::scene::builtin::{self, NAMES, load_builtin};
-use raytree::scene::{Light, Scene, rules, scene_to_toml};
+use raytree::scene::{Light, NormalsMode, ObjectSource, Scene, rules, scene_to_toml};
 
 /// Numbers an edit may bring: ordinary ones, the edges of every rule, and hostile ones.
 const NUMBERS: &[f32] = &[
@@ -63,7 +65,27 @@ enum Edit {
     MaterialScalar(usize, usize, f32),
     Sphere(usize, usize, f32),
     SphereRadius(usize, f32),
+    LightName(usize, usize),
+    MeshNormals(usize, usize),
+    CreaseAngle(usize, f32),
 }
+
+/// Names a light may be given: unusual ones (escaping, blanks, another light's name), so that
+/// saving quotes them right and a repeated name is refused by both sides.
+const NAMES_FOR_LIGHTS: &[&str] = &[
+    "",
+    " ",
+    "a \"quoted\" name",
+    "back\\slash",
+    "line\nbreak",
+    "tab\there",
+    "ünïcödé ☀",
+    "[[light]]",
+    "# not a comment",
+    "key",
+    "light 1",
+    "added 2",
+];
 
 fn number() -> impl Strategy<Value = f32> {
     prop_oneof![
@@ -87,6 +109,9 @@ fn edit() -> impl Strategy<Value = Edit> {
         (0..8usize, 0..2usize, number()).prop_map(|(i, f, x)| Edit::MaterialScalar(i, f, x)),
         (0..8usize, 0..3usize, number()).prop_map(|(i, c, x)| Edit::Sphere(i, c, x)),
         (0..8usize, number()).prop_map(|(i, x)| Edit::SphereRadius(i, x)),
+        (0..4usize, 0..NAMES_FOR_LIGHTS.len()).prop_map(|(i, n)| Edit::LightName(i, n)),
+        (0..4usize, 0..3usize).prop_map(|(i, m)| Edit::MeshNormals(i, m)),
+        (0..4usize, number()).prop_map(|(i, x)| Edit::CreaseAngle(i, x)),
     ]
 }
 
@@ -164,7 +189,38 @@ fn apply(scene: &mut Scene, e: &Edit) {
                 s.radius = x;
             }
         }
+        Edit::LightName(i, name) => {
+            let n = scene.lights.len();
+            if let Some(l) = scene.lights.get_mut(i % n.max(1)) {
+                l.name = NAMES_FOR_LIGHTS[name].to_string();
+            }
+        }
+        Edit::MeshNormals(i, mode) => {
+            if let Some(ObjectSource::Mesh { normals, .. }) = mesh(scene, i) {
+                *normals = [NormalsMode::File, NormalsMode::Flat, NormalsMode::Smooth][mode];
+            }
+        }
+        Edit::CreaseAngle(i, x) => {
+            if let Some(ObjectSource::Mesh {
+                crease_angle_deg, ..
+            }) = mesh(scene, i)
+            {
+                *crease_angle_deg = x;
+            }
+        }
     }
+}
+
+/// The source of the `i`-th mesh object (modulo their number), if the scene has meshes.
+fn mesh(scene: &mut Scene, i: usize) -> Option<&mut ObjectSource> {
+    let mut meshes: Vec<&mut ObjectSource> = scene
+        .objects
+        .iter_mut()
+        .map(|o| &mut o.source)
+        .filter(|s| matches!(s, ObjectSource::Mesh { .. }))
+        .collect();
+    let n = meshes.len();
+    (n > 0).then(|| meshes.swap_remove(i % n))
 }
 
 fn runner(cases: u32) -> TestRunner {
@@ -184,6 +240,9 @@ fn an_edit_the_viewer_accepts_saves_a_scene_that_loads_and_a_refused_one_does_no
         .collect();
     let accepted = Cell::new(0u32);
     let refused = Cell::new(0u32);
+    // Cases whose edits changed a mesh's `normals` or `crease_angle`, or a light's name.
+    let sources_accepted = Cell::new(0u32);
+    let sources_refused = Cell::new(0u32);
     let strategy = (0..bases.len(), proptest::collection::vec(edit(), 1..5));
     runner(3000)
         .run(&strategy, |(which, edits)| {
@@ -199,9 +258,16 @@ fn an_edit_the_viewer_accepts_saves_a_scene_that_loads_and_a_refused_one_does_no
                 &builtin::resolve,
                 &builtin::resolve_bytes,
             );
+            let changed = scene.objects != base.objects
+                || scene
+                    .lights
+                    .iter()
+                    .zip(&base.lights)
+                    .any(|(a, b)| a.name != b.name);
             match rules::check_scene(&scene, true) {
                 Ok(()) => {
                     accepted.set(accepted.get() + 1);
+                    sources_accepted.set(sources_accepted.get() + u32::from(changed));
                     let back = loaded.map_err(|e| {
                         TestCaseError::fail(format!("accepted, but does not load: {e}\n{text}"))
                     })?;
@@ -211,11 +277,13 @@ fn an_edit_the_viewer_accepts_saves_a_scene_that_loads_and_a_refused_one_does_no
                     prop_assert_eq!(&back.materials, &scene.materials);
                     prop_assert_eq!(&back.spheres, &scene.spheres);
                     prop_assert_eq!(&back.triangles, &scene.triangles);
+                    prop_assert_eq!(&back.objects, &scene.objects);
                     // And the text is a fixed point.
                     prop_assert_eq!(scene_to_toml(&back), text);
                 }
                 Err(verdict) => {
                     refused.set(refused.get() + 1);
+                    sources_refused.set(sources_refused.get() + u32::from(changed));
                     let error = match loaded {
                         Ok(_) => {
                             return Err(TestCaseError::fail(format!(
@@ -240,10 +308,16 @@ fn an_edit_the_viewer_accepts_saves_a_scene_that_loads_and_a_refused_one_does_no
             Ok(())
         })
         .unwrap_or_else(|e| panic!("{e}"));
-    // Both sides of the property were exercised.
+    // Both sides of the property were exercised, on every kind of edit.
     let (accepted, refused) = (accepted.get(), refused.get());
     assert!(
         accepted > 300 && refused > 300,
         "{accepted} accepted, {refused} refused"
+    );
+    let (sources_accepted, sources_refused) = (sources_accepted.get(), sources_refused.get());
+    assert!(
+        sources_accepted > 100 && sources_refused > 100,
+        "edits of mesh normals and light names: {sources_accepted} accepted, {sources_refused} \
+         refused"
     );
 }

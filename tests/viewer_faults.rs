@@ -302,3 +302,38 @@ fn an_edit_far_beyond_the_scene_size_limit_is_refused() {
     settle(&mut app);
     assert_converged(&app);
 }
+
+/// Every file of the hostile corpus that the loader refuses (broken `vn`/`vt` indices,
+/// `crease_angle`, `normals`, devices, folders, ...), opened in the viewer: the message is the
+/// loader's sentence, and the scene being shown stays exactly as it was.
+#[test]
+fn opening_each_refused_hostile_file_keeps_the_scene() {
+    let mut app = headless(small("default", 64, 48, 1), "default");
+    let before = app.scene().clone();
+    let mut paths: Vec<_> = std::fs::read_dir("tests/fixtures/hostile")
+        .expect("the hostile corpus")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "obj" || e == "toml"))
+        .collect();
+    paths.sort();
+    let mut refused = 0;
+    for path in paths {
+        let Err(e) = raytree::scene::load_scene_file(&path) else {
+            continue;
+        };
+        refused += 1;
+        app.command(Command::OpenFile(path.clone()));
+        app.apply();
+        let (error, message) = app.messages.last().cloned().expect("a message");
+        assert!(error, "{}: {message}", path.display());
+        assert_eq!(message, e.to_string());
+        assert!(
+            app.scene() == &before,
+            "{}: the scene changed",
+            path.display()
+        );
+    }
+    assert!(refused >= 40, "{refused} refused files");
+    settle(&mut app);
+    assert_converged(&app);
+}

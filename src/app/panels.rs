@@ -450,7 +450,16 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                 restart = true;
             }
             if ui.button("Add light").clicked() {
-                let n = app.edit.lights.len() + 1;
+                // A name no light has (after a removal, `light {len + 1}` may be taken).
+                let mut n = app.edit.lights.len() + 1;
+                while app
+                    .edit
+                    .lights
+                    .iter()
+                    .any(|l| l.name == format!("light {n}"))
+                {
+                    n += 1;
+                }
                 let pos = app.edit.camera.position + Vec3::Y;
                 app.edit.lights.push(Light {
                     name: format!("light {n}"),

@@ -11,6 +11,7 @@ pub mod files;
 pub mod first_look;
 pub mod load;
 pub mod obj;
+mod obj_corners;
 pub mod obj_parse;
 pub mod procedural;
 pub mod rules;

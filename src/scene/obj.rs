@@ -20,6 +20,7 @@ use glam::{Mat3, Vec2, Vec3};
 
 use super::budget::{MemoryLimit, memory_limit, mesh_memory_estimate};
 use super::diag::{list_and, short, short_path};
+use super::obj_corners::{ALL_NORMALS, ALL_UVS};
 use super::rules::{MAX_COORDINATE, is_visible_triangle};
 use super::texture::decode_texture;
 use super::{
@@ -439,6 +440,22 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
         Err(reason) => return Err(ObjProblem { line: None, reason }),
     };
     let mtl_materials = mtl_materials.unwrap_or_default();
+    // Which faces give `vn`/`vt` at every corner (tobj fills the others from a neighbour).
+    let (uvs_in_file, normals_in_file) = models.iter().fold((false, false), |(t, n), m| {
+        (
+            t || !m.mesh.texcoords.is_empty(),
+            n || !m.mesh.normals.is_empty(),
+        )
+    });
+    let face_corners = match uvs_in_file || normals_in_file {
+        true => super::obj_corners::face_corners(&text, uvs_in_file, normals_in_file).map_err(
+            |(line, reason)| ObjProblem {
+                line: Some(line),
+                reason: reason.into(),
+            },
+        )?,
+        false => Default::default(),
+    };
     let mut warnings = mtl_warnings.into_inner();
     let mtl_texts = mtl_texts.into_inner();
     if polylines > 0 {
@@ -466,6 +483,12 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
         ..MeshAttributes::default()
     };
     let mut corners = Corners::default();
+    let triangles_read: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+    let explicit = |t: usize| match face_corners.triangles.len() == triangles_read {
+        true => face_corners.triangles[t],
+        false => ALL_NORMALS | ALL_UVS,
+    };
+    let mut triangle_read = 0;
     for model in &models {
         let mesh = &model.mesh;
         let mut material = None;
@@ -502,6 +525,8 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
         for (k, face) in mesh.indices.chunks_exact(3).enumerate() {
             let mut v =
                 [face[0], face[1], face[2]].map(|i| linear * corner(i) + req.placement.translate);
+            let given = explicit(triangle_read);
+            triangle_read += 1;
             let lookup = |indices: &[u32], base: u32, count: u32, ok: &dyn Fn(u32) -> bool| {
                 let idx = indices.get(3 * k..3 * k + 3)?;
                 let idx = [idx[0], idx[1], idx[2]];
@@ -509,7 +534,7 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
                     .all(|&i| i < count && ok(base + i))
                     .then(|| idx.map(|i| base + i))
             };
-            let mut ni = if has_normals {
+            let mut ni = if has_normals && given & ALL_NORMALS != 0 {
                 let normals = &attrs.normals;
                 let usable = |i: u32| {
                     let n = normals[i as usize];
@@ -521,7 +546,7 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
             } else {
                 None
             };
-            let mut ti = if has_uvs {
+            let mut ti = if has_uvs && given & ALL_UVS != 0 {
                 let uvs = &attrs.uvs;
                 let usable = |i: u32| uvs[i as usize].is_finite();
                 let found = lookup(&mesh.texcoord_indices, uv_base, n_uvs, &usable);
@@ -572,6 +597,8 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
         scene.material(t.material).diffuse_map.is_some()
             || scene.material(t.material).ambient_map.is_some()
     });
+    corners.partial_normals = face_corners.partial_normals * usize::from(file_normals);
+    corners.partial_uvs = face_corners.partial_uvs;
     finish_attributes(scene, req, attrs, corners, textured, &mut warnings);
     if dropped > 0 {
         let s = if dropped == 1 { "" } else { "s" };
@@ -600,6 +627,9 @@ struct Corners {
     bad_normals: usize,
     /// Faces whose `vt` indices are out of range or name non-finite coordinates.
     bad_uvs: usize,
+    /// Faces with `vn` (`vt`) at some corners only.
+    partial_normals: usize,
+    partial_uvs: usize,
 }
 
 /// Keeps the mesh's normals (from the file, or computed for `normals = "smooth"`) and, when a
@@ -617,12 +647,29 @@ fn finish_attributes(
     let count = scene.triangles.len() - first;
     attrs.triangle_count = count as u32;
     let plural = |n: usize| if n == 1 { "" } else { "s" };
+    let faces_give = |n: usize| if n == 1 { "face gives" } else { "faces give" };
     if corners.bad_normals > 0 {
         let n = corners.bad_normals;
         warnings.push(format!(
             "{}: {n} face{} name normals (`vn`) that are out of range, zero or not finite; they are shaded flat.",
             req.label,
             plural(n)
+        ));
+    }
+    if corners.partial_normals > 0 {
+        let n = corners.partial_normals;
+        warnings.push(format!(
+            "{}: {n} {} normals (`vn`) at some corners only; they are shaded flat.",
+            req.label,
+            faces_give(n)
+        ));
+    }
+    if corners.partial_uvs > 0 && textured {
+        let n = corners.partial_uvs;
+        warnings.push(format!(
+            "{}: {n} {} texture coordinates (`vt`) at some corners only; they are not textured.",
+            req.label,
+            faces_give(n)
         ));
     }
     if corners.bad_uvs > 0 && textured {

@@ -9,7 +9,7 @@ use std::ops::RangeInclusive;
 
 use glam::Vec3;
 
-use super::{Camera, Light, Material, RenderParams, Scene, Sphere};
+use super::{Camera, Light, Material, ObjectId, ObjectSource, RenderParams, Scene};
 
 /// Largest image side, in pixels.
 pub const MAX_IMAGE_SIZE: u32 = 16384;
@@ -255,12 +255,39 @@ pub fn describe(what: &str, v: &Violation) -> String {
     format!("{what} field `{}` {}{got}", v.field, v.phrase)
 }
 
+/// Names of one kind (lights, materials, objects), as the loader requires them: not blank,
+/// and all different. The first broken one as a violation of field `name`.
+pub fn check_names<'a>(
+    names: impl IntoIterator<Item = &'a str>,
+    kind: &str,
+) -> Result<(), Violation> {
+    let mut seen = std::collections::HashSet::new();
+    for name in names {
+        if name.trim().is_empty() {
+            return Err(whole("name", "must not be empty"));
+        }
+        if !seen.insert(name) {
+            return Err(whole(
+                "name",
+                &format!(
+                    "repeats \"{}\", the name of another {kind}; {kind} names must be unique",
+                    name.escape_debug()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Every rule over a whole scene that did not come from a file (a viewer edit): the first
 /// broken one as a phrase naming the section and field. `geometry`: also every sphere and
 /// triangle (an edit that leaves the geometry alone need not walk a million triangles).
 pub fn check_scene(s: &Scene, geometry: bool) -> Result<(), String> {
     check_render(&s.render).map_err(|v| describe("render", &v))?;
     check_camera(&s.camera).map_err(|v| describe("camera", &v))?;
+    // Names first, as the loader reads them.
+    check_names(s.lights.iter().map(|l| l.name.as_str()), "light")
+        .map_err(|v| describe("light", &v))?;
     for l in &s.lights {
         check_light(l).map_err(|v| describe(&format!("light \"{}\"", l.name), &v))?;
     }
@@ -268,28 +295,43 @@ pub fn check_scene(s: &Scene, geometry: bool) -> Result<(), String> {
         check_material(m).map_err(|v| describe(&format!("material \"{}\"", m.name), &v))?;
     }
     if geometry {
-        for Sphere {
-            center,
-            radius,
-            object,
-            ..
-        } in &s.spheres
-        {
-            check_sphere(*center, *radius)
-                .map_err(|v| describe(&format!("sphere \"{}\"", s.object(*object).name), &v))?;
+        // The first broken object in the order the loader meets them (file order, the order
+        // of `objects`), so that both name the same field.
+        let mut first: Option<(u32, String)> = None;
+        let mut note = |object: ObjectId, what: &str, v: Violation| {
+            if first.as_ref().is_none_or(|(o, _)| object.0 < *o) {
+                let what = format!("{what} \"{}\"", s.object(object).name);
+                first = Some((object.0, describe(&what, &v)));
+            }
+        };
+        for sphere in &s.spheres {
+            if let Err(v) = check_sphere(sphere.center, sphere.radius) {
+                note(sphere.object, "sphere", v);
+            }
         }
-        for o in &s.objects {
-            if let super::ObjectSource::Mesh {
-                crease_angle_deg, ..
+        for (i, o) in s.objects.iter().enumerate() {
+            if let ObjectSource::Mesh {
+                translate,
+                rotate_deg,
+                scale,
+                crease_angle_deg,
+                ..
             } = &o.source
             {
-                check_mesh_normals(*crease_angle_deg)
-                    .map_err(|v| describe(&format!("mesh \"{}\"", o.name), &v))?;
+                let checked = check_placement(*translate, *rotate_deg, *scale)
+                    .and_then(|()| check_mesh_normals(*crease_angle_deg));
+                if let Err(v) = checked {
+                    note(ObjectId(i as u32), "mesh", v);
+                }
             }
         }
         for t in &s.triangles {
-            check_triangle(&t.vertices)
-                .map_err(|v| describe(&format!("object \"{}\"", s.object(t.object).name), &v))?;
+            if let Err(v) = check_triangle(&t.vertices) {
+                note(t.object, "object", v);
+            }
+        }
+        if let Some((_, message)) = first {
+            return Err(message);
         }
     }
     Ok(())
@@ -362,6 +404,18 @@ mod tests {
         assert_eq!(
             check_scene(&s, false),
             Err("light \"key\" field `color` must be finite, got NaN".into())
+        );
+        // Two lights of one name: the loader would refuse the saved file, so the viewer does.
+        s.lights[0].color = Vec3::ONE;
+        let twin = s.lights[0].clone();
+        s.lights.push(twin);
+        assert_eq!(
+            check_scene(&s, false),
+            Err(
+                "light field `name` repeats \"key\", the name of another light; light names \
+                 must be unique"
+                    .into()
+            )
         );
     }
 }

@@ -5,6 +5,8 @@
 
 use std::io::Cursor;
 
+use image::ImageDecoder;
+
 use super::Texture;
 use super::budget::{MemoryLimit, format_bytes};
 
@@ -23,36 +25,45 @@ fn srgb_to_linear(code: u8) -> f32 {
 
 /// Decodes PNG or JPEG `bytes` into a linear texture named `name`, or says why not in a phrase
 /// ("it is not a PNG or JPEG image", "its 40000x40000 texels would need ..."). `limit` is the
-/// memory still available: a texture larger than it is refused before it is decoded.
+/// memory still available: a texture larger than it is refused from its header, before a texel
+/// is decoded. A JPEG cut short (no end-of-image marker after its last scan) is refused too:
+/// the decoder would fill the missing part with grey and say nothing.
 pub fn decode_texture(name: &str, bytes: &[u8], limit: &MemoryLimit) -> Result<Texture, String> {
     let reader = image::ImageReader::new(Cursor::new(bytes))
         .with_guessed_format()
-        .map_err(|e| format!("cannot read it ({e})"))?;
+        .map_err(|e| format!("cannot read it ({})", one_line(&e)))?;
     match reader.format() {
-        Some(image::ImageFormat::Png | image::ImageFormat::Jpeg) => {}
+        Some(image::ImageFormat::Png) => {}
+        Some(image::ImageFormat::Jpeg) if !jpeg_is_whole(bytes) => {
+            return Err("it is cut short (a JPEG without its end-of-image marker)".into());
+        }
+        Some(image::ImageFormat::Jpeg) => {}
         _ => return Err("it is not a PNG or JPEG image".into()),
     }
-    let (width, height) = reader
-        .into_dimensions()
-        .map_err(|e| format!("cannot read its size ({e})"))?;
+    let mut decoder = reader
+        .into_decoder()
+        .map_err(|e| format!("cannot read its size ({})", one_line(&e)))?;
+    let (width, height) = decoder.dimensions();
     if width == 0 || height == 0 {
         return Err(format!("it has no texels ({width}x{height})"));
     }
-    let linear_bytes = Texture::bytes(width, height);
-    // The decoder's 8-bit copy comes on top of the linear texels while both exist.
-    let peak = linear_bytes.saturating_add(u64::from(width) * u64::from(height) * 4);
+    // While the texture is made, three copies exist: the decoded image (its own texel size),
+    // its 8-bit RGB copy and the linear texels.
+    let texels = u64::from(width) * u64::from(height);
+    let decoded_bytes = texels.saturating_mul(u64::from(decoder.color_type().bytes_per_pixel()));
+    let peak = Texture::bytes(width, height)
+        .saturating_add(decoded_bytes)
+        .saturating_add(texels.saturating_mul(3));
     limit
         .check(format!("its {width}x{height} texels"), peak)
         .map_err(|e| e.to_string())?;
-    let mut reader = image::ImageReader::new(Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| format!("cannot read it ({e})"))?;
     let mut limits = image::Limits::default();
     limits.max_alloc = Some(peak.max(1 << 20));
-    reader.limits(limits);
-    let decoded = reader
-        .decode()
-        .map_err(|e| format!("cannot decode it ({e})"))?;
+    decoder
+        .set_limits(limits)
+        .map_err(|e| format!("cannot decode it ({})", one_line(&e)))?;
+    let decoded = image::DynamicImage::from_decoder(decoder)
+        .map_err(|e| format!("cannot decode it ({})", one_line(&e)))?;
     let rgb = decoded.to_rgb8();
     let lut: Vec<f32> = (0..=255u8).map(srgb_to_linear).collect();
     let texels = rgb
@@ -65,6 +76,27 @@ pub fn decode_texture(name: &str, bytes: &[u8], limit: &MemoryLimit) -> Result<T
         height,
         texels,
     })
+}
+
+/// A decoder's error as words on one line (some end theirs with a line break): a warning is
+/// one line.
+fn one_line(e: &impl std::fmt::Display) -> String {
+    e.to_string()
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// True if the JPEG `bytes` has an end-of-image marker (`FF D9`) after the start of its last
+/// scan (`FF DA`). Inside a scan's data a byte `FF` is always followed by `00` or a restart
+/// marker, so neither can appear there by chance; a thumbnail's markers come before the main
+/// image's scans. Bytes after the marker (some cameras append data) do not matter.
+fn jpeg_is_whole(bytes: &[u8]) -> bool {
+    let marker = |code: u8| bytes.windows(2).rposition(|w| w == [0xFF, code]);
+    match (marker(0xDA), marker(0xD9)) {
+        (Some(scan), Some(end)) => end > scan,
+        _ => false,
+    }
 }
 
 /// A resolver of binary files (textures) relative to `folder`: regular files only (a folder,
@@ -180,5 +212,24 @@ mod tests {
         };
         let e = decode_texture("x", &bytes, &small).expect_err("over budget");
         assert!(e.contains("its 4x4 texels would need about"), "{e}");
+    }
+
+    #[test]
+    fn jpegs_cut_short_are_refused() {
+        let mut jpeg = Vec::new();
+        image::RgbImage::from_pixel(16, 16, image::Rgb([200, 100, 50]))
+            .write_to(&mut Cursor::new(&mut jpeg), image::ImageFormat::Jpeg)
+            .expect("encodes");
+        let t = decode_texture("x.jpg", &jpeg, &roomy()).expect("a whole JPEG decodes");
+        assert_eq!((t.width, t.height), (16, 16));
+        // Appended bytes after the end marker are harmless.
+        let mut longer = jpeg.clone();
+        longer.extend_from_slice(b"trailing");
+        assert!(decode_texture("x.jpg", &longer, &roomy()).is_ok());
+        let e = decode_texture("x.jpg", &jpeg[..jpeg.len() - 40], &roomy()).expect_err("cut short");
+        assert_eq!(
+            e,
+            "it is cut short (a JPEG without its end-of-image marker)"
+        );
     }
 }
