@@ -276,6 +276,13 @@ struct Given {
 const GIVEN_LIGHTS: usize = 4;
 
 impl Given {
+    const NONE: Given = Given {
+        found: Found::Nothing,
+        surface: None,
+        blocked: 0,
+        lights: [LightRay::NONE; GIVEN_LIGHTS],
+    };
+
     #[inline(always)]
     fn blocked(&self, light: usize) -> Option<bool> {
         (light < 64).then(|| self.blocked >> light & 1 != 0)
@@ -494,19 +501,16 @@ impl Tracer {
         let scene = &*self.scene;
         let mut hits = [None; K];
         self.accel.closest_hits(m, rays, active, &mut hits);
-        let mut given: [Given; K] = std::array::from_fn(|i| {
-            let found = self.with_lights(&rays[i], hits[i]);
-            let surface = match found {
-                Found::Prim(hit) if active & (1 << i) != 0 => Some(self.surface(&rays[i], &hit)),
-                _ => None,
-            };
-            Given {
-                found,
-                surface,
-                blocked: 0,
-                lights: [LightRay::NONE; GIVEN_LIGHTS],
+        // Filled in place: a `Given` is large, and building the array by value copies it.
+        let mut given = [Given::NONE; K];
+        for (i, g) in given.iter_mut().enumerate() {
+            g.found = self.with_lights(&rays[i], hits[i]);
+            if let Found::Prim(hit) = g.found
+                && active & (1 << i) != 0
+            {
+                g.surface = Some(self.surface(&rays[i], &hit));
             }
-        });
+        }
         for (li, light) in scene.lights.iter().enumerate().take(64) {
             let mut shadow = [Ray::new(Vec3::ZERO, Vec3::Z); K];
             let mut lengths = [0.0; K];
