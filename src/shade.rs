@@ -98,15 +98,30 @@ pub fn light_terms_with(
         Shading::BlinnPhong => n_dot_h,
         Shading::Phong => r_dot_v,
     };
-    let spec = cos_spec.max(0.0).powf(material.shininess);
+    let ks = color * material.specular;
     LightTerms {
         n_dot_l,
         n_dot_h,
         r_dot_v,
         diffuse: color * kd * n_dot_l,
-        specular: color * material.specular * spec,
+        specular: specular_term(ks, cos_spec, material.shininess),
     }
 }
+
+/// `ks·max(cos, 0)^shininess` (`ks` is `C_l ⊙ ks`). Where `ks` is zero in every channel (a
+/// mirror or glass without highlights) the power is not formed: for a shininess in
+/// `[0, 10⁶]` it is finite and not negative (`cos` of unit vectors is at most `1` plus a few
+/// ulp), so the product is `ks` itself, signed zeros included, bit for bit.
+#[inline(always)]
+fn specular_term(ks: Vec3, cos: f32, shininess: f32) -> Vec3 {
+    if ks == Vec3::ZERO && (0.0..=MAX_SKIPPED_SHININESS).contains(&shininess) {
+        return ks;
+    }
+    ks * cos.max(0.0).powf(shininess)
+}
+
+/// Largest shininess for which [`specular_term`] may skip the power.
+const MAX_SKIPPED_SHININESS: f32 = 1e6;
 
 /// `ka ⊙ A`.
 #[inline]
@@ -119,6 +134,46 @@ mod tests {
     use super::*;
 
     const H: f32 = std::f32::consts::FRAC_1_SQRT_2;
+
+    /// Skipping the power where `C_l ⊙ ks` is zero gives the full product's bits: random
+    /// cosines (negative, above 1, NaN), colours and specular coefficients with `+0` and `−0`
+    /// channels, every shininess up to the bound.
+    #[test]
+    fn zero_specular_skips_the_power_bit_for_bit() {
+        let mut seed = 99u32;
+        let mut rnd = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed as f32 / u32::MAX as f32 * 2.0 - 1.0
+        };
+        let mut skipped = 0;
+        for k in 0..20000 {
+            let cos = match k % 7 {
+                0 => f32::NAN,
+                1 => 1.0 + 1e-6 * rnd().abs(),
+                _ => rnd(),
+            };
+            let shininess = [0.0, 1.0, 40.0, 200.0, 1e4, 1e6][k % 6];
+            let zero = |x: f32| if x < 0.0 { -0.0 } else { 0.0 };
+            let color = Vec3::new(rnd().abs(), zero(rnd()), rnd().abs() * 3.0);
+            let specular = match k % 3 {
+                0 => Vec3::new(zero(rnd()), zero(rnd()), zero(rnd())),
+                1 => Vec3::new(0.0, rnd().abs(), 0.0),
+                _ => Vec3::new(rnd().abs(), rnd().abs(), rnd().abs()),
+            };
+            let ks = color * specular;
+            skipped += usize::from(ks == Vec3::ZERO);
+            let full = ks * cos.max(0.0).powf(shininess);
+            let fast = specular_term(ks, cos, shininess);
+            assert_eq!(
+                fast.to_array().map(f32::to_bits),
+                full.to_array().map(f32::to_bits),
+                "cos {cos} shininess {shininess} ks {ks}"
+            );
+        }
+        assert!(skipped > 5000, "{skipped}");
+    }
 
     #[test]
     fn reflect_about_floor() {

@@ -266,9 +266,23 @@ struct Given {
     /// Bit `i`: the shadow ray towards light `i` is blocked (lights from 64 on are asked one
     /// ray at a time).
     blocked: u64,
+    /// What [`Tracer::light_ray`] gave for each of the first [`GIVEN_LIGHTS`] lights, so
+    /// shading does not set the shadow rays up a second time (the terms, where it formed them,
+    /// are formed again: the same numbers); set when `surface` is.
+    lights: [LightRay; GIVEN_LIGHTS],
 }
 
+/// Lights whose shadow-ray setup a packet keeps for shading (the rest are set up again).
+const GIVEN_LIGHTS: usize = 4;
+
 impl Given {
+    const NONE: Given = Given {
+        found: Found::Nothing,
+        surface: None,
+        blocked: 0,
+        lights: [LightRay::NONE; GIVEN_LIGHTS],
+    };
+
     #[inline(always)]
     fn blocked(&self, light: usize) -> Option<bool> {
         (light < 64).then(|| self.blocked >> light & 1 != 0)
@@ -439,21 +453,7 @@ impl Tracer {
                     s.rec.light(i, t);
                     self.scene.lights[i].color
                 }
-                Found::Prim(hit) => match given {
-                    Some(g) => {
-                        let blocked = |i: usize, r: &Ray, length: f32| match g.blocked(i) {
-                            Some(blocked) => blocked,
-                            None => self.accel.occluded(self.methods(), r, 0.0, length),
-                        };
-                        self.shade(ray, &hit, g.surface, b, s, blocked)
-                    }
-                    None => {
-                        let blocked = |_: usize, r: &Ray, length: f32| {
-                            self.accel.occluded(self.methods(), r, 0.0, length)
-                        };
-                        self.shade(ray, &hit, None, b, s, blocked)
-                    }
-                },
+                Found::Prim(hit) => self.shade(ray, &hit, given, b, s),
             }
         };
         s.rec.leave(color);
@@ -501,37 +501,36 @@ impl Tracer {
         let scene = &*self.scene;
         let mut hits = [None; K];
         self.accel.closest_hits(m, rays, active, &mut hits);
-        let mut given: [Given; K] = std::array::from_fn(|i| {
-            let found = self.with_lights(&rays[i], hits[i]);
-            let surface = match found {
-                Found::Prim(hit) if active & (1 << i) != 0 => Some(self.surface(&rays[i], &hit)),
-                _ => None,
-            };
-            Given {
-                found,
-                surface,
-                blocked: 0,
+        // Filled in place: a `Given` is large, and building the array by value copies it.
+        let mut given = [Given::NONE; K];
+        for (i, g) in given.iter_mut().enumerate() {
+            g.found = self.with_lights(&rays[i], hits[i]);
+            if let Found::Prim(hit) = g.found
+                && active & (1 << i) != 0
+            {
+                g.surface = Some(self.surface(&rays[i], &hit));
             }
-        });
+        }
         for (li, light) in scene.lights.iter().enumerate().take(64) {
             let mut shadow = [Ray::new(Vec3::ZERO, Vec3::Z); K];
             let mut lengths = [0.0; K];
             let mut cast = 0u32;
-            for (i, g) in given.iter().enumerate() {
+            for (i, g) in given.iter_mut().enumerate() {
                 if let Some((surface, error)) = &g.surface {
                     let material = scene.material(surface.material);
                     let v = -rays[i].dir;
                     let mut terms = None;
                     let Found::Prim(hit) = g.found else { continue };
-                    let ray = self
-                        .light_ray::<NoRecord>(
-                            surface, hit.prim, *error, material, v, light, &mut terms,
-                        )
-                        .ray;
-                    if let Some((ray, length)) = ray {
+                    let lr = self.light_ray::<NoRecord>(
+                        surface, hit.prim, *error, material, v, light, &mut terms,
+                    );
+                    if let Some((ray, length)) = lr.ray {
                         shadow[i] = ray;
                         lengths[i] = length;
                         cast |= 1 << i;
+                    }
+                    if let Some(slot) = g.lights.get_mut(li) {
+                        *slot = lr;
                     }
                 }
             }
@@ -724,21 +723,32 @@ impl Tracer {
 
     /// The colour of a ray `b` that hit `hit`: the local model with a shadow ray per light,
     /// then the reflected and refracted children.
+    ///
+    /// `given` holds what a packet query found for a primary ray (its surface, its shadow rays
+    /// and their answers); without it everything is found here, one ray at a time.
     fn shade<R: Recorder>(
         &self,
         ray: &Ray,
         hit: &PrimHit,
-        at: Option<(SurfaceHit, Vec3)>,
+        given: Option<&Given>,
         b: Branch,
         s: &mut Sample<'_, R>,
-        occluded: impl Fn(usize, &Ray, f32) -> bool,
     ) -> Vec3 {
         let scene = &*self.scene;
         let offset = self.methods().offset;
-        let (surface, error) = at.unwrap_or_else(|| self.surface(ray, hit));
+        // The surface, and the shadow rays' setups and answers, the packet found, if any (by
+        // reference: they are large).
+        let found_here;
+        let (surface, error, known) = match given.and_then(|g| g.surface.as_ref().map(|s| (s, g))) {
+            Some(((surface, error), g)) => (surface, *error, Some(g)),
+            None => {
+                found_here = self.surface(ray, hit);
+                (&found_here.0, found_here.1, None)
+            }
+        };
         let (p, n, ng) = (surface.point, surface.normal, surface.geometric_normal);
         let v = -ray.dir;
-        s.rec.hit(&surface, v);
+        s.rec.hit(surface, v);
         if b.depth == 0 {
             s.info.normal = n;
             s.info.hit_t = surface.t;
@@ -764,7 +774,12 @@ impl Tracer {
                 distance,
                 ray: cast,
                 behind_surface,
-            } = self.light_ray::<R>(&surface, hit.prim, error, material, v, light, &mut terms);
+            } = match known.and_then(|g| g.lights.get(i)) {
+                Some(&lr) => lr,
+                None => {
+                    self.light_ray::<R>(surface, hit.prim, error, material, v, light, &mut terms)
+                }
+            };
             let mut blocked_by = None;
             let mut blocked_at = None;
             if let Some((shadow_ray, length)) = cast {
@@ -778,7 +793,12 @@ impl Tracer {
                     blocked_at = blocker.map(|b| b.t);
                     blocker.is_some()
                 } else {
-                    occluded(i, &shadow_ray, length)
+                    match known.and_then(|g| g.blocked(i)) {
+                        Some(blocked) => blocked,
+                        None => self
+                            .accel
+                            .occluded(self.methods(), &shadow_ray, 0.0, length),
+                    }
                 };
                 if !blocked {
                     let terms = terms.unwrap_or_else(|| terms_of(light.color, l));
@@ -940,11 +960,22 @@ fn texelled(colour: Vec3, texel: Option<Vec3>) -> Vec3 {
 
 /// One light seen from a hit: the unit vector to it, its distance, the shadow ray and its
 /// length when one is cast, and whether it is behind the geometric surface (STABILITY N3).
+#[derive(Clone, Copy)]
 struct LightRay {
     l: Vec3,
     distance: f32,
     ray: Option<(Ray, f32)>,
     behind_surface: bool,
+}
+
+impl LightRay {
+    /// A placeholder for lights not yet set up.
+    const NONE: LightRay = LightRay {
+        l: Vec3::ZERO,
+        distance: 0.0,
+        ray: None,
+        behind_surface: false,
+    };
 }
 
 /// The shadow ray from hit point `p` (error bound `error`, geometric normal `n`) towards the

@@ -24,6 +24,7 @@ mod bvh;
 mod grid;
 mod visits;
 
+pub use bvh::{PacketSimd, packet_simd, packet_uses_avx2, set_packet_simd};
 pub use visits::{AccelBox, VisitedBox, Visits};
 
 use glam::Vec3;

@@ -211,6 +211,97 @@ pub fn accumulate_tile_single(
     }
 }
 
+/// The viewer's coarse preview of `rect` (inside a `width × height` image): sample 0 of the
+/// pixel at the centre of each `block × block` block (clamped to the image), copied to the
+/// whole block; the colours and the facts, row-major within the rect, with the rays traced
+/// added to `counts`. The centres of neighbouring blocks are traced as packets of
+/// [`PACKET_BLOCK`] blocks ([`Tracer::trace_packet`]), bit for bit as
+/// [`preview_tile_single`] traces them one by one.
+pub fn preview_tile(
+    tracer: &Tracer,
+    frame: &CameraFrame,
+    rect: Rect,
+    block: u32,
+    counts: &mut RayCounts,
+) -> (Vec<Vec3>, Vec<SampleInfo>) {
+    preview_with(tracer, rect, block, |centres, out| {
+        let mut rays = [crate::geometry::Ray::new(Vec3::ZERO, Vec3::Z); PACKET_RAYS];
+        let mut traced = [(Vec3::ZERO, SampleInfo::default()); PACKET_RAYS];
+        for (chunk, outs) in centres.chunks(PACKET_RAYS).zip(out.chunks_mut(PACKET_RAYS)) {
+            for (ray, &(x, y)) in rays.iter_mut().zip(chunk) {
+                *ray = primary_ray(frame, x, y, 0);
+            }
+            let active = (1u32 << chunk.len()) - 1;
+            tracer.trace_packet(&rays, active, counts, &mut traced);
+            outs.copy_from_slice(&traced[..chunk.len()]);
+        }
+    })
+}
+
+/// [`preview_tile`] with every ray traced alone: the reference it is tested against.
+pub fn preview_tile_single(
+    tracer: &Tracer,
+    frame: &CameraFrame,
+    rect: Rect,
+    block: u32,
+    counts: &mut RayCounts,
+) -> (Vec<Vec3>, Vec<SampleInfo>) {
+    preview_with(tracer, rect, block, |centres, out| {
+        for (o, &(x, y)) in out.iter_mut().zip(centres) {
+            *o = trace_sample(tracer, frame, x, y, 0, counts);
+        }
+    })
+}
+
+/// The block centres of a preview of `rect` (clamped to the tracer's image), in packets of
+/// [`PACKET_BLOCK`] blocks (block rows and columns), traced by `trace` (centres in, sample
+/// colour and facts out), copied to their blocks.
+fn preview_with(
+    tracer: &Tracer,
+    rect: Rect,
+    block: u32,
+    trace: impl FnOnce(&[(u32, u32)], &mut [(Vec3, SampleInfo)]),
+) -> (Vec<Vec3>, Vec<SampleInfo>) {
+    let block = block.max(1);
+    let (w, h) = (tracer.scene.render.width, tracer.scene.render.height);
+    let (cols, rows) = (rect.width.div_ceil(block), rect.height.div_ceil(block));
+    let (bw, bh) = PACKET_BLOCK;
+    // Block coordinates in packet order, and their centres in image coordinates.
+    let mut blocks = Vec::with_capacity((cols * rows) as usize);
+    for py in (0..rows).step_by(bh as usize) {
+        for px in (0..cols).step_by(bw as usize) {
+            for j in py..(py + bh).min(rows) {
+                for i in px..(px + bw).min(cols) {
+                    blocks.push((i, j));
+                }
+            }
+        }
+    }
+    let centres: Vec<(u32, u32)> = blocks
+        .iter()
+        .map(|&(i, j)| {
+            (
+                (rect.x + i * block + block / 2).min(w.saturating_sub(1)),
+                (rect.y + j * block + block / 2).min(h.saturating_sub(1)),
+            )
+        })
+        .collect();
+    let mut traced = vec![(Vec3::ZERO, SampleInfo::default()); centres.len()];
+    trace(&centres, &mut traced);
+    let n = (rect.width * rect.height) as usize;
+    let mut pixels = vec![Vec3::ZERO; n];
+    let mut facts = vec![SampleInfo::default(); n];
+    for (&(i, j), &(c, info)) in blocks.iter().zip(&traced) {
+        for y in j * block..((j + 1) * block).min(rect.height) {
+            for x in i * block..((i + 1) * block).min(rect.width) {
+                pixels[(y * rect.width + x) as usize] = c;
+                facts[(y * rect.width + x) as usize] = info;
+            }
+        }
+    }
+    (pixels, facts)
+}
+
 /// Sample `s` of pixel (`x`, `y`): its colour and the facts the image modes show.
 pub fn trace_sample(
     tracer: &Tracer,

@@ -19,7 +19,7 @@ use std::time::Instant;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::{Rect, TILE_SIZE, accumulate_tile, panic_message, tiles, trace_sample};
+use super::{Rect, TILE_SIZE, accumulate_tile, panic_message, tiles};
 use crate::scene::{CameraFrame, Scene};
 use crate::trace::{RayCounts, SampleInfo, TraceSettings, Tracer};
 
@@ -523,31 +523,16 @@ impl Job {
         }
     }
 
-    /// One centre sample per 8×8 block, copied to the whole block.
+    /// One centre sample per 8×8 block, copied to the whole block (packets of neighbouring
+    /// blocks: [`super::preview_tile`]).
     fn preview_tile(
         &self,
         frame: &CameraFrame,
         rect: Rect,
     ) -> (Vec<Vec3>, Option<Vec<SampleInfo>>) {
-        let scene = &self.tracer.scene;
-        let (w, h) = (scene.render.width, scene.render.height);
-        let n = (rect.width * rect.height) as usize;
-        let mut pixels = vec![Vec3::ZERO; n];
-        let mut aux = vec![SampleInfo::default(); n];
         let mut counts = RayCounts::default();
-        for by in (0..rect.height).step_by(PREVIEW_BLOCK as usize) {
-            for bx in (0..rect.width).step_by(PREVIEW_BLOCK as usize) {
-                let x = (rect.x + bx + PREVIEW_BLOCK / 2).min(w - 1);
-                let y = (rect.y + by + PREVIEW_BLOCK / 2).min(h - 1);
-                let (c, a) = trace_sample(&self.tracer, frame, x, y, 0, &mut counts);
-                for j in by..(by + PREVIEW_BLOCK).min(rect.height) {
-                    for i in bx..(bx + PREVIEW_BLOCK).min(rect.width) {
-                        pixels[(j * rect.width + i) as usize] = c;
-                        aux[(j * rect.width + i) as usize] = a;
-                    }
-                }
-            }
-        }
+        let (pixels, aux) =
+            super::preview_tile(&self.tracer, frame, rect, PREVIEW_BLOCK, &mut counts);
         self.stats.add(&counts);
         // The image modes get the preview too, so a mode view never shows render colours.
         (pixels, Some(aux))

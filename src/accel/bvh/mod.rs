@@ -40,6 +40,69 @@ const SPHERE: u32 = 0x4000_0000;
 /// Most primitives the leaf words can address (2²⁸ packets of up to four triangles).
 pub const MAX_PRIMS: usize = 1 << 28;
 
+/// Which node test the packet traversal uses: eight rays wide with AVX2 where the CPU has it
+/// (the default, `Auto`), or four wide with SSE. Both give the same answers bit for bit; the
+/// environment variable `RAYTREE_SIMD=sse` (or `avx2`, `auto`) sets it at start, and
+/// [`set_packet_simd`] at run time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PacketSimd {
+    Auto,
+    Sse,
+    Avx2,
+}
+
+/// 0: not yet read from the environment; else `PacketSimd as u8 + 1`.
+static PACKET_SIMD: std::sync::atomic::AtomicU8 = std::sync::atomic::AtomicU8::new(0);
+
+/// Sets the packet traversal's node test for the whole process. `Avx2` on a CPU without it
+/// falls back to SSE.
+pub fn set_packet_simd(simd: PacketSimd) {
+    PACKET_SIMD.store(simd as u8 + 1, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// The node test asked for: [`set_packet_simd`], else `RAYTREE_SIMD`, else `Auto`.
+pub fn packet_simd() -> PacketSimd {
+    let from = |v: u8| match v {
+        2 => PacketSimd::Sse,
+        3 => PacketSimd::Avx2,
+        _ => PacketSimd::Auto,
+    };
+    match PACKET_SIMD.load(std::sync::atomic::Ordering::Relaxed) {
+        0 => {
+            let asked = match std::env::var("RAYTREE_SIMD").as_deref() {
+                Ok("sse") => PacketSimd::Sse,
+                Ok("avx2") => PacketSimd::Avx2,
+                _ => PacketSimd::Auto,
+            };
+            set_packet_simd(asked);
+            asked
+        }
+        v => from(v),
+    }
+}
+
+/// Whether the packet traversal runs eight wide: AVX2 (and the rest of x86-64-v3) present and
+/// not turned off.
+pub fn packet_uses_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        avx2().is_some()
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[inline]
+fn avx2() -> Option<pulp::x86::V3> {
+    match packet_simd() {
+        PacketSimd::Sse => None,
+        PacketSimd::Auto | PacketSimd::Avx2 => pulp::x86::V3::try_new(),
+    }
+}
+
 /// Up to four triangles of a leaf, one per lane, and their primitive ids.
 #[derive(Clone, Copy, Debug)]
 struct Packet {

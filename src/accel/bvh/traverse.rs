@@ -159,17 +159,46 @@ impl Bvh {
         rays: &[Ray; K],
         t_min: f32,
         vs: &mut [V; K],
-        mut active: u32,
+        active: u32,
     ) {
         const { assert!(K <= 32) };
         if self.nodes.is_empty() || active == 0 {
             return;
         }
-        let trs: [TravRay; K] = std::array::from_fn(|i| TravRay::new(&rays[i], t_min));
+        #[cfg(target_arch = "x86_64")]
+        if let Some(v3) = super::avx2() {
+            // The whole walk compiled for AVX2 (the node test eight rays wide; the rest the
+            // same SSE arithmetic, VEX-encoded: no fused multiply-add is formed, so every
+            // number is the SSE path's).
+            return v3.vectorize(Avx8Walk {
+                bvh: self,
+                rays,
+                t_min,
+                vs,
+                active,
+                v3,
+            });
+        }
+        self.walk_packet_with(rays, t_min, vs, active, Sse4);
+    }
+
+    /// [`Bvh::walk_packet`] with the node test `T`.
+    #[inline(always)]
+    fn walk_packet_with<V: Visitor, const K: usize, T: NodeTest>(
+        &self,
+        rays: &[Ray; K],
+        t_min: f32,
+        vs: &mut [V; K],
+        mut active: u32,
+        test: T,
+    ) {
+        let mut rays4 = Rays4::new(rays, t_min);
+        for (i, v) in vs.iter().enumerate() {
+            rays4.set_limit(i, v.limit());
+        }
         let mut stack = [(0u32, 0u32, 0f32); STACK_SIZE];
         let mut sp = 0;
         let (mut word, mut mask) = (0u32, active);
-        let slack = Vec4::splat(box_t_slack());
         loop {
             if word & LEAF != 0 {
                 let mut m = mask;
@@ -185,6 +214,8 @@ impl Bvh {
                     };
                     if stop {
                         active &= !(1 << i);
+                    } else if V::ORDERED {
+                        rays4.set_limit(i, v.limit());
                     }
                 }
                 if active == 0 {
@@ -192,32 +223,9 @@ impl Bvh {
                 }
             } else {
                 let node = &self.nodes[word as usize];
-                let p = &node.planes;
-                // Per child slot, the rays that enter it, and the nearest of their entry ts.
-                let mut entered = [0u32; 4];
-                let mut key = Vec4::splat(f32::INFINITY);
-                let mut m = mask;
-                while m != 0 {
-                    let i = m.trailing_zeros() as usize;
-                    m &= m - 1;
-                    let r = &trs[i];
-                    let (nx, ny, nz) = (r.near[0], r.near[1], r.near[2]);
-                    let t_near = ((p[nx] - r.ox) * r.ix)
-                        .max((p[ny] - r.oy) * r.iy)
-                        .max((p[nz] - r.oz) * r.iz);
-                    let t_far = ((p[nx ^ 1] - r.ox) * r.ix)
-                        .min((p[ny ^ 1] - r.oy) * r.iy)
-                        .min((p[nz ^ 1] - r.oz) * r.iz);
-                    let t_near = (t_near - t_near.abs() * slack).max(r.t_min);
-                    let t_far = (t_far + t_far.abs() * slack).min(Vec4::splat(vs[i].limit()));
-                    let hit = t_near.cmple(t_far);
-                    let bits = hit.bitmask() & node.valid;
-                    key = key.min(Vec4::select(hit, t_near, Vec4::splat(f32::INFINITY)));
-                    for (slot, e) in entered.iter_mut().enumerate() {
-                        *e |= ((bits >> slot) & 1) << i;
-                    }
-                }
-                let key = key.to_array();
+                // Per child slot, the rays that enter it, and a `t` no later than any of their
+                // entry ts.
+                let (entered, key) = test.enter::<K>(&rays4, node, mask);
                 // The children entered, nearest first when ordered.
                 let mut hits = [(0u32, 0u32, 0f32); 4];
                 let mut k = 0;
@@ -304,6 +312,212 @@ impl TravRay {
             near: [near(inv.x, 0), near(inv.y, 1), near(inv.z, 2)],
             t_min: Vec4::splat(t_min),
         }
+    }
+}
+
+/// The rays of a packet for the node test, lane `i` for ray `i`, so one SIMD test checks four
+/// (SSE) or eight (AVX2) rays against one child box: the same slab arithmetic as [`TravRay`],
+/// each ray's own numbers, with the near and far planes per axis taken as the smaller and
+/// larger of the two planes' `t` (for `1/d` of either sign, the plane [`TravRay::near`] picks
+/// gives the smaller: `(plane − o)·(1/d)` rounds monotonically in the plane, so the values are
+/// the same, bar the sign of a zero, which no comparison sees).
+struct Rays4 {
+    o: [[f32; 32]; 3],
+    inv: [[f32; 32]; 3],
+    t_min: f32,
+    /// Each ray's [`Visitor::limit`], as of its last leaf.
+    limit: [f32; 32],
+}
+
+impl Rays4 {
+    #[inline(always)]
+    fn new<const K: usize>(rays: &[Ray; K], t_min: f32) -> Self {
+        let mut o = [[0.0f32; 32]; 3];
+        let mut inv = [[1.0f32; 32]; 3];
+        for (i, ray) in rays.iter().enumerate() {
+            let d = trav_inv(ray.dir);
+            for axis in 0..3 {
+                o[axis][i] = ray.origin[axis];
+                inv[axis][i] = d[axis];
+            }
+        }
+        Rays4 {
+            o,
+            inv,
+            t_min,
+            limit: [f32::NEG_INFINITY; 32],
+        }
+    }
+
+    #[inline(always)]
+    fn set_limit(&mut self, i: usize, limit: f32) {
+        self.limit[i] = limit;
+    }
+}
+
+/// The node test of a packet: for the rays of `mask` (a subset of the packet's), per child
+/// slot, the rays whose widened `(t_min, limit]` interval meets its box (as [`Bvh::walk_from`]
+/// tests each), and the smallest entry `t` of the rays of their lane groups that meet it (no
+/// later than any of theirs, so a child popped behind it is behind every one of them).
+trait NodeTest: Copy {
+    fn enter<const K: usize>(
+        &self,
+        r: &Rays4,
+        node: &super::Node,
+        mask: u32,
+    ) -> ([u32; 4], [f32; 4]);
+}
+
+/// The node test four rays wide (SSE, glam).
+#[derive(Clone, Copy)]
+struct Sse4;
+
+impl NodeTest for Sse4 {
+    #[inline(always)]
+    fn enter<const K: usize>(
+        &self,
+        r: &Rays4,
+        node: &super::Node,
+        mask: u32,
+    ) -> ([u32; 4], [f32; 4]) {
+        let mut entered = [0u32; 4];
+        let mut key = [f32::INFINITY; 4];
+        let planes = node.planes.map(|p| p.to_array());
+        let slack = Vec4::splat(box_t_slack());
+        let t_min = Vec4::splat(r.t_min);
+        for g in 0..K.div_ceil(4) {
+            let group = (mask >> (4 * g)) & 0xf;
+            if group == 0 {
+                continue;
+            }
+            let lanes = 4 * g..4 * g + 4;
+            let load = |a: &[f32; 32]| Vec4::from_slice(&a[lanes.clone()]);
+            let (ox, oy, oz) = (load(&r.o[0]), load(&r.o[1]), load(&r.o[2]));
+            let (ix, iy, iz) = (load(&r.inv[0]), load(&r.inv[1]), load(&r.inv[2]));
+            let limit = load(&r.limit);
+            let mut valid = node.valid;
+            while valid != 0 {
+                let c = valid.trailing_zeros() as usize;
+                valid &= valid - 1;
+                let ax = (Vec4::splat(planes[0][c]) - ox) * ix;
+                let bx = (Vec4::splat(planes[1][c]) - ox) * ix;
+                let ay = (Vec4::splat(planes[2][c]) - oy) * iy;
+                let by = (Vec4::splat(planes[3][c]) - oy) * iy;
+                let az = (Vec4::splat(planes[4][c]) - oz) * iz;
+                let bz = (Vec4::splat(planes[5][c]) - oz) * iz;
+                let t_near = ax.min(bx).max(ay.min(by)).max(az.min(bz));
+                let t_far = ax.max(bx).min(ay.max(by)).min(az.max(bz));
+                let t_near = (t_near - t_near.abs() * slack).max(t_min);
+                let t_far = (t_far + t_far.abs() * slack).min(limit);
+                let hit = t_near.cmple(t_far);
+                let bits = hit.bitmask() & group;
+                if bits != 0 {
+                    entered[c] |= bits << (4 * g);
+                    let t = Vec4::select(hit, t_near, Vec4::INFINITY).min_element();
+                    key[c] = key[c].min(t);
+                }
+            }
+        }
+        (entered, key)
+    }
+}
+
+/// [`Bvh::walk_packet_with`] the [`Avx8`] test, as the function `pulp` compiles with AVX2:
+/// its `call` must be inlined there, hence a type rather than a closure.
+#[cfg(target_arch = "x86_64")]
+struct Avx8Walk<'a, V, const K: usize> {
+    bvh: &'a Bvh,
+    rays: &'a [Ray; K],
+    t_min: f32,
+    vs: &'a mut [V; K],
+    active: u32,
+    v3: pulp::x86::V3,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<V: Visitor, const K: usize> pulp::NullaryFnOnce for Avx8Walk<'_, V, K> {
+    type Output = ();
+
+    #[inline(always)]
+    fn call(self) {
+        let test = Avx8(self.v3);
+        self.bvh
+            .walk_packet_with(self.rays, self.t_min, self.vs, self.active, test);
+    }
+}
+
+/// The node test eight rays wide (AVX2 through `pulp`'s safe intrinsics), the same operations
+/// in the same order as [`Sse4`] (`min`/`max` return the second operand on NaN in both), so
+/// the same numbers.
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy)]
+struct Avx8(pulp::x86::V3);
+
+#[cfg(target_arch = "x86_64")]
+impl NodeTest for Avx8 {
+    #[inline(always)]
+    fn enter<const K: usize>(
+        &self,
+        r: &Rays4,
+        node: &super::Node,
+        mask: u32,
+    ) -> ([u32; 4], [f32; 4]) {
+        use std::arch::x86_64::{__m256, _CMP_LE_OQ};
+        let avx = self.0.avx;
+        let mut entered = [0u32; 4];
+        let mut key = [f32::INFINITY; 4];
+        let planes = node.planes.map(|p| p.to_array());
+        let splat = |x: f32| avx._mm256_set1_ps(x);
+        let slack = splat(box_t_slack());
+        let t_min = splat(r.t_min);
+        let sign = splat(-0.0);
+        let inf = splat(f32::INFINITY);
+        let (min, max) = (
+            |a, b| avx._mm256_min_ps(a, b),
+            |a, b| avx._mm256_max_ps(a, b),
+        );
+        let (sub, mul) = (
+            |a, b| avx._mm256_sub_ps(a, b),
+            |a, b| avx._mm256_mul_ps(a, b),
+        );
+        let abs = |a| avx._mm256_andnot_ps(sign, a);
+        for g in 0..K.div_ceil(8) {
+            let group = (mask >> (8 * g)) & 0xff;
+            if group == 0 {
+                continue;
+            }
+            let load = |a: &[f32; 32]| -> __m256 {
+                let mut lanes = [0.0f32; 8];
+                lanes.copy_from_slice(&a[8 * g..8 * g + 8]);
+                pulp::cast(lanes)
+            };
+            let (ox, oy, oz) = (load(&r.o[0]), load(&r.o[1]), load(&r.o[2]));
+            let (ix, iy, iz) = (load(&r.inv[0]), load(&r.inv[1]), load(&r.inv[2]));
+            let limit = load(&r.limit);
+            let mut valid = node.valid;
+            while valid != 0 {
+                let c = valid.trailing_zeros() as usize;
+                valid &= valid - 1;
+                let ax = mul(sub(splat(planes[0][c]), ox), ix);
+                let bx = mul(sub(splat(planes[1][c]), ox), ix);
+                let ay = mul(sub(splat(planes[2][c]), oy), iy);
+                let by = mul(sub(splat(planes[3][c]), oy), iy);
+                let az = mul(sub(splat(planes[4][c]), oz), iz);
+                let bz = mul(sub(splat(planes[5][c]), oz), iz);
+                let t_near = max(max(min(ax, bx), min(ay, by)), min(az, bz));
+                let t_far = min(min(max(ax, bx), max(ay, by)), max(az, bz));
+                let t_near = max(sub(t_near, mul(abs(t_near), slack)), t_min);
+                let t_far = min(avx._mm256_add_ps(t_far, mul(abs(t_far), slack)), limit);
+                let hit = avx._mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far);
+                let bits = avx._mm256_movemask_ps(hit) as u32 & group;
+                if bits != 0 {
+                    entered[c] |= bits << (8 * g);
+                    let t: [f32; 8] = pulp::cast(avx._mm256_blendv_ps(inf, t_near, hit));
+                    key[c] = t.iter().fold(key[c], |k, &x| k.min(x));
+                }
+            }
+        }
+        (entered, key)
     }
 }
 
