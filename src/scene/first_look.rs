@@ -111,13 +111,15 @@ pub(crate) fn load_obj_scene(
         position: key,
         color: Vec3::splat(0.8),
         radius: 0.0,
+        follow_camera: false,
     });
-    // A headlight at the camera, as model viewers have: what the camera sees is lit.
+    // A headlight that follows the camera, as model viewers have: what the camera sees is lit.
     scene.lights.push(Light {
         name: "headlight".into(),
         position: camera.position,
         color: Vec3::splat(0.35),
         radius: 0.0,
+        follow_camera: true,
     });
     if room {
         scene.warnings.push(format!(
