@@ -716,7 +716,18 @@ impl ViewerApp {
             for w in &edit.warnings {
                 self.messages.push((false, w.clone()));
             }
+            // The camera as it is now (it may have moved while the file was read), the
+            // accelerator shown kept: rendered as any edit is.
+            let camera = self.edit.camera.clone();
             self.edit = edit;
+            self.edit.camera = camera;
+            self.messages
+                .push((false, format!("reloaded {} after a save", path.display())));
+            self.rates.learn(&timings);
+            self.last_open = Some(timings);
+            self.watch_scene();
+            self.restart(false);
+            return;
         } else {
             self.replace_scene(edit, path.display().to_string());
         }
