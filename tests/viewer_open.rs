@@ -376,3 +376,32 @@ fn the_window_keeps_drawing_and_says_what_it_loads() {
     }
     assert_eq!(h.state().scene().source.as_deref(), Some(obj.as_path()));
 }
+
+/// The previous render keeps refining while a file opens, and does not hold the open back:
+/// the new scene comes in long before the old one would have converged.
+#[test]
+fn an_open_does_not_wait_for_the_previous_render_to_converge() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let obj = write_obj(dir.path(), "quick.obj", 3_000);
+    let mut scene = small_default();
+    (scene.render.width, scene.render.height) = (160, 120);
+    let mut app = ViewerApp::headless(scene, "default".into()).expect("the viewer starts");
+    // Thousands of samples of a glass scene: minutes of work for the render's workers.
+    app.set_view(4096, false);
+    app.apply();
+    frames_until(&mut app, "the first pass", |a| a.samples_done() >= 1);
+    app.command(Command::OpenFile(obj.clone()));
+    app.apply();
+    let deadline = Instant::now() + Duration::from_secs(300);
+    let mut old_samples = 0;
+    while app.opening().is_some() {
+        assert!(Instant::now() < deadline, "the open did not finish");
+        old_samples = app.samples_done();
+        frame(&mut app);
+    }
+    assert_eq!(app.scene().source.as_deref(), Some(obj.as_path()));
+    assert!(
+        old_samples < 4096,
+        "the open waited for the previous render to converge"
+    );
+}

@@ -231,7 +231,18 @@ pub const MAX_TREES: usize = 64;
 
 /// Opens the window and runs the viewer until it is closed.
 pub fn run(scene_arg: Option<&str>) -> anyhow::Result<()> {
+    // A file is opened in the background once the window is up (a big mesh takes seconds to
+    // read and build): the window shows the default scene and the open's progress meanwhile.
+    // Built-in scene names and missing files are answered at once.
+    let mut background = None;
     let (scene, label) = match scene_arg {
+        Some(arg) if Path::new(arg).is_file() => {
+            background = Some(PathBuf::from(arg));
+            (
+                scene::builtin::load_builtin("default")?,
+                "default".to_string(),
+            )
+        }
         Some(arg) => (scene::open_scene_arg(arg)?, arg.to_string()),
         None => (
             scene::builtin::load_builtin("default")?,
@@ -250,7 +261,10 @@ pub fn run(scene_arg: Option<&str>) -> anyhow::Result<()> {
         "raytree",
         options,
         Box::new(move |cc| {
-            let app = ViewerApp::new(cc, scene, label).map_err(|e| -> Box<dyn std::error::Error + Send + Sync> { e.into() })?;
+            let mut app = ViewerApp::new(cc, scene, label).map_err(|e| -> Box<dyn std::error::Error + Send + Sync> { e.into() })?;
+            if let Some(path) = background {
+                app.command(Command::OpenFile(path));
+            }
             Ok(Box::new(app))
         }),
     )
@@ -628,10 +642,7 @@ impl ViewerApp {
             reload: reload.then(|| (self.tracer.clone(), self.edit.camera.clone())),
             hook: self.open_hook.clone(),
         };
-        if let Err(e) = self.session.set_threads(self.settings.threads) {
-            self.error(e);
-        }
-        match opening::OpenJob::start(request, self.session.pool()) {
+        match opening::OpenJob::start(request) {
             Ok(job) => self.opening = Some(job),
             Err(e) => {
                 self.error(e);

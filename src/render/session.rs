@@ -227,12 +227,6 @@ impl Session {
         self.spawn(Source::Ready(tracer), Some(view), target, None)
     }
 
-    /// The worker pool, for other background work that should use the same threads (the
-    /// viewer's background open parses and builds on it).
-    pub fn pool(&self) -> Arc<rayon::ThreadPool> {
-        self.pool.clone()
-    }
-
     /// Like [`Self::start`], but first builds the tracer (its accelerator) of `scene` on the
     /// coordinator thread, so the caller never waits for a build (SPEC §4: the window never
     /// freezes). The tracer is handed out by [`Self::take_built`] once built, just before the
