@@ -481,6 +481,7 @@ mod tests {
             Rates::default().build_triangles_per_sec
         );
         assert_eq!(r.bytes_per_triangle, 50.0);
+        r.build_triangles_per_sec = 1.5e6;
         assert!((r.build_secs(3_000_000) - 2.0).abs() < 1e-9);
     }
 }
