@@ -405,3 +405,29 @@ fn an_open_does_not_wait_for_the_previous_render_to_converge() {
         "the open waited for the previous render to converge"
     );
 }
+
+/// Esc (the Stop command) stops an open under way: it never installs, the scene shown stays.
+#[test]
+fn stopping_cancels_the_open() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let obj = write_obj(dir.path(), "stopped.obj", 2_000);
+    let mut app = headless(small_default());
+    let gate = Gate::new(Some(OpenStage::Parse));
+    gate.install(&mut app);
+    app.command(Command::OpenFile(obj.clone()));
+    app.apply();
+    frames_until(&mut app, "the read", |_| gate.count(OpenStage::Parse) == 1);
+    app.command(Command::Stop);
+    app.apply();
+    assert_eq!(app.opening(), None);
+    gate.hold_at(None);
+    for _ in 0..50 {
+        frame(&mut app);
+    }
+    assert_eq!(app.scene().source, None, "the stopped open never installs");
+    assert_eq!(
+        gate.count(OpenStage::Build),
+        0,
+        "it stopped before its build"
+    );
+}

@@ -945,6 +945,13 @@ impl ViewerApp {
                     restart = true;
                 }
                 Command::Stop => {
+                    // Esc stops an open under way too; the scene shown stays (and is watched).
+                    if let Some(job) = self.opening.take() {
+                        job.cancel();
+                        self.messages
+                            .push((false, format!("stopped opening {}", job.path.display())));
+                        self.watch_scene();
+                    }
                     self.session.stop();
                     self.generation = self.session.generation();
                 }
