@@ -364,6 +364,7 @@ fn many_and_visible_lights_are_bit_identical() {
             position: rng.vec() * 6.0 + Vec3::Y * 3.0,
             color: Vec3::splat(0.01),
             radius: if k % 9 == 0 { 0.2 } else { 0.0 },
+            follow_camera: false,
         });
     }
     let rays = assert_same(

@@ -144,6 +144,7 @@ fn apply(scene: &mut Scene, e: &Edit) {
                 position: Vec3::new(1.0, 3.0, 2.0),
                 color: Vec3::ONE,
                 radius: 0.0,
+                follow_camera: false,
             });
         }
         Edit::Light(i, f, c, x) => {

@@ -127,6 +127,12 @@ fn dropping_a_bad_scene_shows_its_error_and_keeps_the_old_scene() {
         .dropped_files
         .push(Arc::new(Dropped(bad.clone())));
     h.step();
+    // Read and parsed in the background: the error comes when that open ends.
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    while h.state().opening().is_some() || h.state().messages.is_empty() {
+        assert!(std::time::Instant::now() < deadline, "the open never ended");
+        h.step();
+    }
     h.step();
     let message = h
         .state()

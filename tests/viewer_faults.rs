@@ -135,6 +135,9 @@ fn opening_a_scene_mid_render() {
     std::fs::write(&bad, "[render]\nwidth = 0\n").expect("write");
     app.command(Command::OpenFile(bad.clone()));
     app.apply();
+    // Read and parsed in the background: the error comes when the open ends.
+    settle(&mut app);
+    assert_eq!(app.opening(), None);
     let (error, message) = app.messages.last().cloned().expect("a message");
     assert!(error, "{message}");
     assert!(

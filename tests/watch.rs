@@ -137,3 +137,63 @@ fn saving_the_scene_reloads_it_and_a_broken_save_keeps_the_last_good_one() {
         "the fixed file was not reloaded"
     );
 }
+
+/// The reload runs in the background like an open: while it is held before its parse, the
+/// scene shown stays and keeps rendering; then the saved scene comes in.
+#[test]
+fn a_reload_is_read_and_parsed_off_the_ui_thread() {
+    use raytree::app::opening::OpenStage;
+    use std::sync::{Arc, Condvar, Mutex};
+
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("held.toml");
+    std::fs::write(&path, SCENE).expect("write");
+    let scene = load_scene_file(&path).expect("loads");
+    let mut app = ViewerApp::headless(scene, "held".into()).expect("the viewer starts");
+    assert!(poll_until(&mut app, ViewerApp::is_finished));
+    let gate = Arc::new((Mutex::new(true), Condvar::new()));
+    let hook_gate = gate.clone();
+    app.set_open_hook(Some(Arc::new(move |stage| {
+        let (held, released) = &*hook_gate;
+        let mut held = held.lock().expect("gate");
+        let deadline = Instant::now() + Duration::from_secs(60);
+        while stage == OpenStage::Parse && *held && Instant::now() < deadline {
+            held = released
+                .wait_timeout(held, Duration::from_millis(50))
+                .expect("gate")
+                .0;
+        }
+    })));
+    std::thread::sleep(Duration::from_millis(50));
+    save(
+        &path,
+        &SCENE.replace("color = [1, 1, 1]", "color = [0.25, 0.5, 1]"),
+    );
+    assert!(
+        poll_until(&mut app, |a| a.opening() == Some(path.as_path())),
+        "the save started no reload"
+    );
+    // Held: the old scene stays and renders an edit.
+    app.edit.camera.position.y += 0.1;
+    app.command(Command::MoveCamera);
+    app.apply();
+    let generation = app.generation();
+    assert!(poll_until(&mut app, |a| a.samples_done() >= 1
+        && a.generation() == generation));
+    assert_eq!(app.scene().lights[0].color.x, 1.0, "the old scene stays");
+    assert!(
+        app.opening().is_some(),
+        "the reload waits in the background"
+    );
+    let camera = app.edit.camera.clone();
+    // Let go: the reload comes in, keeping the camera as moved.
+    *gate.0.lock().expect("gate") = false;
+    gate.1.notify_all();
+    assert!(
+        poll_until(&mut app, |a| a.scene().lights[0].color.x == 0.25
+            && a.is_finished()),
+        "the reload did not come in: {:?}",
+        app.messages
+    );
+    assert_eq!(app.scene().camera, camera, "the viewer's camera stays");
+}

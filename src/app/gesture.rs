@@ -33,6 +33,8 @@ pub fn drag_light(
             .lights
             .iter()
             .enumerate()
+            // A headlight stays at the eye: it is moved with the camera, not dragged.
+            .filter(|(_, l)| !l.follow_camera)
             .filter_map(|(i, l)| to_screen(l.position).map(|s| (i, s.distance(origin))))
             .filter(|(_, d)| *d <= LIGHT_GRAB_RADIUS)
             .min_by(|a, b| a.1.total_cmp(&b.1))

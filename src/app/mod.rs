@@ -11,6 +11,7 @@ pub mod gesture;
 mod input;
 mod legend;
 pub mod modes;
+pub mod opening;
 mod paint3d;
 mod panels;
 pub mod scene_pane;
@@ -137,6 +138,8 @@ struct Progress {
     finished_secs: Option<f64>,
     /// What the status bar says of the pass under way: "preview", "4 samples", "stopped".
     pass_label: String,
+    /// The largest build percentage shown, so it never goes back.
+    build_percent: f64,
 }
 
 /// The viewer.
@@ -151,6 +154,15 @@ pub struct ViewerApp {
     session: Session,
     /// The open scene's files, watched for saves (`None` for built-in scenes).
     watch: Option<watch::SceneWatch>,
+    /// A file being opened (or reloaded) in the background; the scene shown stays until it
+    /// is ready.
+    opening: Option<opening::OpenJob>,
+    /// Called by background opens at each stage (the tests hold an open with it).
+    open_hook: Option<Arc<opening::OpenHook>>,
+    /// Rates of the stages of the last open, for the next one's progress estimate.
+    rates: opening::Rates,
+    /// Times of the last open, for the record (benchmarks print them).
+    pub last_open: Option<opening::Timings>,
     /// A build asked of the session and not yet installed (`Some(restart the scene view)`);
     /// while it is, the current tracer's accelerator does not fit the working copy, so every
     /// restart builds (a stop in the middle of a build drops it).
@@ -219,7 +231,18 @@ pub const MAX_TREES: usize = 64;
 
 /// Opens the window and runs the viewer until it is closed.
 pub fn run(scene_arg: Option<&str>) -> anyhow::Result<()> {
+    // A file is opened in the background once the window is up (a big mesh takes seconds to
+    // read and build): the window shows the default scene and the open's progress meanwhile.
+    // Built-in scene names and missing files are answered at once.
+    let mut background = None;
     let (scene, label) = match scene_arg {
+        Some(arg) if Path::new(arg).is_file() => {
+            background = Some(PathBuf::from(arg));
+            (
+                scene::builtin::load_builtin("default")?,
+                "default".to_string(),
+            )
+        }
         Some(arg) => (scene::open_scene_arg(arg)?, arg.to_string()),
         None => (
             scene::builtin::load_builtin("default")?,
@@ -238,7 +261,10 @@ pub fn run(scene_arg: Option<&str>) -> anyhow::Result<()> {
         "raytree",
         options,
         Box::new(move |cc| {
-            let app = ViewerApp::new(cc, scene, label).map_err(|e| -> Box<dyn std::error::Error + Send + Sync> { e.into() })?;
+            let mut app = ViewerApp::new(cc, scene, label).map_err(|e| -> Box<dyn std::error::Error + Send + Sync> { e.into() })?;
+            if let Some(path) = background {
+                app.command(Command::OpenFile(path));
+            }
             Ok(Box::new(app))
         }),
     )
@@ -306,6 +332,10 @@ impl ViewerApp {
             session,
             pending_build: None,
             watch: None,
+            opening: None,
+            open_hook: None,
+            rates: opening::Rates::default(),
+            last_open: None,
             generation: 0,
             progress: Progress::default(),
             film: Film::new(w, h),
@@ -357,8 +387,9 @@ impl ViewerApp {
         self.progress.samples_done
     }
 
+    /// Whether the current render reached its target and no file is being opened.
     pub fn is_finished(&self) -> bool {
-        self.progress.finished_secs.is_some()
+        self.progress.finished_secs.is_some() && self.opening.is_none()
     }
 
     /// Samples per pixel the viewer refines to (then it idles).
@@ -437,40 +468,19 @@ impl ViewerApp {
             }
         }
         self.scene_size = (self.edit.render.width, self.edit.render.height);
+        // Headlights stand at the camera's eye, wherever it went (the one rule for it).
+        self.edit.place_lights();
         // The viewer's buffers must fit the GPU's largest texture and the memory budget: a
         // larger render is shown scaled down (with a message); `raytree render` does full size.
-        let (w, h) = match self.pane_px {
-            Some(px) if self.prefs.pane_size => px,
-            _ => (self.edit.render.width, self.edit.render.height),
-        };
-        let limit = crate::scene::budget::memory_limit();
-        let per_pixel = crate::scene::budget::viewer_memory_estimate(1, 1).max(1);
-        let max_pixels = (limit.bytes / per_pixel).max(1) as f64;
-        let k = (self.max_side as f64 / w.max(h) as f64)
-            .min((max_pixels / (w as f64 * h as f64)).sqrt())
-            .min(1.0);
-        let mut render_scene = self.edit.clone();
-        (render_scene.render.width, render_scene.render.height) = (w, h);
-        if k < 1.0 && self.prefs.pane_size && self.pane_px.is_some() {
-            // A pane larger than the GPU or the budget allows: render fewer pixels, scaled up.
-            render_scene.render.width = ((w as f64 * k) as u32).max(1);
-            render_scene.render.height = ((h as f64 * k) as u32).max(1);
-        } else if k < 1.0 {
-            let (nw, nh) = (
-                ((w as f64 * k) as u32).max(1),
-                ((h as f64 * k) as u32).max(1),
-            );
-            self.error(format!(
-                "the viewer shows at most {} pixels across and {:.0} MiB of buffers ({}): showing {w}x{h} at {nw}x{nh}; `raytree render` renders the full size",
-                self.max_side,
-                limit.bytes as f64 / (1 << 20) as f64,
-                limit.source
-            ));
-            self.edit.render.width = nw;
-            self.edit.render.height = nh;
-            self.scene_size = (nw, nh);
-            (render_scene.render.width, render_scene.render.height) = (nw, nh);
+        let pane = self.pane_px.filter(|_| self.prefs.pane_size);
+        let fit = opening::fit_render(self.scene_size, pane, self.max_side);
+        if let Some(message) = fit.message {
+            self.error(message);
         }
+        (self.edit.render.width, self.edit.render.height) = fit.scene;
+        self.scene_size = fit.scene;
+        let mut render_scene = self.edit.clone();
+        (render_scene.render.width, render_scene.render.height) = fit.render;
         let scene = Arc::new(render_scene);
         let target = self.viewer_target();
         let focus = self.hover.map(|(x, y)| (x as f32, y as f32));
@@ -606,37 +616,153 @@ impl ViewerApp {
         self.watch.as_ref().is_some_and(watch::SceneWatch::pending)
     }
 
-    /// Reloads the open scene after a save. Same geometry: the camera (as moved in the viewer)
-    /// and the clicked trees stay, and the accelerator is kept. A broken save: its error, and
-    /// the last good scene stays.
+    /// Reloads the open scene after a save, in the background like an open. Same geometry:
+    /// the camera (as moved in the viewer) and the clicked trees stay, and the accelerator is
+    /// kept. A broken save: its error, and the last good scene stays.
     fn reload(&mut self) {
-        let Some(path) = self.edit.source.clone() else {
+        if let Some(path) = self.edit.source.clone() {
+            self.start_open(path, true);
+        }
+    }
+
+    /// Opens `path` (or reloads it after a save, `reload`) in the background: read, parse and
+    /// build off the UI thread, the scene shown staying up until the new one is ready. Cancels
+    /// an open already under way (its result is never installed).
+    fn start_open(&mut self, path: PathBuf, reload: bool) {
+        self.cancel_open();
+        if !reload {
+            // The old scene's saves must not reload it over the file being opened.
+            self.watch = None;
+        }
+        let request = opening::Request {
+            path,
+            settings: self.settings.trace,
+            pane: self.pane_px.filter(|_| self.prefs.pane_size),
+            max_side: self.max_side,
+            reload: reload.then(|| (self.tracer.clone(), self.edit.camera.clone())),
+            hook: self.open_hook.clone(),
+        };
+        match opening::OpenJob::start(request) {
+            Ok(job) => self.opening = Some(job),
+            Err(e) => {
+                self.error(e);
+                self.watch_scene();
+            }
+        }
+    }
+
+    /// Cancels the open under way, if any.
+    fn cancel_open(&mut self) {
+        if let Some(job) = self.opening.take() {
+            job.cancel();
+        }
+    }
+
+    /// Sets (or with `None` removes) the hook every background open calls at each stage, on
+    /// its thread; takes effect at the next open.
+    pub fn set_open_hook(&mut self, hook: Option<Arc<opening::OpenHook>>) {
+        self.open_hook = hook;
+    }
+
+    /// The file being opened in the background, if any.
+    pub fn opening(&self) -> Option<&Path> {
+        self.opening.as_ref().map(|j| j.path.as_path())
+    }
+
+    /// What the status bar says of the open under way, and its percentage (below 100 until
+    /// the new scene is installed): "loading FILE… n %", then "building BVH… n %".
+    pub fn open_status(&mut self) -> Option<(String, f32)> {
+        let rates = self.rates;
+        let job = self.opening.as_mut()?;
+        let percent = job.percent(&rates);
+        let name = job
+            .path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let label = match job.stage() {
+            opening::OpenStage::Read | opening::OpenStage::Parse => {
+                format!("loading {name}… {percent:.0} %")
+            }
+            opening::OpenStage::Build | opening::OpenStage::Ready => {
+                format!("building BVH… {percent:.0} %")
+            }
+        };
+        Some((label, percent))
+    }
+
+    /// Takes the result of the background open, when it is ready.
+    fn poll_open(&mut self) {
+        let Some(outcome) = self.opening.as_ref().and_then(opening::OpenJob::try_take) else {
             return;
         };
-        match scene::load_scene_file(&path) {
-            Ok(mut s) => {
-                let same_geometry =
-                    s.triangles == self.edit.triangles && s.spheres == self.edit.spheres;
-                for w in &s.warnings {
-                    self.messages.push((false, w.clone()));
-                }
-                self.messages
-                    .push((false, format!("reloaded {} after a save", path.display())));
-                if same_geometry {
-                    s.camera = self.edit.camera.clone();
-                    self.edit = s;
-                    self.watch_scene();
-                    self.restart(false);
-                } else {
-                    self.replace_scene(s, path.display().to_string());
-                    self.watch_scene();
-                    self.restart(true);
-                }
-            }
-            Err(e) => self.error(format!(
+        let Some(job) = self.opening.take() else {
+            return;
+        };
+        let path = job.path.clone();
+        match outcome {
+            opening::Outcome::Opened(opened) => self.install_opened(&path, job.reload, *opened),
+            // The message names the file, place and field; the old scene stays.
+            opening::Outcome::Failed(e) if job.reload => self.error(format!(
                 "{e} (after a save; the last good scene stays until the file loads again)"
             )),
+            opening::Outcome::Failed(e) => {
+                self.error(e);
+                // The scene shown is watched again.
+                self.watch_scene();
+            }
         }
+    }
+
+    /// Makes an opened (or reloaded) scene the one shown and rendered.
+    fn install_opened(&mut self, path: &Path, reload: bool, opened: opening::Opened) {
+        let opening::Opened {
+            edit,
+            tracer,
+            fit,
+            same_geometry,
+            timings,
+        } = opened;
+        if same_geometry {
+            for w in &edit.warnings {
+                self.messages.push((false, w.clone()));
+            }
+            // The camera as it is now (it may have moved while the file was read), the
+            // accelerator shown kept: rendered as any edit is.
+            let camera = self.edit.camera.clone();
+            self.edit = edit;
+            self.edit.camera = camera;
+            self.messages
+                .push((false, format!("reloaded {} after a save", path.display())));
+            self.rates.learn(&timings);
+            self.last_open = Some(timings);
+            self.watch_scene();
+            self.restart(false);
+            return;
+        } else {
+            self.replace_scene(edit, path.display().to_string());
+        }
+        if reload {
+            self.messages
+                .push((false, format!("reloaded {} after a save", path.display())));
+        }
+        if let Some(message) = fit.message {
+            self.error(message);
+        }
+        self.scene_size = fit.scene;
+        self.rates.learn(&timings);
+        self.last_open = Some(timings);
+        self.watch_scene();
+        self.pending_build = None;
+        let target = self.viewer_target();
+        let focus = self.hover.map(|(x, y)| (x as f32, y as f32));
+        self.generation = self.session.start(tracer.clone(), target, focus);
+        self.progress = Progress {
+            started: Some(Instant::now()),
+            pass_label: "preview".into(),
+            ..Progress::default()
+        };
+        self.install_tracer(tracer, true);
     }
 
     /// Takes the tiles that arrived, within a time budget so the UI stays responsive.
@@ -644,13 +770,20 @@ impl ViewerApp {
         if self.watch.as_mut().is_some_and(watch::SceneWatch::poll) {
             self.reload();
         }
+        self.poll_open();
         // A tracer built off the UI thread comes before its generation's first tile.
         if let Some(tracer) = self.session.take_built() {
             let scene_view = self.pending_build.take().unwrap_or(true);
             self.install_tracer(tracer, scene_view);
             self.progress.pass_label = "preview".into();
         } else if let Some(t) = self.session.building_for() {
-            self.progress.pass_label = format!("building BVH… {:.1} s", t.as_secs_f64());
+            // obvhs reports no progress: the time so far against the estimate at this run's
+            // measured rate, held below 100 % until the build is handed over.
+            let estimate = self.rates.build_secs(self.edit.triangles.len() as u64);
+            let percent = (100.0 * t.as_secs_f64() / estimate.max(1e-3)).min(99.0);
+            let percent = self.progress.build_percent.max(percent);
+            self.progress.build_percent = percent;
+            self.progress.pass_label = format!("building BVH… {percent:.0} %");
         }
         self.scene_view.poll();
         let budget = Instant::now();
@@ -731,18 +864,12 @@ impl ViewerApp {
                     restart = true;
                     rebuild = true;
                 }
-                Command::OpenFile(path) => match scene::load_scene_file(&path) {
-                    Ok(s) => {
-                        self.replace_scene(s, path.display().to_string());
-                        self.watch_scene();
-                        rebuild = true;
-                        restart = true;
-                    }
-                    // The message names the file, place and field; the old scene stays.
-                    Err(e) => self.error(e.to_string()),
-                },
+                // Read, parsed and built in the background ([`opening`]).
+                Command::OpenFile(path) => self.start_open(path, false),
                 Command::OpenBuiltin(name) => match scene::builtin::load_builtin(&name) {
                     Ok(s) => {
+                        // Built-in scenes are tiny: opened at once, superseding any open.
+                        self.cancel_open();
                         self.replace_scene(s, name);
                         self.watch = None;
                         rebuild = true;
@@ -818,10 +945,26 @@ impl ViewerApp {
                     restart = true;
                 }
                 Command::Stop => {
+                    // Esc stops an open under way too; the scene shown stays (and is watched).
+                    if let Some(job) = self.opening.take() {
+                        job.cancel();
+                        self.messages
+                            .push((false, format!("stopped opening {}", job.path.display())));
+                        self.watch_scene();
+                    }
                     self.session.stop();
                     self.generation = self.session.generation();
                 }
             }
+        }
+        // An accelerator change while a file opens: the open starts again with it (the
+        // first one is cancelled and never installed).
+        if rebuild
+            && let Some(job) = &self.opening
+            && job.accel != self.settings.trace.accel
+        {
+            let (path, reload) = (job.path.clone(), job.reload);
+            self.start_open(path, reload);
         }
         if restart {
             self.restart_views(rebuild, !camera_only);

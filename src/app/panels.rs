@@ -41,6 +41,7 @@ pub mod tips {
     pub const ORBIT: &str =
         "How far a drag across the whole image turns the camera (the same rate up and down).";
     pub const LIGHT_POSITION: &str = "Where the point light is: shadow rays are shot from each hit towards it. Drag the light's marker in the scene view to move it.";
+    pub const LIGHT_FOLLOW: &str = "A headlight: the light stands at the render camera's eye and moves with it, so what the camera sees is lit (saved as `follow_camera = true`).";
     pub const LIGHT_COLOUR: &str = "The light's colour and intensity: multiplies the diffuse and specular terms of every point it lights.";
     pub const LIGHT_RADIUS: &str = "0: a point light with hard shadows; larger: an area light whose shadow rays go to random points on it (soft shadows, needs more samples).";
     pub const KA: &str = "ka, ambient coefficient: the share of the ambient light Ia the surface returns (I_ambient = ka·Ia), shown even in shadow.";
@@ -234,6 +235,14 @@ pub fn top_bar(app: &mut ViewerApp, ui: &mut Ui) {
 
 pub fn status_bar(app: &mut ViewerApp, ui: &mut Ui) {
     egui::Panel::bottom("status").show(ui, |ui| {
+        if let Some((label, percent)) = app.open_status() {
+            // The open runs in the background; the scene shown stays usable meanwhile.
+            ui.horizontal(|ui| {
+                ui.add(egui::ProgressBar::new(percent / 100.0).desired_width(220.0));
+                ui.strong(label);
+                ui.weak("(the scene shown stays until the new one is ready)");
+            });
+        }
         let target = app.viewer_target();
         let stats = app.session.stats().counts();
         let elapsed = match (app.progress.finished_secs, app.progress.started) {
@@ -429,10 +438,37 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                     .id_salt(("light", i))
                     .default_open(selected)
                     .show(ui, |ui| {
-                        restart |=
-                            vec3_edit(ui, "position", &mut l.position, 0.05, tips::LIGHT_POSITION);
+                        if ui
+                            .checkbox(&mut l.follow_camera, "follows the camera")
+                            .on_hover_text(tips::LIGHT_FOLLOW)
+                            .changed()
+                        {
+                            // A headlight is a point light (a ball around the eye would hide
+                            // the scene).
+                            if l.follow_camera {
+                                l.radius = 0.0;
+                            }
+                            restart = true;
+                        }
+                        if l.follow_camera {
+                            ui.label(format!(
+                                "at the camera's eye ({:.2}, {:.2}, {:.2})",
+                                l.position.x, l.position.y, l.position.z
+                            ));
+                        } else {
+                            restart |= vec3_edit(
+                                ui,
+                                "position",
+                                &mut l.position,
+                                0.05,
+                                tips::LIGHT_POSITION,
+                            );
+                        }
                         restart |= color_edit(ui, "colour", &mut l.color, tips::LIGHT_COLOUR);
                         ui.horizontal(|ui| {
+                            if l.follow_camera {
+                                ui.disable();
+                            }
                             restart |= drag(
                                 ui,
                                 "radius",
@@ -466,6 +502,7 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                     position: pos,
                     color: Vec3::ONE,
                     radius: 0.0,
+                    follow_camera: false,
                 });
                 restart = true;
             }

@@ -75,6 +75,10 @@ pub struct RenderArgs {
     /// Turntable frames A to B−1 (A..B, B excluded, as in Rust), for a node that takes several.
     #[arg(long, requires = "turntable", value_parser = frame_range_arg, value_name = "A..B")]
     frame_range: Option<Range<u32>>,
+    /// Put the camera's eye here, X,Y,Z (it keeps looking at its `look_at`); lights with
+    /// `follow_camera = true` move with it.
+    #[arg(long, value_name = "X,Y,Z", value_parser = super::tree::parse_vec3, allow_hyphen_values = true)]
+    eye: Option<glam::Vec3>,
     #[command(flatten)]
     overrides: SceneOverrides,
 }
@@ -86,6 +90,13 @@ pub fn run_render(args: &RenderArgs) -> Result<()> {
     let load_secs = load_start.elapsed().as_secs_f64();
     print_warnings(&scene);
     let trace = apply_overrides(&mut scene, &args.overrides);
+    if let Some(eye) = args.eye {
+        scene.camera.position = eye;
+        if let Err(v) = rules::check_camera(&scene.camera) {
+            bail!("--eye {eye}: the camera's `{}` {}", v.field, v.phrase);
+        }
+        scene.place_lights();
+    }
     if let Some(s) = args.samples {
         scene.render.samples = s;
     }
@@ -248,6 +259,7 @@ fn frame_list(args: &RenderArgs) -> Result<Vec<Option<(u32, u32)>>> {
 pub fn turn(scene: &mut Scene, i: u32, n: u32) {
     let angle = std::f64::consts::TAU * f64::from(i) / f64::from(n);
     scene.camera.orbit(angle as f32, 0.0);
+    scene.place_lights();
 }
 
 /// The output name of turntable frame `i`: `{frame}` replaced by the 4-digit number, or

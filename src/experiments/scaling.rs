@@ -120,6 +120,7 @@ pub fn scaling_scene(triangles_wanted: usize, width: u32, height: u32) -> Scene 
             position: Vec3::new(3.0, 4.0, 5.0),
             color: Vec3::ONE,
             radius: 0.0,
+            follow_camera: false,
         }],
         materials: vec![Material::default()],
         objects: vec![Object {

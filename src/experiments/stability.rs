@@ -1165,6 +1165,7 @@ pub fn smooth_mesh_scene(
             position: light,
             color: Vec3::ONE,
             radius: 0.0,
+            follow_camera: false,
         }],
         ..Scene::default()
     };

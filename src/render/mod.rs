@@ -224,7 +224,7 @@ pub fn preview_tile(
     block: u32,
     counts: &mut RayCounts,
 ) -> (Vec<Vec3>, Vec<SampleInfo>) {
-    preview_with(tracer, rect, block, |centres, out| {
+    preview_with(frame, rect, block, |centres, out| {
         let mut rays = [crate::geometry::Ray::new(Vec3::ZERO, Vec3::Z); PACKET_RAYS];
         let mut traced = [(Vec3::ZERO, SampleInfo::default()); PACKET_RAYS];
         for (chunk, outs) in centres.chunks(PACKET_RAYS).zip(out.chunks_mut(PACKET_RAYS)) {
@@ -246,24 +246,24 @@ pub fn preview_tile_single(
     block: u32,
     counts: &mut RayCounts,
 ) -> (Vec<Vec3>, Vec<SampleInfo>) {
-    preview_with(tracer, rect, block, |centres, out| {
+    preview_with(frame, rect, block, |centres, out| {
         for (o, &(x, y)) in out.iter_mut().zip(centres) {
             *o = trace_sample(tracer, frame, x, y, 0, counts);
         }
     })
 }
 
-/// The block centres of a preview of `rect` (clamped to the tracer's image), in packets of
+/// The block centres of a preview of `rect` (clamped to the frame's image), in packets of
 /// [`PACKET_BLOCK`] blocks (block rows and columns), traced by `trace` (centres in, sample
 /// colour and facts out), copied to their blocks.
 fn preview_with(
-    tracer: &Tracer,
+    frame: &CameraFrame,
     rect: Rect,
     block: u32,
     trace: impl FnOnce(&[(u32, u32)], &mut [(Vec3, SampleInfo)]),
 ) -> (Vec<Vec3>, Vec<SampleInfo>) {
     let block = block.max(1);
-    let (w, h) = (tracer.scene.render.width, tracer.scene.render.height);
+    let (w, h) = frame.size();
     let (cols, rows) = (rect.width.div_ceil(block), rect.height.div_ceil(block));
     let (bw, bh) = PACKET_BLOCK;
     // Block coordinates in packet order, and their centres in image coordinates.

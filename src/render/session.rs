@@ -20,7 +20,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::{Rect, TILE_SIZE, accumulate_tile, panic_message, tiles};
-use crate::scene::{CameraFrame, Scene};
+use crate::scene::{Camera, CameraFrame, Scene};
 use crate::trace::{RayCounts, SampleInfo, TraceSettings, Tracer};
 
 /// Side of the blocks of the coarse preview pass.
@@ -217,7 +217,14 @@ impl Session {
     /// (pixels; `None`: the image centre) first. Returns the new generation; when its thread
     /// cannot be spawned, that generation's first event is [`SessionEvent::Failed`].
     pub fn start(&mut self, tracer: Arc<Tracer>, target: u32, focus: Option<(f32, f32)>) -> u64 {
-        self.spawn(Source::Ready(tracer), target, focus)
+        self.spawn(Source::Ready(tracer), None, target, focus)
+    }
+
+    /// Like [`Self::start`], but seen through `view` (its own camera and size) instead of the
+    /// scene's camera and `[render]` size: the scene view renders the render's scene this way,
+    /// sharing it (and its accelerator) instead of copying a million triangles per orbit.
+    pub fn start_view(&mut self, tracer: Arc<Tracer>, view: View, target: u32) -> u64 {
+        self.spawn(Source::Ready(tracer), Some(view), target, None)
     }
 
     /// Like [`Self::start`], but first builds the tracer (its accelerator) of `scene` on the
@@ -234,7 +241,7 @@ impl Session {
         target: u32,
         focus: Option<(f32, f32)>,
     ) -> u64 {
-        let generation = self.spawn(Source::Build(scene, settings), target, focus);
+        let generation = self.spawn(Source::Build(scene, settings), None, target, focus);
         self.building.set(Some((generation, Instant::now())));
         generation
     }
@@ -261,7 +268,13 @@ impl Session {
         }
     }
 
-    fn spawn(&mut self, source: Source, target: u32, focus: Option<(f32, f32)>) -> u64 {
+    fn spawn(
+        &mut self,
+        source: Source,
+        view: Option<View>,
+        target: u32,
+        focus: Option<(f32, f32)>,
+    ) -> u64 {
         let generation = self.stop();
         self.start_failure.set(None);
         self.building.set(None);
@@ -301,8 +314,14 @@ impl Session {
                     }
                 }
             };
+            let view = view.unwrap_or_else(|| View {
+                camera: tracer.scene.camera.clone(),
+                width: tracer.scene.render.width,
+                height: tracer.scene.render.height,
+            });
             let job = Job {
                 tracer,
+                view,
                 target: target.max(1),
                 focus,
                 generation,
@@ -376,6 +395,14 @@ impl Session {
 /// Where the coordinator leaves a built tracer, with its generation.
 type BuiltSlot = Mutex<Option<(u64, Arc<Tracer>)>>;
 
+/// A camera and an image size to render a scene through, other than its own.
+#[derive(Clone, Debug, PartialEq)]
+pub struct View {
+    pub camera: Camera,
+    pub width: u32,
+    pub height: u32,
+}
+
 /// What a generation renders: a tracer, or a scene whose tracer is built first.
 enum Source {
     Ready(Arc<Tracer>),
@@ -392,6 +419,8 @@ fn build_pool(threads: usize) -> Result<rayon::ThreadPool, String> {
 
 struct Job {
     tracer: Arc<Tracer>,
+    /// The camera and size rendered (the scene's own, or the scene view's).
+    view: View,
     target: u32,
     focus: Option<(f32, f32)>,
     generation: u64,
@@ -417,9 +446,8 @@ impl Job {
 
     fn run(&self) {
         let start = Instant::now();
-        let scene = &self.tracer.scene;
-        let (w, h) = (scene.render.width, scene.render.height);
-        let frame = CameraFrame::new(&scene.camera, w, h);
+        let (w, h) = (self.view.width, self.view.height);
+        let frame = CameraFrame::new(&self.view.camera, w, h);
         let mut order = tiles(w, h, TILE_SIZE);
         if let Some((fx, fy)) = self.focus {
             let dist = |r: &Rect| {

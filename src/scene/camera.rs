@@ -67,6 +67,11 @@ impl CameraFrame {
 
     /// The primary ray through image position (`x`, `y`) in pixels, where pixel (i, j) covers
     /// `[i, i+1) × [j, j+1)` and its centre is (i + 0.5, j + 0.5).
+    /// The image's width and height in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        (self.width as u32, self.height as u32)
+    }
+
     pub fn ray(&self, x: f32, y: f32) -> Ray {
         let cx = (2.0 * x / self.width - 1.0) * self.aspect * self.tan_half_fov_y;
         let cy = (1.0 - 2.0 * y / self.height) * self.tan_half_fov_y;

@@ -23,6 +23,36 @@ pub fn open_scene_arg(arg: &str) -> Result<Scene, SceneError> {
 /// Loads a `.toml` scene or a bare `.obj` mesh (chosen by the extension, in any case). Meshes
 /// and material libraries are resolved relative to the file's folder. Sets [`Scene::source`].
 pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
+    match load_scene_file_watched(path, &mut |_| true)? {
+        Some(scene) => Ok(scene),
+        // The watcher above never stops the load.
+        None => Err(SceneError(format!(
+            "{}: the load was cancelled.",
+            path.display()
+        ))),
+    }
+}
+
+/// A step of [`load_scene_file_watched`], told as it happens.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LoadStep {
+    /// `done` of the file's `total` bytes are read.
+    Read { done: u64, total: u64 },
+    /// The file is read; parsing begins (for a scene file this also reads its meshes and
+    /// textures; for a bare OBJ it includes its materials and the first look).
+    Parse,
+}
+
+/// Bytes read between two [`LoadStep::Read`] reports (and cancel checks).
+const READ_CHUNK: usize = 4 << 20;
+
+/// [`load_scene_file`], telling `watch` of each [`LoadStep`]; when `watch` answers false (the
+/// caller cancelled), the load stops at that step and returns `Ok(None)`. The viewer opens
+/// files in the background this way, with progress, and drops a superseded open early.
+pub fn load_scene_file_watched(
+    path: &Path,
+    watch: &mut dyn FnMut(LoadStep) -> bool,
+) -> Result<Option<Scene>, SceneError> {
     let file = path.display().to_string();
     let extension = path
         .extension()
@@ -42,8 +72,18 @@ pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
     } else {
         MAX_SCENE_FILE_BYTES
     };
-    let text = read_text(path, max_bytes)
-        .map_err(|reason| SceneError(format!("{file}: cannot read the scene file: {reason}.")))?;
+    let text = match read_text_watched(path, max_bytes, watch) {
+        Ok(Some(text)) => text,
+        Ok(None) => return Ok(None),
+        Err(reason) => {
+            return Err(SceneError(format!(
+                "{file}: cannot read the scene file: {reason}."
+            )));
+        }
+    };
+    if !watch(LoadStep::Parse) {
+        return Ok(None);
+    }
     let folder = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let resolve = fs_resolver(folder.clone());
     let resolve_bytes = fs_bytes_resolver(folder);
@@ -57,7 +97,7 @@ pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
         load_scene_str_with_files(&text, &file, &resolve, &resolve_bytes)?
     };
     scene.source = Some(path.to_path_buf());
-    Ok(scene)
+    Ok(Some(scene))
 }
 
 /// Parses scene TOML; `name` stands for the file in messages. Meshes are resolved relative to
@@ -83,6 +123,16 @@ pub fn fs_resolver(folder: PathBuf) -> impl Fn(&str) -> Result<String, String> {
 /// carry Latin-1 comments). Only regular files are read: a device such as `/dev/zero` or a
 /// pipe would never end (or block), and a folder is never what was meant.
 fn read_text(path: &Path, max_bytes: u64) -> Result<String, String> {
+    read_text_watched(path, max_bytes, &mut |_| true).map(Option::unwrap_or_default)
+}
+
+/// [`read_text`] in chunks of [`READ_CHUNK`], telling `watch` the bytes read after each;
+/// `Ok(None)` when `watch` answers false.
+fn read_text_watched(
+    path: &Path,
+    max_bytes: u64,
+    watch: &mut dyn FnMut(LoadStep) -> bool,
+) -> Result<Option<String>, String> {
     use std::io::Read;
     let meta = std::fs::metadata(path).map_err(|e| os_reason(&e))?;
     if meta.is_dir() {
@@ -102,17 +152,34 @@ fn read_text(path: &Path, max_bytes: u64) -> Result<String, String> {
         return Err(too_big(meta.len()));
     }
     let file = std::fs::File::open(path).map_err(|e| os_reason(&e))?;
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    let total = meta.len();
+    let mut bytes = Vec::with_capacity(total as usize);
     // `take` also stops a file that grows while it is read.
-    file.take(max_bytes + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| os_reason(&e))?;
+    let mut reader = file.take(max_bytes + 1);
+    if !watch(LoadStep::Read { done: 0, total }) {
+        return Ok(None);
+    }
+    loop {
+        let n = (&mut reader)
+            .take(READ_CHUNK as u64)
+            .read_to_end(&mut bytes)
+            .map_err(|e| os_reason(&e))?;
+        if n == 0 {
+            break;
+        }
+        // A file that grew while it was read may pass its size: the report never goes past it.
+        let done = (bytes.len() as u64).min(total);
+        if !watch(LoadStep::Read { done, total }) {
+            return Ok(None);
+        }
+    }
     if bytes.len() as u64 > max_bytes {
         return Err(too_big(bytes.len() as u64));
     }
     // Valid UTF-8 is taken as it is, without the copy `from_utf8_lossy` would make.
-    Ok(String::from_utf8(bytes)
-        .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned()))
+    Ok(Some(String::from_utf8(bytes).unwrap_or_else(|e| {
+        String::from_utf8_lossy(e.as_bytes()).into_owned()
+    })))
 }
 
 /// The OS's reason without the platform-specific "(os error N)" tail, for stable messages.

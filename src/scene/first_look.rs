@@ -121,13 +121,15 @@ pub(crate) fn load_obj_scene(
         position: key,
         color: Vec3::splat(KEY),
         radius: 0.0,
+        follow_camera: false,
     });
-    // A headlight at the camera, as model viewers have: what the camera sees is lit.
+    // A headlight that follows the camera, as model viewers have: what the camera sees is lit.
     scene.lights.push(Light {
         name: "headlight".into(),
         position: camera.position,
         color: Vec3::splat(HEADLIGHT),
         radius: 0.0,
+        follow_camera: true,
     });
     if let Some(room) = look.room {
         scene.warnings.push(format!(

@@ -65,7 +65,7 @@ const RENDER_KEYS: &[&str] = &[
     "shading",
 ];
 const CAMERA_KEYS: &[&str] = &["position", "look_at", "up", "fov_y"];
-const LIGHT_KEYS: &[&str] = &["name", "position", "color", "radius"];
+const LIGHT_KEYS: &[&str] = &["name", "position", "color", "radius", "follow_camera"];
 const MATERIAL_KEYS: &[&str] = &[
     "name",
     "ambient",
@@ -238,12 +238,22 @@ impl SceneBuilder<'_> {
         let refs: Vec<&Section> = lights.iter().collect();
         let names = unique_names(&refs, "light", |i| Ok(format!("light {}", i + 1)))?;
         for (s, name) in lights.iter().zip(names) {
+            let follow_camera = s.boolean("follow_camera", false)?;
+            if follow_camera && let Some(v) = s.get("position") {
+                return Err(s.error(
+                    &v.span(),
+                    "position",
+                    "cannot be given with `follow_camera = true`: that light stands at the camera's eye",
+                ));
+            }
             let light = Light {
                 name,
-                // Without a position, a headlight: a light at the eye.
+                // Without a position, a light at the eye (where it stays only with
+                // `follow_camera`: see `Scene::place_lights`).
                 position: s.vec3("position", self.scene.camera.position)?,
                 color: s.color("color", Vec3::ONE)?,
                 radius: s.f32("radius", 0.0)?,
+                follow_camera,
             };
             rules::check_light(&light).map_err(|v| s.verdict(&v))?;
             self.scene.lights.push(light);

@@ -110,6 +110,11 @@ pub struct Light {
     pub position: Vec3,
     pub color: Vec3,
     pub radius: f32,
+    /// A headlight (SPEC §3b, `follow_camera = true`): it stands at the render camera's eye
+    /// wherever the camera goes; [`Scene::place_lights`] sets its `position`. Always a point
+    /// light (radius 0): a ball around the eye would swallow every camera ray.
+    #[serde(default)]
+    pub follow_camera: bool,
 }
 
 /// A Phong material; every coefficient is linear RGB.
@@ -358,6 +363,17 @@ impl Scene {
         }
         self.materials.push(Material::default());
         MaterialId(self.materials.len() as u32 - 1)
+    }
+
+    /// THE rule of lights that follow the camera (SPEC §3b): each stands at the render
+    /// camera's eye. Whatever sets the camera (the loader, `raytree render --eye`, a turntable
+    /// frame, the viewer before each render) calls this, so the image, its tiles, the ray trees
+    /// and the scene view all see the light at the same place. Idempotent; other lights stay.
+    pub fn place_lights(&mut self) {
+        let eye = self.camera.position;
+        for light in self.lights.iter_mut().filter(|l| l.follow_camera) {
+            light.position = eye;
+        }
     }
 
     pub fn material(&self, id: MaterialId) -> &Material {

@@ -188,7 +188,15 @@ pub fn check_camera(c: &Camera) -> Result<(), Violation> {
 pub fn check_light(l: &Light) -> Result<(), Violation> {
     vector("position", l.position, COORDINATE)?;
     vector("color", l.color, NON_NEGATIVE)?;
-    number("radius", 0, l.radius, LIGHT_RADIUS)
+    number("radius", 0, l.radius, LIGHT_RADIUS)?;
+    // A ball around the eye would end every camera ray at once.
+    let headlight: Rule = |x| {
+        (x != 0.0).then_some("must be 0 for a light that follows the camera (a ball around the eye would hide the scene)")
+    };
+    if l.follow_camera {
+        number("radius", 0, l.radius, headlight)?;
+    }
+    Ok(())
 }
 
 /// `[[material]]`.
@@ -400,6 +408,7 @@ mod tests {
             position: Vec3::ZERO,
             color: Vec3::new(1.0, f32::NAN, 1.0),
             radius: 0.0,
+            follow_camera: false,
         });
         assert_eq!(
             check_scene(&s, false),

@@ -36,7 +36,12 @@ pub fn scene_to_toml(scene: &Scene) -> String {
     for l in &scene.lights {
         out += "\n[[light]]\n";
         line(&mut out, "name", string(&l.name));
-        line(&mut out, "position", vec3(l.position));
+        if l.follow_camera {
+            // It stands at the camera's eye: its position is the camera's.
+            line(&mut out, "follow_camera", "true");
+        } else {
+            line(&mut out, "position", vec3(l.position));
+        }
         line(&mut out, "color", color(l.color));
         line(&mut out, "radius", float(l.radius));
     }

@@ -206,6 +206,17 @@ impl<'s, 't, 'i> Section<'s, 't, 'i> {
         self.scalar_or_vec3(key, default, "a number or an array [r, g, b]")
     }
 
+    /// `true` or `false`.
+    pub(crate) fn boolean(&self, key: &str, default: bool) -> Result<bool, SceneError> {
+        match self.get(key) {
+            None => Ok(default),
+            Some(v) => match v.get_ref() {
+                DeValue::Boolean(b) => Ok(*b),
+                _ => Err(self.type_error(key, v, "true or false")),
+            },
+        }
+    }
+
     /// A whole number in `range`.
     pub(crate) fn uint(
         &self,

@@ -286,6 +286,7 @@ mod tests {
                 position: Vec3::new(x, 0.0, 0.0),
                 color: Vec3::ONE,
                 radius,
+                follow_camera: false,
             });
         }
         let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());

@@ -48,6 +48,7 @@ impl Build {
             position,
             color,
             radius: 0.0,
+            follow_camera: false,
         });
         self
     }
@@ -106,6 +107,7 @@ impl Build {
             position,
             color,
             radius,
+            follow_camera: false,
         });
         self
     }

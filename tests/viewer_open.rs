@@ -1,0 +1,433 @@
+//! Opening a file never freezes the viewer (issue 14.5): the read, the parse and the build run
+//! in the background while the previous scene stays up and usable; a second open cancels the
+//! first, which never installs; the progress only goes up and stays below 100 % until the new
+//! scene is in; a headlight follows the camera without a rebuild. Headless
+//! (`ViewerApp::headless`), the open held at a stage boundary by the open hook; the window
+//! case drives the real app through egui_kittest (`WGPU_BACKEND=vulkan XDG_RUNTIME_DIR=...`).
+
+use std::panic::AssertUnwindSafe;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Condvar, Mutex};
+use std::time::{Duration, Instant};
+
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use raytree::accel::AccelKind;
+use raytree::app::opening::OpenStage;
+use raytree::app::{Command, ViewerApp};
+use raytree::scene::Scene;
+use raytree::scene::builtin::load_builtin;
+use raytree::scene::procedural::bumpy_torus_obj;
+use raytree::trace::TraceSettings;
+
+/// Holds background opens at one stage boundary until told to let go, and records the
+/// stages they reached.
+#[derive(Default)]
+struct Gate {
+    hold: Mutex<Option<OpenStage>>,
+    released: Condvar,
+    seen: Mutex<Vec<OpenStage>>,
+}
+
+impl Gate {
+    fn new(hold: Option<OpenStage>) -> Arc<Self> {
+        let gate = Arc::new(Self::default());
+        *gate.hold.lock().expect("gate") = hold;
+        gate
+    }
+
+    fn install(self: &Arc<Self>, app: &mut ViewerApp) {
+        let gate = self.clone();
+        app.set_open_hook(Some(Arc::new(move |stage| {
+            gate.seen.lock().expect("gate").push(stage);
+            let mut hold = gate.hold.lock().expect("gate");
+            // Held for at most a minute: a test that forgets to let go fails instead of hanging.
+            let deadline = Instant::now() + Duration::from_secs(60);
+            while *hold == Some(stage) && Instant::now() < deadline {
+                hold = gate
+                    .released
+                    .wait_timeout(hold, Duration::from_millis(50))
+                    .expect("gate")
+                    .0;
+            }
+        })));
+    }
+
+    fn hold_at(&self, stage: Option<OpenStage>) {
+        *self.hold.lock().expect("gate") = stage;
+        self.released.notify_all();
+    }
+
+    fn count(&self, stage: OpenStage) -> usize {
+        self.seen
+            .lock()
+            .expect("gate")
+            .iter()
+            .filter(|s| **s == stage)
+            .count()
+    }
+}
+
+fn small_default() -> Scene {
+    let mut s = load_builtin("default").expect("built-in scene");
+    (s.render.width, s.render.height, s.render.samples) = (96, 72, 4);
+    s
+}
+
+fn headless(scene: Scene) -> ViewerApp {
+    let samples = scene.render.samples;
+    let mut app = ViewerApp::headless(scene, "default".into()).expect("the viewer starts");
+    app.set_view(samples, false);
+    app.apply();
+    app
+}
+
+/// One UI frame without a window: what `ui` does around the panels.
+fn frame(app: &mut ViewerApp) {
+    app.poll_session();
+    app.apply();
+    std::thread::sleep(Duration::from_millis(2));
+}
+
+/// Frames until `done`; a hang guard, not a measure of speed.
+fn frames_until(app: &mut ViewerApp, what: &str, done: impl Fn(&ViewerApp) -> bool) {
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while !done(app) {
+        assert!(Instant::now() < deadline, "{what}: timed out");
+        frame(app);
+    }
+}
+
+fn write_obj(dir: &Path, name: &str, triangles: usize) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, bumpy_torus_obj(triangles)).expect("the OBJ is written");
+    path
+}
+
+/// The open's percentage each frame: never back, below 100 while it runs.
+struct Watch(f32);
+
+impl Watch {
+    fn check(&mut self, app: &mut ViewerApp) {
+        if let Some((label, percent)) = app.open_status() {
+            assert!(percent >= self.0, "{percent} % after {} %", self.0);
+            assert!(percent < 100.0, "{label} before the scene is in");
+            assert!(
+                label.starts_with("loading ") || label.starts_with("building BVH… "),
+                "{label}"
+            );
+            assert!(label.ends_with(" %"), "{label}");
+            self.0 = percent;
+        }
+    }
+}
+
+#[test]
+fn an_open_held_in_the_background_leaves_the_old_scene_usable_then_installs() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let obj = write_obj(dir.path(), "torus.obj", 20_000);
+    let mut app = headless(small_default());
+    frames_until(&mut app, "first render", ViewerApp::is_finished);
+    let old_triangles = app.scene().triangles.len();
+    let gate = Gate::new(Some(OpenStage::Parse));
+    gate.install(&mut app);
+
+    app.command(Command::OpenFile(obj.clone()));
+    app.apply();
+    assert_eq!(app.opening(), Some(obj.as_path()));
+    let mut watch = Watch(0.0);
+    // Held before the parse: the UI goes on with the old scene.
+    let generation = app.generation();
+    for _ in 0..20 {
+        frame(&mut app);
+        watch.check(&mut app);
+    }
+    assert_eq!(app.scene().source, None, "the old (built-in) scene stays");
+    assert_eq!(app.scene().triangles.len(), old_triangles);
+    let (label, _) = app.open_status().expect("still opening");
+    assert!(label.starts_with("loading torus.obj… "), "{label}");
+    // The old scene is usable: a click gives its tree, a camera move renders it again.
+    app.command(Command::Pick(48, 36));
+    app.edit.camera.position.x += 0.2;
+    app.command(Command::MoveCamera);
+    app.apply();
+    assert!(app.tree.is_some(), "a tree of the old scene");
+    assert!(app.generation() > generation, "the old scene re-renders");
+    let moved = app.generation();
+    frames_until(&mut app, "the old scene's first pass", |a| {
+        a.samples_done() >= 1 && a.generation() == moved
+    });
+    watch.check(&mut app);
+
+    // Let it parse, hold it before the build.
+    gate.hold_at(Some(OpenStage::Build));
+    frames_until(&mut app, "the parse", |_| gate.count(OpenStage::Build) == 1);
+    for _ in 0..10 {
+        frame(&mut app);
+        watch.check(&mut app);
+    }
+    let (label, _) = app.open_status().expect("still opening");
+    assert!(label.starts_with("building BVH… "), "{label}");
+    assert_eq!(app.scene().source, None, "not installed before it is built");
+
+    gate.hold_at(None);
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while app.opening().is_some() {
+        assert!(Instant::now() < deadline, "the install timed out");
+        watch.check(&mut app);
+        frame(&mut app);
+    }
+    assert_eq!(app.scene().source.as_deref(), Some(obj.as_path()));
+    assert!(app.scene().triangles.len() > 10_000);
+    assert!(app.tree.is_none(), "the old scene's trees went with it");
+    let names: Vec<&str> = app.scene().lights.iter().map(|l| l.name.as_str()).collect();
+    assert_eq!(names, ["key", "headlight"]);
+    frames_until(&mut app, "the new scene's render", ViewerApp::is_finished);
+    assert!(app.samples_done() >= 1);
+    let timings = app.last_open.expect("the open's times");
+    assert!(timings.built && timings.triangles > 10_000, "{timings:?}");
+}
+
+#[test]
+fn a_second_open_cancels_the_first_which_never_installs() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let first = write_obj(dir.path(), "first.obj", 3_000);
+    let second = write_obj(dir.path(), "second.obj", 2_000);
+    let mut app = headless(small_default());
+    let gate = Gate::new(Some(OpenStage::Parse));
+    gate.install(&mut app);
+
+    app.command(Command::OpenFile(first.clone()));
+    app.apply();
+    frames_until(&mut app, "the first open's read", |_| {
+        gate.count(OpenStage::Parse) == 1
+    });
+    app.command(Command::OpenFile(second.clone()));
+    app.apply();
+    assert_eq!(app.opening(), Some(second.as_path()));
+    frames_until(&mut app, "the second open's read", |_| {
+        gate.count(OpenStage::Parse) == 2
+    });
+    // Both let go at once: the first stops at its boundary, the second goes on.
+    gate.hold_at(None);
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while app.opening().is_some() || !app.is_finished() {
+        assert!(Instant::now() < deadline, "the second open did not finish");
+        frame(&mut app);
+        assert_ne!(
+            app.scene().source.as_deref(),
+            Some(first.as_path()),
+            "the cancelled open was installed"
+        );
+    }
+    assert_eq!(app.scene().source.as_deref(), Some(second.as_path()));
+    // Give a straggler time to show up: the first never reaches the build nor installs.
+    for _ in 0..50 {
+        frame(&mut app);
+    }
+    assert_eq!(app.scene().source.as_deref(), Some(second.as_path()));
+    assert_eq!(
+        gate.count(OpenStage::Build),
+        1,
+        "only the second open built"
+    );
+    assert_eq!(gate.count(OpenStage::Ready), 1);
+}
+
+#[test]
+fn an_accelerator_change_mid_open_starts_it_again_with_that_accelerator() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let obj = write_obj(dir.path(), "grid.obj", 3_000);
+    let mut app = headless(small_default());
+    let gate = Gate::new(Some(OpenStage::Build));
+    gate.install(&mut app);
+    app.command(Command::OpenFile(obj.clone()));
+    app.apply();
+    frames_until(&mut app, "the parse", |_| gate.count(OpenStage::Build) == 1);
+    app.set_trace(TraceSettings {
+        accel: AccelKind::Grid,
+        ..TraceSettings::default()
+    });
+    app.apply();
+    assert_eq!(app.opening(), Some(obj.as_path()), "opening again");
+    gate.hold_at(None);
+    frames_until(&mut app, "the open", |a| {
+        a.opening().is_none() && a.is_finished()
+    });
+    assert_eq!(app.scene().source.as_deref(), Some(obj.as_path()));
+    assert_eq!(app.accel().kind(), AccelKind::Grid);
+    assert_eq!(
+        gate.count(OpenStage::Ready),
+        1,
+        "the first open, cancelled at its build, never finished"
+    );
+}
+
+#[test]
+fn a_broken_file_opened_in_the_background_is_one_sentence_and_the_scene_stays() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let bad = dir.path().join("bad.obj");
+    std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nf 1 2 9\n").expect("write");
+    let mut app = headless(small_default());
+    app.command(Command::OpenFile(bad.clone()));
+    app.apply();
+    frames_until(&mut app, "the open", |a| a.opening().is_none());
+    let (error, message) = app.messages.last().cloned().expect("a message");
+    assert!(error, "{message}");
+    let direct = raytree::scene::load_scene_file(&bad)
+        .expect_err("the file is broken")
+        .to_string();
+    assert_eq!(message, direct, "the loader's one sentence, as before");
+    assert_eq!(app.scene().source, None, "the old scene stays");
+}
+
+#[test]
+fn a_moved_camera_moves_the_headlight_without_a_rebuild() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let obj = write_obj(dir.path(), "lamp.obj", 2_000);
+    let mut app = headless(small_default());
+    app.command(Command::OpenFile(obj));
+    app.apply();
+    frames_until(&mut app, "the open", |a| {
+        a.opening().is_none() && a.is_finished()
+    });
+    let head = app
+        .scene()
+        .lights
+        .iter()
+        .position(|l| l.follow_camera)
+        .expect("a bare OBJ has a headlight");
+    assert_eq!(
+        app.scene().lights[head].position,
+        app.scene().camera.position
+    );
+    let accel = app.accel() as *const _;
+    app.edit.camera.orbit(0.8, 0.1);
+    app.command(Command::MoveCamera);
+    app.apply();
+    frames_until(&mut app, "the render", ViewerApp::is_finished);
+    let eye = app.scene().camera.position;
+    assert_eq!(
+        app.scene().lights[head].position,
+        eye,
+        "rendered at the new eye"
+    );
+    assert_eq!(
+        app.edit.lights[head].position, eye,
+        "the panel shows it there"
+    );
+    assert!(
+        std::ptr::eq(accel, app.accel()),
+        "the accelerator was kept (no rebuild)"
+    );
+    // The tree sees it there too.
+    app.command(Command::Pick(48, 36));
+    app.apply();
+    if let Some(shadow) = app
+        .tree
+        .as_ref()
+        .and_then(|t| t.root.shadow_rays.iter().find(|s| s.light == "headlight"))
+    {
+        let point = app
+            .tree
+            .as_ref()
+            .and_then(|t| t.root.hit.as_ref())
+            .expect("hit")
+            .point;
+        assert!(shadow.to_light.dot((eye - point).normalize()) > 0.9999);
+    }
+}
+
+/// The window while a file loads: frames keep coming, the status says what is loading.
+#[test]
+fn the_window_keeps_drawing_and_says_what_it_loads() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let obj = write_obj(dir.path(), "window.obj", 5_000);
+    let renderer =
+        std::panic::catch_unwind(AssertUnwindSafe(egui_kittest::wgpu::WgpuTestRenderer::new))
+            .unwrap_or_else(|_| panic!("no wgpu adapter: see tests/viewer.rs"));
+    let gate = Gate::new(Some(OpenStage::Parse));
+    let hook_gate = gate.clone();
+    let mut h: Harness<'static, ViewerApp> = Harness::builder()
+        .with_size(eframe::egui::vec2(1024.0, 640.0))
+        .renderer(renderer)
+        .build_eframe(move |cc| {
+            let mut app =
+                ViewerApp::new(cc, small_default(), "default".into()).expect("the viewer starts");
+            app.set_view(4, false);
+            hook_gate.install(&mut app);
+            app
+        });
+    h.run_steps(3);
+    h.state_mut().command(Command::OpenFile(obj.clone()));
+    let mut steps = 0;
+    for _ in 0..15 {
+        h.step();
+        steps += 1;
+    }
+    assert_eq!(steps, 15, "the window drew while the open was held");
+    assert!(h.state().opening().is_some());
+    h.get_by_label_contains("loading window.obj… ");
+    gate.hold_at(None);
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while h.state().opening().is_some() {
+        assert!(Instant::now() < deadline, "the open did not finish");
+        h.step();
+    }
+    assert_eq!(h.state().scene().source.as_deref(), Some(obj.as_path()));
+}
+
+/// The previous render keeps refining while a file opens, and does not hold the open back:
+/// the new scene comes in long before the old one would have converged.
+#[test]
+fn an_open_does_not_wait_for_the_previous_render_to_converge() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let obj = write_obj(dir.path(), "quick.obj", 3_000);
+    let mut scene = small_default();
+    (scene.render.width, scene.render.height) = (160, 120);
+    let mut app = ViewerApp::headless(scene, "default".into()).expect("the viewer starts");
+    // Thousands of samples of a glass scene: minutes of work for the render's workers.
+    app.set_view(4096, false);
+    app.apply();
+    frames_until(&mut app, "the first pass", |a| a.samples_done() >= 1);
+    app.command(Command::OpenFile(obj.clone()));
+    app.apply();
+    let deadline = Instant::now() + Duration::from_secs(300);
+    let mut old_samples = 0;
+    while app.opening().is_some() {
+        assert!(Instant::now() < deadline, "the open did not finish");
+        old_samples = app.samples_done();
+        frame(&mut app);
+    }
+    assert_eq!(app.scene().source.as_deref(), Some(obj.as_path()));
+    assert!(
+        old_samples < 4096,
+        "the open waited for the previous render to converge"
+    );
+}
+
+/// Esc (the Stop command) stops an open under way: it never installs, the scene shown stays.
+#[test]
+fn stopping_cancels_the_open() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let obj = write_obj(dir.path(), "stopped.obj", 2_000);
+    let mut app = headless(small_default());
+    let gate = Gate::new(Some(OpenStage::Parse));
+    gate.install(&mut app);
+    app.command(Command::OpenFile(obj.clone()));
+    app.apply();
+    frames_until(&mut app, "the read", |_| gate.count(OpenStage::Parse) == 1);
+    app.command(Command::Stop);
+    app.apply();
+    assert_eq!(app.opening(), None);
+    gate.hold_at(None);
+    for _ in 0..50 {
+        frame(&mut app);
+    }
+    assert_eq!(app.scene().source, None, "the stopped open never installs");
+    assert_eq!(
+        gate.count(OpenStage::Build),
+        0,
+        "it stopped before its build"
+    );
+}
