@@ -544,16 +544,54 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
             normals: has_normals.then_some((&attrs.normals[..], normal_base)),
             uvs: has_uvs.then_some((&attrs.uvs[..], uv_base)),
         };
-        // In parallel, in runs of faces kept in order.
-        let parts: Vec<FacePart> = (0..mesh.indices.len() / 3)
-            .into_par_iter()
-            .with_min_len(1 << 12)
-            .fold(FacePart::default, |mut part, k| {
-                faces.place(k, &mut part);
-                part
-            })
-            .collect();
-        let kept: usize = parts.iter().map(|p| p.vertices.len()).sum();
+        // In parallel, straight into the scene's list (then the dropped ones taken out): no
+        // per-thread lists, whose memory the allocator would keep after the load.
+        let count = mesh.indices.len() / 3;
+        let start = scene.triangles.len();
+        let object = req.object;
+        scene.triangles.par_extend(
+            (0..count)
+                .into_par_iter()
+                .map(|k| faces.triangle(k, object)),
+        );
+        let mut normal_ids: Vec<[u32; 3]> = match faces.normals {
+            Some((normals, base)) => {
+                let usable = |i: u32| {
+                    let n = normals[i as usize];
+                    n.is_finite() && n != Vec3::ZERO
+                };
+                let list = (&mesh.normal_indices[..], base, normals.len() as u32 - base);
+                (0..count)
+                    .into_par_iter()
+                    .map(|k| faces.corner_ids(k, list, &usable))
+                    .collect()
+            }
+            None => Vec::new(),
+        };
+        let mut uv_ids: Vec<[u32; 3]> = match faces.uvs {
+            Some((uvs, base)) => {
+                let usable = |i: u32| uvs[i as usize].is_finite();
+                let list = (&mesh.texcoord_indices[..], base, uvs.len() as u32 - base);
+                (0..count)
+                    .into_par_iter()
+                    .map(|k| faces.corner_ids(k, list, &usable))
+                    .collect()
+            }
+            None => Vec::new(),
+        };
+        let unusable = |ids: &[[u32; 3]]| ids.par_iter().filter(|i| i[0] == NO_INDEX).count();
+        corners.bad_normals += unusable(&normal_ids);
+        corners.bad_uvs += unusable(&uv_ids);
+        let fates = |fate: MaterialId| {
+            scene.triangles[start..]
+                .par_iter()
+                .filter(|t| t.material == fate)
+                .count()
+        };
+        let (degenerate, far) = (fates(DEGENERATE), fates(TOO_FAR));
+        dropped += degenerate;
+        too_far += far;
+        let kept = count - degenerate - far;
         // Materials are added on first use, so a scene lists only what it shows.
         let material = (kept > 0).then(|| match (req.material_override, mesh.material_id) {
             (Some(id), _) => id,
@@ -562,31 +600,44 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
             }),
             (None, _) => scene.default_material(),
         });
-        for part in parts {
-            dropped += part.dropped;
-            too_far += part.too_far;
-            corners.bad_normals += part.bad_normals;
-            corners.bad_uvs += part.bad_uvs;
-            let done = added;
-            if has_normals {
-                corners.normals.resize(done, [NO_INDEX; 3]);
-                corners.normals.extend_from_slice(&part.normals);
+        if kept < count {
+            // Rare: keep the placed ones, in order, with their corner indices.
+            let mut w = 0;
+            for k in 0..count {
+                if scene.triangles[start + k].material == PLACED {
+                    scene.triangles[start + w] = scene.triangles[start + k];
+                    for ids in [&mut normal_ids, &mut uv_ids] {
+                        if !ids.is_empty() {
+                            ids[w] = ids[k];
+                        }
+                    }
+                    w += 1;
+                }
             }
-            if has_uvs {
-                corners.uvs.resize(done, [NO_INDEX; 3]);
-                corners.uvs.extend_from_slice(&part.uvs);
-            }
-            if let Some(material) = material {
-                scene
-                    .triangles
-                    .extend(part.vertices.iter().map(|&vertices| Triangle {
-                        vertices,
-                        material,
-                        object: req.object,
-                    }));
-            }
-            added += part.vertices.len();
+            scene.triangles.truncate(start + w);
+            normal_ids.truncate(w);
+            uv_ids.truncate(w);
         }
+        if let Some(material) = material {
+            scene.triangles[start..]
+                .par_iter_mut()
+                .for_each(|t| t.material = material);
+        }
+        for (list, ids) in [
+            (&mut corners.normals, normal_ids),
+            (&mut corners.uvs, uv_ids),
+        ] {
+            if ids.is_empty() {
+                continue;
+            }
+            if list.is_empty() && added == 0 {
+                *list = ids;
+            } else {
+                list.resize(added, [NO_INDEX; 3]);
+                list.extend_from_slice(&ids);
+            }
+        }
+        added += kept;
     }
     if added < scene.triangles.capacity() / 2 {
         scene.triangles.shrink_to_fit();
@@ -626,24 +677,17 @@ struct Faces<'a> {
     uvs: Option<(&'a [Vec2], u32)>,
 }
 
-/// A run of placed faces: the kept triangles' vertices and, when the model has them, their
-/// normal and texture-coordinate indices ([`NO_INDEX`] where unusable), and what was dropped.
-#[derive(Default)]
-struct FacePart {
-    vertices: Vec<[Vec3; 3]>,
-    normals: Vec<[u32; 3]>,
-    uvs: Vec<[u32; 3]>,
-    dropped: usize,
-    too_far: usize,
-    bad_normals: usize,
-    bad_uvs: usize,
-}
+/// The material of a placed triangle until its model's material is known.
+const PLACED: MaterialId = MaterialId(u32::MAX);
+/// The material of a triangle to drop: zero area or not finite.
+const DEGENERATE: MaterialId = MaterialId(u32::MAX - 1);
+/// The material of a triangle to drop: beyond the scene-size limit.
+const TOO_FAR: MaterialId = MaterialId(u32::MAX - 2);
 
 impl Faces<'_> {
-    /// Places face `k` into `part`: its corners transformed (swapped when the placement
-    /// mirrors), its normal and texture indices checked, the triangle dropped when degenerate
-    /// or beyond the scene-size limit.
-    fn place(&self, k: usize, part: &mut FacePart) {
+    /// Face `k` placed: its corners transformed (two swapped when the placement mirrors),
+    /// marked [`PLACED`], [`DEGENERATE`] or [`TOO_FAR`] in place of its material.
+    fn triangle(&self, k: usize, object: ObjectId) -> Triangle {
         let mesh = self.mesh;
         let corner = |index: u32| {
             let i = index as usize * 3;
@@ -653,54 +697,43 @@ impl Faces<'_> {
         };
         let face = &mesh.indices[3 * k..3 * k + 3];
         let mut v = [face[0], face[1], face[2]].map(|i| self.linear * corner(i) + self.translate);
-        let lookup = |indices: &[u32], base: u32, count: u32, ok: &dyn Fn(u32) -> bool| {
-            let idx = indices.get(3 * k..3 * k + 3)?;
-            let idx = [idx[0], idx[1], idx[2]];
-            idx.iter()
-                .all(|&i| i < count && ok(base + i))
-                .then(|| idx.map(|i| base + i))
-        };
-        let mut ni = self.normals.map(|(normals, base)| {
-            let usable = |i: u32| {
-                let n = normals[i as usize];
-                n.is_finite() && n != Vec3::ZERO
-            };
-            let count = normals.len() as u32 - base;
-            let found = lookup(&mesh.normal_indices, base, count, &usable);
-            part.bad_normals += usize::from(found.is_none());
-            found
-        });
-        let mut ti = self.uvs.map(|(uvs, base)| {
-            let usable = |i: u32| uvs[i as usize].is_finite();
-            let count = uvs.len() as u32 - base;
-            let found = lookup(&mesh.texcoord_indices, base, count, &usable);
-            part.bad_uvs += usize::from(found.is_none());
-            found
-        });
         if self.mirrors {
             v.swap(1, 2);
-            if let Some(Some(n)) = ni.as_mut() {
-                n.swap(1, 2);
-            }
-            if let Some(Some(t)) = ti.as_mut() {
-                t.swap(1, 2);
-            }
         }
-        if !is_visible_triangle(&v) {
-            part.dropped += 1;
-            return;
+        let material = if !is_visible_triangle(&v) {
+            DEGENERATE
+        } else if v.iter().any(|p| p.abs().max_element() > MAX_COORDINATE) {
+            TOO_FAR
+        } else {
+            PLACED
+        };
+        Triangle {
+            vertices: v,
+            material,
+            object,
         }
-        if v.iter().any(|p| p.abs().max_element() > MAX_COORDINATE) {
-            part.too_far += 1;
-            return;
+    }
+
+    /// The mesh's normal or texture-coordinate indices of face `k` (swapped as its corners),
+    /// from `(the model's index list, the model's first in the mesh's list, how many the model
+    /// has)`; [`NO_INDEX`]`× 3` when one is out of range or names a value that is not `usable`.
+    fn corner_ids(
+        &self,
+        k: usize,
+        (indices, base, count): (&[u32], u32, u32),
+        usable: &(impl Fn(u32) -> bool + Sync),
+    ) -> [u32; 3] {
+        let Some(idx) = indices.get(3 * k..3 * k + 3) else {
+            return [NO_INDEX; 3];
+        };
+        let mut idx = [idx[0], idx[1], idx[2]];
+        if !idx.iter().all(|&i| i < count && usable(base + i)) {
+            return [NO_INDEX; 3];
         }
-        part.vertices.push(v);
-        if let Some(n) = ni {
-            part.normals.push(n.unwrap_or([NO_INDEX; 3]));
+        if self.mirrors {
+            idx.swap(1, 2);
         }
-        if let Some(t) = ti {
-            part.uvs.push(t.unwrap_or([NO_INDEX; 3]));
-        }
+        idx.map(|i| base + i)
     }
 }
 
