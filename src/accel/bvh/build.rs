@@ -87,6 +87,12 @@ impl Bvh {
     /// tree exist (the leaves' boxes are its node list, filled here; no list of boxes or of
     /// primitives beside it); the primitives are read again for the leaves.
     pub(in crate::accel) fn build_from<P: Prims + ?Sized>(prims: &P) -> Bvh {
+        Self::build_split(prims, SPLIT_BUILD_MIN_PRIMS)
+    }
+
+    /// [`Bvh::build_from`] with the two-tree build from `split_min` primitives on (at least
+    /// 4; the tests lower it).
+    fn build_split<P: Prims + ?Sized>(prims: &P, split_min: usize) -> Bvh {
         let n = prims.count();
         // Loaded scenes stay far below (the file-size caps and the memory budget bound them);
         // beyond this, ids would not fit a leaf word.
@@ -98,7 +104,7 @@ impl Bvh {
         let params = build_params(n);
         let mut built = None;
         if max_stacked(n, &bounds) <= MAX_STACKED {
-            let flat = if n >= SPLIT_BUILD_MIN_PRIMS {
+            let flat = if n >= split_min.max(4) {
                 split_ploc(n, &bounds, &params)
             } else {
                 let leaves: Vec<Bvh2Node> = (0..n)
@@ -623,6 +629,136 @@ fn median_bvh2(boxes: &[Aabb]) -> Bvh2 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::accel::{Closest, Visitor};
+    use crate::geometry::{Methods, Ray};
+
+    /// The surface-area cost of a wide tree, relative to its root's box: every child box's
+    /// area times the cost of visiting it (node, triangle leaf, sphere).
+    fn sah_cost(bvh: &Bvh) -> f64 {
+        let area = |lo: Vec3, hi: Vec3| {
+            let d = (hi - lo).max(Vec3::ZERO);
+            f64::from((d.x + d.y) * d.z + d.x * d.y)
+        };
+        let (mut total, mut lo, mut hi) = (0.0, Vec3::INFINITY, Vec3::NEG_INFINITY);
+        for node in &bvh.nodes {
+            for slot in 0..4 {
+                if node.valid & (1 << slot) == 0 {
+                    continue;
+                }
+                let a = Vec3::new(
+                    node.planes[0][slot],
+                    node.planes[2][slot],
+                    node.planes[4][slot],
+                );
+                let b = Vec3::new(
+                    node.planes[1][slot],
+                    node.planes[3][slot],
+                    node.planes[5][slot],
+                );
+                let child = node.child[slot];
+                let cost = if child & LEAF == 0 {
+                    NODE_COST
+                } else if child & SPHERE != 0 {
+                    SPHERE_COST
+                } else {
+                    PACKET_COST
+                };
+                total += f64::from(cost) * area(a, b);
+                if std::ptr::eq(node, &bvh.nodes[0]) {
+                    (lo, hi) = (lo.min(a), hi.max(b));
+                }
+            }
+        }
+        total / area(lo, hi)
+    }
+
+    /// A bumpy torus of about `n` triangles (a surface like the benchmark's), as primitives.
+    fn torus(n: usize) -> Vec<Prim> {
+        let (nu, nv) = (
+            (n as f32 / 8.0).sqrt() as usize * 4,
+            (n as f32 / 8.0).sqrt() as usize,
+        );
+        let p = |i: usize, j: usize| {
+            let (u, v) = (
+                std::f32::consts::TAU * (i % nu) as f32 / nu as f32,
+                std::f32::consts::TAU * (j % nv) as f32 / nv as f32,
+            );
+            let r = 0.5 * (1.0 + 0.12 * (9.0 * u).sin() * (6.0 * v).sin());
+            Vec3::new(
+                (1.35 + r * v.cos()) * u.cos(),
+                r * v.sin(),
+                (1.35 + r * v.cos()) * u.sin(),
+            )
+        };
+        let mut prims = Vec::new();
+        for i in 0..nu {
+            for j in 0..nv {
+                for v in [
+                    [p(i, j), p(i, j + 1), p(i + 1, j + 1)],
+                    [p(i, j), p(i + 1, j + 1), p(i + 1, j)],
+                ] {
+                    prims.push(Prim {
+                        shape: Shape::Triangle(v),
+                        id: prims.len() as u32,
+                    });
+                }
+            }
+        }
+        prims
+    }
+
+    /// The two-tree build (forced at a small size here) finds what brute force finds, and
+    /// its tree costs about what one PLOC tree costs (surface-area cost within 3 %).
+    #[test]
+    fn the_two_tree_build_finds_the_same_hits_at_about_the_same_cost() {
+        let mut prims = torus(40_000);
+        // Spheres first, as `Accel` lists them.
+        for (k, c) in [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.35, 0.0, 0.0)]
+            .into_iter()
+            .enumerate()
+        {
+            prims.insert(
+                k,
+                Prim {
+                    shape: Shape::Sphere {
+                        center: c,
+                        radius: 0.3,
+                    },
+                    id: 0,
+                },
+            );
+        }
+        for (id, p) in prims.iter_mut().enumerate() {
+            p.id = id as u32;
+        }
+        let whole = Bvh::build_split(&prims[..], usize::MAX);
+        let split = Bvh::build_split(&prims[..], 0);
+        let (a, b) = (sah_cost(&whole), sah_cost(&split));
+        assert!(b < a * 1.03, "split {b:.2} against whole {a:.2}");
+        assert!(split.spheres.len() == 2 && split.packets.len() > 40_000 / 4);
+        let m = Methods::default();
+        let mut seed = 7u32;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed as f32 / u32::MAX as f32 * 2.0 - 1.0
+        };
+        let mut hits = 0;
+        for _ in 0..3000 {
+            let o = Vec3::new(rnd(), rnd(), rnd()) * 3.0;
+            let ray = Ray::new(o, (Vec3::new(rnd(), rnd(), rnd()) * 0.5 - o).normalize());
+            let mut brute = Closest::new(&m, &ray, 0.0, f32::INFINITY);
+            for p in &prims {
+                brute.visit(p);
+            }
+            let mut found = Closest::new(&m, &ray, 0.0, f32::INFINITY);
+            split.walk(&ray, 0.0, &mut found);
+            assert_eq!(found.hit(), brute.hit());
+            hits += usize::from(brute.hit().is_some());
+        }
+        assert!(hits > 1000, "{hits}");
+    }
 
     #[test]
     fn the_preset_follows_the_scene_size() {
