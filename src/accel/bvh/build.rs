@@ -734,6 +734,7 @@ mod tests {
         let whole = Bvh::build_split(&prims[..], usize::MAX);
         let split = Bvh::build_split(&prims[..], 0);
         let (a, b) = (sah_cost(&whole), sah_cost(&split));
+        eprintln!("surface-area cost: two trees {b:.3}, one tree {a:.3}");
         assert!(b < a * 1.03, "split {b:.2} against whole {a:.2}");
         assert!(split.spheres.len() == 2 && split.packets.len() > 40_000 / 4);
         let m = Methods::default();
