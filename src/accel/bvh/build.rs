@@ -731,8 +731,31 @@ mod tests {
         for (id, p) in prims.iter_mut().enumerate() {
             p.id = id as u32;
         }
-        let whole = Bvh::build_split(&prims[..], usize::MAX);
-        let split = Bvh::build_split(&prims[..], 0);
+        let n = prims.len();
+        let bounds = |i: usize| {
+            let (lo, hi) = prims[i].bounds();
+            Aabb::new(lo.into(), hi.into())
+        };
+        assert!(
+            max_stacked(n, &bounds) <= MAX_STACKED,
+            "PLOC, not the median split"
+        );
+        let params = build_params(n);
+        let leaves: Vec<Bvh2Node> = (0..n)
+            .map(|i| Bvh2Node::new(jitter(&bounds(i), i), 1, i as u32))
+            .collect();
+        let mut bvh2 = ploc(leaves, &params);
+        ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
+        let whole = collapse_flat(preorder(&bvh2).expect("shallow"), &prims[..]).expect("a tree");
+        let split = collapse_flat(
+            split_ploc(n, &bounds, &params).expect("shallow"),
+            &prims[..],
+        )
+        .expect("a tree");
+        assert!(stack_need(&split.nodes) + 3 <= STACK_SIZE);
+        // `build_split` takes this path too.
+        let built = Bvh::build_split(&prims[..], 0);
+        assert_eq!(built.nodes.len(), split.nodes.len());
         let (a, b) = (sah_cost(&whole), sah_cost(&split));
         eprintln!("surface-area cost: two trees {b:.3}, one tree {a:.3}");
         assert!(b < a * 1.03, "split {b:.2} against whole {a:.2}");
