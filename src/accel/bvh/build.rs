@@ -709,6 +709,45 @@ mod tests {
 
     /// The two-tree build (forced at a small size here) finds what brute force finds, and
     /// its tree costs about what one PLOC tree costs (surface-area cost within 3 %).
+    /// `n` small triangles in clusters scattered in a box (uneven, unlike the torus).
+    fn clusters(n: usize) -> Vec<Prim> {
+        let mut seed = 99u32;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed as f32 / u32::MAX as f32
+        };
+        let mut prims = Vec::new();
+        while prims.len() < n {
+            let c = Vec3::new(rnd() * 8.0 - 4.0, rnd() * 2.0, rnd() * 3.0);
+            for _ in 0..1 + (rnd() * 200.0) as usize {
+                let a = c + Vec3::new(rnd(), rnd(), rnd()) * 0.5;
+                let v = [
+                    a,
+                    a + Vec3::new(rnd(), rnd(), 0.0) * 0.05,
+                    a + Vec3::Z * 0.03,
+                ];
+                prims.push(Prim {
+                    shape: Shape::Triangle(v),
+                    id: prims.len() as u32,
+                });
+            }
+        }
+        prims
+    }
+
+    /// On uneven input the two-tree build costs a little more than one PLOC tree, but not much.
+    #[test]
+    fn the_two_tree_build_costs_about_the_same_on_uneven_input() {
+        let prims = clusters(40_000);
+        let whole = Bvh::build_split(&prims[..], usize::MAX);
+        let split = Bvh::build_split(&prims[..], 0);
+        let (a, b) = (sah_cost(&whole), sah_cost(&split));
+        eprintln!("clusters, surface-area cost: two trees {b:.3}, one tree {a:.3}");
+        assert!(b < a * 1.05, "split {b:.2} against whole {a:.2}");
+    }
+
     #[test]
     fn the_two_tree_build_finds_the_same_hits_at_about_the_same_cost() {
         let mut prims = torus(40_000);
