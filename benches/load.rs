@@ -5,7 +5,8 @@
 //! as `cargo bench --bench peer` writes it) and the same torus with `vt`, `vn` and
 //! `f a/a/a b/b/b c/c/c` faces. Runs alternate between the readers; median and spread printed.
 //!
-//! Run: `cargo bench --bench load -- --triangles 1280000 --runs 5 --threads 2 [--keep DIR]`
+//! Run: `cargo bench --bench load -- --triangles 1280000 --runs 5 --threads 2 [--keep DIR]`;
+//! `--whole` times only `load_scene_file` (to profile it), `--memory` the BVH build's memory.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -23,6 +24,8 @@ struct Options {
     memory: bool,
     /// Only the viewer's open of a big OBJ: its load, build and longest frame.
     viewer: bool,
+    /// Only `load_scene_file` (no readers alone, no tobj): for profiling the whole load.
+    whole: bool,
 }
 
 fn options() -> Options {
@@ -33,6 +36,7 @@ fn options() -> Options {
         keep: None,
         memory: false,
         viewer: false,
+        whole: false,
     };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -47,6 +51,7 @@ fn options() -> Options {
             "--keep" => o.keep = Some(PathBuf::from(value("--keep"))),
             "--memory" => o.memory = true,
             "--viewer" => o.viewer = true,
+            "--whole" => o.whole = true,
             "--bench" => {}
             other => panic!("unknown option {other}"),
         }
@@ -286,9 +291,18 @@ fn main() {
         });
         std::fs::write(&file, &text).expect("the OBJ is written");
         let (mut fast, mut slow, mut whole) = (Vec::new(), Vec::new(), Vec::new());
-        let (mut fast_cpu, mut slow_cpu) = (Vec::new(), Vec::new());
+        let (mut fast_cpu, mut slow_cpu, mut whole_cpu) = (Vec::new(), Vec::new(), Vec::new());
         let mut triangles = 0;
         for _ in 0..o.runs {
+            if o.whole {
+                let (t, c) = (Instant::now(), cpu_seconds());
+                let scene = raytree::scene::load_scene_file(&file).expect("the scene loads");
+                whole.push(t.elapsed().as_secs_f64());
+                whole_cpu.push(cpu_seconds() - c);
+                triangles = scene.triangles.len();
+                drop(scene);
+                continue;
+            }
             let (t, c) = (Instant::now(), cpu_seconds());
             let a = obj_parse::parse(&text, |_| Ok(Default::default()))
                 .expect("the fast reader takes the benchmark mesh")
@@ -303,15 +317,24 @@ fn main() {
             slow.push(t.elapsed().as_secs_f64());
             slow_cpu.push(cpu_seconds() - c);
             drop(b);
-            let t = Instant::now();
+            let (t, c) = (Instant::now(), cpu_seconds());
             let scene = raytree::scene::load_scene_file(&file).expect("the scene loads");
             whole.push(t.elapsed().as_secs_f64());
+            whole_cpu.push(cpu_seconds() - c);
             drop(scene);
         }
         println!(
             "{name}: {triangles} triangles, {:.1} MB of text",
             text.len() as f64 / 1e6
         );
+        if o.whole {
+            println!(
+                "  load_scene_file (read, parse, place, frame): {}; CPU seconds {:.2}",
+                stats(whole),
+                median(&whole_cpu)
+            );
+            continue;
+        }
         let (f, s) = (median(&fast), median(&slow));
         println!("  raytree obj_parse: {}", stats(fast));
         println!("  tobj 4.0.5:        {}", stats(slow));
@@ -322,8 +345,9 @@ fn main() {
             median(&slow_cpu)
         );
         println!(
-            "  load_scene_file (read, parse, place, frame): {}",
-            stats(whole)
+            "  load_scene_file (read, parse, place, frame): {}; CPU seconds {:.2}",
+            stats(whole),
+            median(&whole_cpu)
         );
     }
 }

@@ -320,7 +320,16 @@ struct Sample<'a, R> {
 impl Tracer {
     pub fn new(scene: Arc<Scene>, settings: TraceSettings) -> Self {
         let start = std::time::Instant::now();
-        let accel = Arc::new(Accel::build(settings.accel, &prim_set(&scene)));
+        // From the scene's own triangles: a `prim_set` copy would stay alive through the build.
+        let spheres: Vec<(Vec3, f32)> =
+            scene.spheres.iter().map(|s| (s.center, s.radius)).collect();
+        let triangles = &scene.triangles;
+        let accel = Arc::new(Accel::build_from(
+            settings.accel,
+            &spheres,
+            triangles.len(),
+            &|i: usize| triangles[i].vertices,
+        ));
         let build_secs = start.elapsed().as_secs_f64();
         let mut tracer = Self::with_accel(scene, settings, accel);
         tracer.build_secs = build_secs;

@@ -565,7 +565,13 @@ fn texture_files() -> HashMap<String, Vec<u8>> {
     TEXTURE_NAMES
         .iter()
         .filter_map(|name| {
-            let bytes = std::fs::read(corpus.join(name)).ok()?;
+            // Only the corpus's regular files: a device (`/dev/zero`, or a link to it) is named in
+            // the MTLs, never read here (reading `/dev/zero` would fill the memory).
+            let path = corpus.join(name);
+            if Path::new(name).is_absolute() || !std::fs::metadata(&path).ok()?.is_file() {
+                return None;
+            }
+            let bytes = std::fs::read(path).ok()?;
             Some((name.to_string(), bytes))
         })
         .collect()

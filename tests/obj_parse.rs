@@ -269,34 +269,79 @@ fn big_files_in_several_chunks_read_as_tobj_reads_them() {
 }
 
 /// A bare OBJ loaded through the whole loader gives the same scene as before the fast reader
-/// (tobj only): the fast path is not just equal in isolation.
+/// (tobj only): the fast path is not just equal in isolation. With and without polylines (which
+/// the loader skips and counts in its one pass), and with `usemtl` names no library defines
+/// (which it collects in the same pass): the same triangles, materials and warnings.
 #[test]
 fn scenes_load_the_same_through_either_reader() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let text = big_file(9);
-    let path = dir.path().join("big.obj");
-    std::fs::write(&path, &text).expect("write");
     std::fs::write(
         dir.path().join("m.mtl"),
         "newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\n",
     )
     .expect("write");
-    let fast = raytree::scene::load_scene_file(&path).expect("loads");
-    // With a negative index at the end, the whole file goes to tobj; the index adds one face.
-    let slow_text = format!("{text}f -1 -2 -3\n");
-    std::fs::write(&path, &slow_text).expect("write");
-    assert!(raytree::scene::obj_parse::parse(&slow_text, |_| Ok(Default::default())).is_none());
-    let slow = raytree::scene::load_scene_file(&path).expect("loads");
-    assert!(fast.triangles.len() > 10_000);
-    assert_eq!(
-        slow.triangles.len(),
-        fast.triangles.len() + 1,
-        "{:?}",
-        slow.warnings
-    );
-    for (a, b) in fast.triangles.iter().zip(&slow.triangles) {
-        assert_eq!(a.vertices, b.vertices);
-        assert_eq!(a.material, b.material);
+    let plain = big_file(9);
+    let lines = plain.replacen("\nf ", "\nl 1 2 3\n  l 2 3\nf ", 3);
+    for (text, warning) in [
+        (
+            &plain,
+            "`usemtl` names materials that no material library defines (`none`)",
+        ),
+        (&lines, "ignored 6 polylines (`l`)"),
+    ] {
+        let path = dir.path().join("big.obj");
+        std::fs::write(&path, text).expect("write");
+        let fast = raytree::scene::load_scene_file(&path).expect("loads");
+        // With a negative index at the end, the whole file goes to tobj; the index adds one face.
+        let slow_text = format!("{text}f -1 -2 -3\n");
+        std::fs::write(&path, &slow_text).expect("write");
+        assert!(raytree::scene::obj_parse::parse(&slow_text, |_| Ok(Default::default())).is_none());
+        let slow = raytree::scene::load_scene_file(&path).expect("loads");
+        assert!(fast.triangles.len() > 10_000);
+        assert_eq!(
+            slow.triangles.len(),
+            fast.triangles.len() + 1,
+            "{:?}",
+            slow.warnings
+        );
+        for (a, b) in fast.triangles.iter().zip(&slow.triangles) {
+            assert_eq!(a.vertices, b.vertices);
+            assert_eq!(a.material, b.material);
+        }
+        assert_eq!(fast.materials.len(), slow.materials.len());
+        assert_eq!(fast.warnings, slow.warnings);
+        assert!(
+            fast.warnings.iter().any(|w| w.contains(warning)),
+            "{warning}: {:?}",
+            fast.warnings
+        );
     }
-    assert_eq!(fast.materials.len(), slow.materials.len());
+}
+
+/// The loader's pass skips polylines and counts what the memory budget and the warnings need,
+/// in one pass over chunks: the same counts as line by line, on a file read in several chunks.
+#[test]
+fn the_loader_pass_counts_what_the_budget_and_warnings_need() {
+    use raytree::scene::obj_parse::{Polylines, scan};
+    let text = big_file(5).replacen("\nf ", "\nl 1 1\n\t usemtl  odd name \nf ", 40);
+    let scanned = scan(&text, Polylines::Skip).expect("the fast reader takes it");
+    let facts = scanned.facts().clone();
+    assert_eq!(facts, obj_compare::facts_by_lines(&text));
+    assert_eq!(facts.polylines, 40);
+    let names: Vec<&str> = facts.usemtl.iter().map(String::as_str).collect();
+    assert_eq!(names, ["blue", "none", "odd name", "red"]);
+    assert!(facts.triangles > 50_000 && facts.vertices > 10_000);
+    // As faces (tobj's way) the polylines are triangles of the models, not of the count.
+    let as_faces = scan(&text, Polylines::AsFaces).expect("takes it");
+    assert_eq!(as_faces.facts().polylines, 0);
+    assert_eq!(as_faces.facts().triangles, facts.triangles);
+    let corners = |s: raytree::scene::obj_parse::Scanned| -> usize {
+        let (models, _) = s
+            .assemble(|_| Ok(Default::default()))
+            .expect("assembles")
+            .expect("loads");
+        models.iter().map(|m| m.mesh.indices.len()).sum()
+    };
+    assert_eq!(corners(as_faces), corners(scanned) + 3 * 40);
+    assert!(obj_compare::check(&text, &|_| Ok(Default::default())));
 }

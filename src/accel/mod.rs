@@ -325,6 +325,70 @@ impl Visitor for AnyHit<'_> {
     }
 }
 
+/// The valid primitives of a build, in the order the accelerators number them (spheres
+/// first, then triangles), read where the caller keeps them.
+pub(in crate::accel) trait Prims: Sync {
+    /// How many.
+    fn count(&self) -> usize;
+    /// Primitive `i` (`i < count()`).
+    fn get(&self, i: usize) -> Prim;
+    /// How many of the first are spheres (all the spheres).
+    fn spheres(&self) -> usize;
+    /// All of them, copied.
+    fn to_vec(&self) -> Vec<Prim> {
+        (0..self.count())
+            .into_par_iter()
+            .map(|i| self.get(i))
+            .collect()
+    }
+}
+
+impl Prims for [Prim] {
+    fn count(&self) -> usize {
+        self.len()
+    }
+    fn get(&self, i: usize) -> Prim {
+        self[i]
+    }
+    fn spheres(&self) -> usize {
+        self.iter()
+            .take_while(|p| matches!(p.shape, Shape::Sphere { .. }))
+            .count()
+    }
+}
+
+/// The valid spheres (copied: they are few) and the valid triangles, read through the
+/// caller's function.
+struct Source<'a> {
+    spheres: Vec<Prim>,
+    triangle: &'a (dyn Fn(usize) -> [Vec3; 3] + Sync),
+    /// The caller's index of each valid triangle, in order.
+    valid: Vec<u32>,
+    /// The id of the caller's first triangle (the number of spheres, valid or not).
+    first_id: u32,
+}
+
+impl Prims for Source<'_> {
+    fn count(&self) -> usize {
+        self.spheres.len() + self.valid.len()
+    }
+    fn get(&self, i: usize) -> Prim {
+        match self.spheres.get(i) {
+            Some(p) => *p,
+            None => {
+                let t = self.valid[i - self.spheres.len()];
+                Prim {
+                    shape: Shape::Triangle((self.triangle)(t as usize)),
+                    id: self.first_id + t,
+                }
+            }
+        }
+    }
+    fn spheres(&self) -> usize {
+        self.spheres.len()
+    }
+}
+
 enum Imp {
     /// Every primitive in id order (also used for empty sets of every kind).
     None(Vec<Prim>),
@@ -356,43 +420,62 @@ impl Accel {
     /// Build the accelerator `kind` over `prims` (copied; invalid primitives dropped and
     /// counted). `Auto` resolves to a concrete kind, see [`auto_kind`].
     pub fn build(kind: AccelKind, prims: &PrimSet) -> Accel {
+        Self::build_from(kind, &prims.spheres, prims.triangles.len(), &|i: usize| {
+            prims.triangles[i]
+        })
+    }
+
+    /// [`Accel::build`] over `spheres` and the `triangle_count` triangles that `triangle(i)`
+    /// gives, read where they are (a scene's own list) instead of from a [`PrimSet`] copy: the
+    /// same accelerator, with less memory at the build's peak. The BVH holds no list of
+    /// primitives while `obvhs` builds (it reads each triangle twice: for its box, then for
+    /// its leaf).
+    pub fn build_from(
+        kind: AccelKind,
+        spheres: &[(Vec3, f32)],
+        triangle_count: usize,
+        triangle: &(dyn Fn(usize) -> [Vec3; 3] + Sync),
+    ) -> Accel {
         // Spheres first (the BVH tells kinds apart by index), then triangles; ids are the
-        // indices in `prims` (spheres, then triangles), kept by invalid ones too. In parallel:
-        // a million triangles take tens of milliseconds to check and copy.
-        let n_spheres = prims.spheres.len();
-        let spheres = prims
-            .spheres
-            .par_iter()
+        // indices in the input (spheres, then triangles), kept by invalid ones too. In
+        // parallel: a million triangles take tens of milliseconds to check.
+        let first_id = spheres.len() as u32;
+        let spheres: Vec<Prim> = spheres
+            .iter()
             .enumerate()
             .filter_map(|(i, &(center, radius))| {
                 (center.is_finite() && radius.is_finite() && radius > 0.0).then_some(Prim {
                     shape: Shape::Sphere { center, radius },
                     id: i as u32,
                 })
-            });
-        let triangles = prims.triangles.par_iter().enumerate().filter_map(|(i, v)| {
-            let cross = (v[1] - v[0]).cross(v[2] - v[0]);
-            let finite = v.iter().all(|p| p.is_finite()) && cross.is_finite();
-            (finite && cross != Vec3::ZERO).then_some(Prim {
-                shape: Shape::Triangle(*v),
-                id: (n_spheres + i) as u32,
             })
-        });
-        let list: Vec<Prim> = spheres.chain(triangles).collect();
-        let skipped = n_spheres + prims.triangles.len() - list.len();
+            .collect();
+        let valid: Vec<u32> = (0..triangle_count)
+            .into_par_iter()
+            .filter(|&i| {
+                let v = triangle(i);
+                let cross = (v[1] - v[0]).cross(v[2] - v[0]);
+                v.iter().all(|p| p.is_finite()) && cross.is_finite() && cross != Vec3::ZERO
+            })
+            .map(|i| i as u32)
+            .collect();
+        let source = Source {
+            spheres,
+            triangle,
+            valid,
+            first_id,
+        };
+        let prim_count = source.count();
+        let skipped = first_id as usize + triangle_count - prim_count;
         let kind = match kind {
-            AccelKind::Auto => auto_kind(list.len()),
+            AccelKind::Auto => auto_kind(prim_count),
             k => k,
         };
-        let prim_count = list.len();
-        let imp = if list.is_empty() {
-            Imp::None(list)
-        } else {
-            match kind {
-                AccelKind::Grid => Imp::Grid(grid::Grid::build(list)),
-                AccelKind::Bvh => Imp::Bvh(bvh::Bvh::build(list)),
-                _ => Imp::None(list),
-            }
+        let imp = match kind {
+            _ if prim_count == 0 => Imp::None(Vec::new()),
+            AccelKind::Grid => Imp::Grid(grid::Grid::build(source.to_vec())),
+            AccelKind::Bvh => Imp::Bvh(bvh::Bvh::build_from(&source)),
+            _ => Imp::None(source.to_vec()),
         };
         Accel {
             kind,

@@ -8,7 +8,6 @@
 
 use std::borrow::Cow;
 use std::cell::{Cell, RefCell};
-use std::collections::BTreeSet;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
 use std::sync::Once;
@@ -18,9 +17,12 @@ use std::sync::Arc;
 
 use glam::{Mat3, Vec2, Vec3};
 
+use rayon::prelude::*;
+
 use super::budget::{MemoryLimit, memory_limit, mesh_memory_estimate};
 use super::diag::{list_and, short, short_path};
 use super::obj_corners::{ALL_NORMALS, ALL_UVS};
+use super::obj_parse::{self, Facts, Polylines, Scanned};
 use super::rules::{MAX_COORDINATE, is_visible_triangle};
 use super::texture::decode_texture;
 use super::{
@@ -165,28 +167,32 @@ fn quietly<T>(f: impl FnOnce() -> T) -> Result<T, ()> {
     outcome.map_err(|_| ())
 }
 
-/// Reads OBJ text: the parallel reader of [`super::obj_parse`] (the same result as `tobj`,
-/// faster), or `tobj` itself for whatever that one leaves to it; with panics caught, since
-/// hostile files must never take the program down (SPEC §9). Each `mtllib` reaches `load_mtl`
-/// once, even when the fast reader gives up after it: tobj then gets the recorded results.
+/// Reads OBJ text: the models of the parallel reader's pass `scanned` (the same result as
+/// `tobj`, faster), or `tobj` itself on the text without its polylines when that reader left it
+/// to tobj; with panics caught, since hostile files must never take the program down (SPEC
+/// §9). Each `mtllib` reaches `load_mtl` once, even when the fast reader gives up after it:
+/// tobj then gets the recorded results.
 fn load_obj(
     text: &str,
+    scanned: Option<Scanned>,
     load_mtl: impl Fn(&Path) -> tobj::MTLLoadResult,
 ) -> Result<tobj::LoadResult, String> {
     let failed = |()| "the OBJ reader failed on this file".to_string();
     let recorded = RefCell::new(std::collections::VecDeque::new());
-    let fast = quietly(|| {
-        super::obj_parse::parse(text, |path: &Path| {
-            let result = load_mtl(path);
-            recorded
-                .borrow_mut()
-                .push_back((path.to_path_buf(), result.clone()));
-            result
+    if let Some(scanned) = scanned {
+        let fast = quietly(|| {
+            scanned.assemble(|path: &Path| {
+                let result = load_mtl(path);
+                recorded
+                    .borrow_mut()
+                    .push_back((path.to_path_buf(), result.clone()));
+                result
+            })
         })
-    })
-    .map_err(failed)?;
-    if let Some(loaded) = fast {
-        return Ok(loaded);
+        .map_err(failed)?;
+        if let Some(loaded) = fast {
+            return Ok(loaded);
+        }
     }
     let replay = |path: &Path| {
         let mut recorded = recorded.borrow_mut();
@@ -198,7 +204,15 @@ fn load_obj(
             _ => load_mtl(path),
         }
     };
+    let (text, _) = without_polylines(text);
     quietly(|| tobj::load_obj_buf(&mut text.as_bytes(), &load_options(), replay)).map_err(failed)
+}
+
+/// Reads OBJ text without polylines, as [`add_mesh`] reads it (the error search's reader).
+fn read_plain(text: &str) -> Result<tobj::LoadResult, String> {
+    let scanned = quietly(|| obj_parse::scan(text, Polylines::Skip))
+        .map_err(|()| "the OBJ reader failed on this file".to_string())?;
+    load_obj(text, scanned, |_| Ok(Default::default()))
 }
 
 /// MTL text as `tobj` can take it, or the line and the reason it cannot. The MTL format lets
@@ -293,20 +307,37 @@ pub(crate) fn obj_counts(text: &str) -> (u64, u64) {
     (vertices, triangles)
 }
 
+/// The [`Facts`] of OBJ text that the parallel reader leaves to tobj, counted line by line as
+/// that reader counts them (polylines skipped).
+pub(crate) fn slow_facts(text: &str) -> Facts {
+    let (vertices, triangles) = obj_counts(text);
+    let mut facts = Facts {
+        vertices,
+        triangles,
+        ..Facts::default()
+    };
+    for line in text.lines() {
+        match line.split_whitespace().next() {
+            Some("vn") => facts.normals += 1,
+            Some("vt") => facts.texcoords += 1,
+            Some("l") => facts.polylines += 1,
+            _ => {}
+        }
+        if let Some(rest) = line.trim_start().strip_prefix("usemtl")
+            && rest.starts_with([' ', '\t'])
+            && !rest.trim().is_empty()
+        {
+            facts.usemtl.insert(rest.trim().to_string());
+        }
+    }
+    facts
+}
+
 /// Bytes the per-vertex normals and texture coordinates of an OBJ may keep (SPEC §3b): the
 /// file's `vn` and `vt` and an index triple per triangle for each, or computed normals (three
 /// per triangle) for `normals = "smooth"`; 0 for a flat mesh without `vt`.
-pub(crate) fn attribute_memory_estimate(text: &str, normals: NormalsMode) -> u64 {
-    let (mut vn, mut vt, mut faces) = (0u64, 0u64, 0u64);
-    for line in text.lines() {
-        let mut words = line.split_whitespace();
-        match words.next() {
-            Some("vn") => vn += 1,
-            Some("vt") => vt += 1,
-            Some("f") => faces += (words.count() as u64).saturating_sub(2).max(1),
-            _ => {}
-        }
-    }
+pub(crate) fn attribute_memory_estimate(facts: &Facts, normals: NormalsMode) -> u64 {
+    let (vn, vt, faces) = (facts.normals, facts.texcoords, facts.triangles);
     let per_triangle_index = 12u64;
     let normal_bytes = match normals {
         NormalsMode::Flat => 0,
@@ -322,16 +353,17 @@ pub(crate) fn attribute_memory_estimate(text: &str, normals: NormalsMode) -> u64
     normal_bytes.saturating_add(uv_bytes)
 }
 
-/// Refuses an OBJ whose reading (with the triangles the scene already has) would exceed
-/// `limit`, before tobj allocates anything for it.
+/// Refuses an OBJ of `text_bytes` bytes and these `facts` whose reading (with the triangles the
+/// scene already has) would exceed `limit`, before the models or triangles are made.
 pub(crate) fn check_mesh_memory(
     scene: &Scene,
-    text: &str,
+    text_bytes: usize,
+    facts: &Facts,
     limit: &MemoryLimit,
 ) -> Result<(), String> {
-    let (vertices, triangles) = obj_counts(text);
+    let (vertices, triangles) = (facts.vertices, facts.triangles);
     let estimate = mesh_memory_estimate(
-        text.len() as u64,
+        text_bytes as u64,
         vertices,
         triangles.saturating_add(scene.triangles.len() as u64),
     );
@@ -357,7 +389,7 @@ fn error_line(text: &str) -> Option<usize> {
         .collect();
     let fails = |lines: usize| {
         let prefix = &text[..ends[lines - 1]];
-        !matches!(load_obj(prefix, |_| Ok(Default::default())), Ok(Ok(_)))
+        !matches!(read_plain(prefix), Ok(Ok(_)))
     };
     let (mut lo, mut hi) = (1, ends.len());
     if hi == 0 || !fails(hi) {
@@ -377,14 +409,25 @@ fn error_line(text: &str) -> Option<usize> {
 /// Adds the OBJ's triangles (placed, degenerate ones dropped) and the MTL materials they use
 /// to `scene`; returns how many triangles were added.
 pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, ObjProblem> {
-    check_mesh_memory(scene, req.text, &memory_limit())
+    // One pass of the parallel reader counts what the budget and the warnings need; only a
+    // text it leaves to tobj is counted line by line.
+    let scanned =
+        quietly(|| obj_parse::scan(req.text, Polylines::Skip)).map_err(|()| ObjProblem {
+            line: None,
+            reason: "the OBJ reader failed on this file".into(),
+        })?;
+    let facts = match &scanned {
+        Some(s) => s.facts().clone(),
+        None => slow_facts(req.text),
+    };
+    check_mesh_memory(scene, req.text.len(), &facts, &memory_limit())
         .map_err(|reason| ObjProblem { line: None, reason })?;
-    let attributes = attribute_memory_estimate(req.text, req.normals);
+    let attributes = attribute_memory_estimate(&facts, req.normals);
     if attributes > 0 {
-        let (_, triangles) = obj_counts(req.text);
+        let triangles = facts.triangles;
         let all = mesh_memory_estimate(
             req.text.len() as u64,
-            obj_counts(req.text).0,
+            facts.vertices,
             triangles.saturating_add(scene.triangles.len() as u64),
         )
         .saturating_add(attributes);
@@ -428,12 +471,12 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
             ));
         })
     };
-    let (text, polylines) = without_polylines(req.text);
-    let (models, mtl_materials) = match load_obj(&text, load_mtl) {
+    let polylines = facts.polylines;
+    let (models, mtl_materials) = match load_obj(req.text, scanned, load_mtl) {
         Ok(Ok(loaded)) => loaded,
         Ok(Err(e)) => {
             return Err(ObjProblem {
-                line: error_line(&text),
+                line: error_line(req.text),
                 reason: e.to_string(),
             });
         }
@@ -448,7 +491,7 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
         )
     });
     let face_corners = match uvs_in_file || normals_in_file {
-        true => super::obj_corners::face_corners(&text, uvs_in_file, normals_in_file).map_err(
+        true => super::obj_corners::face_corners(req.text, uvs_in_file, normals_in_file).map_err(
             |(line, reason)| ObjProblem {
                 line: Some(line),
                 reason: reason.into(),
@@ -466,7 +509,7 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
         ));
     }
     if req.material_override.is_none() && warnings.is_empty() {
-        warn_unknown_usemtl(req, &mtl_materials, &mut warnings);
+        warn_unknown_usemtl(req.label, &facts, &mtl_materials, &mut warnings);
     }
 
     let linear = req.placement.linear();
@@ -483,115 +526,160 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
         ..MeshAttributes::default()
     };
     let mut corners = Corners::default();
+    // Which faces give every corner's `vn` (`vt`): flags by triangle in tobj's order, or
+    // none when every face does.
     let triangles_read: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
-    let explicit = |t: usize| match face_corners.triangles.len() == triangles_read {
-        true => face_corners.triangles[t],
-        false => ALL_NORMALS | ALL_UVS,
+    let explicit: &[u8] = match face_corners.triangles.len() == triangles_read {
+        true => &face_corners.triangles,
+        false => &[],
     };
     let mut triangle_read = 0;
+    scene.triangles.reserve(triangles_read);
     for model in &models {
         let mesh = &model.mesh;
-        let mut material = None;
-        let corner = |index: u32| {
-            let i = index as usize * 3;
-            mesh.positions
-                .get(i..i + 3)
-                .map_or(Vec3::NAN, |p| Vec3::new(p[0], p[1], p[2]))
-        };
         // Per-face normal and texture indices exist only when every face gives them.
         let normal_base = attrs.normals.len() as u32;
         let has_normals = file_normals
             && !mesh.normals.is_empty()
             && mesh.normal_indices.len() == mesh.indices.len();
         if has_normals {
-            attrs.normals.extend(
+            attrs.normals.par_extend(
                 mesh.normals
-                    .chunks_exact(3)
+                    .par_chunks_exact(3)
                     .map(|n| (normal_matrix * Vec3::new(n[0], n[1], n[2])).normalize_or_zero()),
             );
         }
-        let n_normals = attrs.normals.len() as u32 - normal_base;
         let uv_base = attrs.uvs.len() as u32;
         let has_uvs =
             !mesh.texcoords.is_empty() && mesh.texcoord_indices.len() == mesh.indices.len();
         if has_uvs {
-            attrs.uvs.extend(
+            attrs.uvs.par_extend(
                 mesh.texcoords
-                    .chunks_exact(2)
+                    .par_chunks_exact(2)
                     .map(|t| Vec2::new(t[0], t[1])),
             );
         }
-        let n_uvs = attrs.uvs.len() as u32 - uv_base;
-        for (k, face) in mesh.indices.chunks_exact(3).enumerate() {
-            let mut v =
-                [face[0], face[1], face[2]].map(|i| linear * corner(i) + req.placement.translate);
-            let given = explicit(triangle_read);
-            triangle_read += 1;
-            let lookup = |indices: &[u32], base: u32, count: u32, ok: &dyn Fn(u32) -> bool| {
-                let idx = indices.get(3 * k..3 * k + 3)?;
-                let idx = [idx[0], idx[1], idx[2]];
-                idx.iter()
-                    .all(|&i| i < count && ok(base + i))
-                    .then(|| idx.map(|i| base + i))
-            };
-            let mut ni = if has_normals && given & ALL_NORMALS != 0 {
-                let normals = &attrs.normals;
+        let faces = Faces {
+            mesh,
+            linear,
+            translate: req.placement.translate,
+            mirrors,
+            normals: has_normals.then_some((&attrs.normals[..], normal_base)),
+            uvs: has_uvs.then_some((&attrs.uvs[..], uv_base)),
+        };
+        // In parallel, straight into the scene's list (then the dropped ones taken out): no
+        // per-thread lists, whose memory the allocator would keep after the load.
+        let count = mesh.indices.len() / 3;
+        let first_read = triangle_read;
+        let given = |k: usize, bit: u8| explicit.get(first_read + k).is_none_or(|f| f & bit != 0);
+        let start = scene.triangles.len();
+        let object = req.object;
+        scene.triangles.par_extend(
+            (0..count)
+                .into_par_iter()
+                .map(|k| faces.triangle(k, object)),
+        );
+        let mut normal_ids: Vec<[u32; 3]> = match faces.normals {
+            Some((normals, base)) => {
                 let usable = |i: u32| {
                     let n = normals[i as usize];
                     n.is_finite() && n != Vec3::ZERO
                 };
-                let found = lookup(&mesh.normal_indices, normal_base, n_normals, &usable);
-                corners.bad_normals += usize::from(found.is_none());
-                found
-            } else {
-                None
-            };
-            let mut ti = if has_uvs && given & ALL_UVS != 0 {
-                let uvs = &attrs.uvs;
+                let list = (&mesh.normal_indices[..], base, normals.len() as u32 - base);
+                (0..count)
+                    .into_par_iter()
+                    .map(|k| match given(k, ALL_NORMALS) {
+                        true => faces.corner_ids(k, list, &usable),
+                        false => [NO_INDEX; 3],
+                    })
+                    .collect()
+            }
+            None => Vec::new(),
+        };
+        let mut uv_ids: Vec<[u32; 3]> = match faces.uvs {
+            Some((uvs, base)) => {
                 let usable = |i: u32| uvs[i as usize].is_finite();
-                let found = lookup(&mesh.texcoord_indices, uv_base, n_uvs, &usable);
-                corners.bad_uvs += usize::from(found.is_none());
-                found
-            } else {
-                None
-            };
-            if mirrors {
-                v.swap(1, 2);
-                if let Some(n) = ni.as_mut() {
-                    n.swap(1, 2);
-                }
-                if let Some(t) = ti.as_mut() {
-                    t.swap(1, 2);
-                }
+                let list = (&mesh.texcoord_indices[..], base, uvs.len() as u32 - base);
+                (0..count)
+                    .into_par_iter()
+                    .map(|k| match given(k, ALL_UVS) {
+                        true => faces.corner_ids(k, list, &usable),
+                        false => [NO_INDEX; 3],
+                    })
+                    .collect()
             }
-            if !is_visible_triangle(&v) {
-                dropped += 1;
-                continue;
-            }
-            if v.iter().any(|p| p.abs().max_element() > MAX_COORDINATE) {
-                too_far += 1;
-                continue;
-            }
-            // Materials are added on first use, so a scene lists only what it shows.
-            let id =
-                *material.get_or_insert_with(|| match (req.material_override, mesh.material_id) {
-                    (Some(id), _) => id,
-                    (None, Some(i)) if i < mtl_materials.len() => {
-                        *mtl_ids[i].get_or_insert_with(|| {
-                            mtl_material(scene, req, &mtl_materials[i], &mtl_texts, &mut warnings)
-                        })
+            None => Vec::new(),
+        };
+        // Faces that give an index at every corner, but one out of range or unusable (a face
+        // that does not give them all is shaded flat, or untextured, and counted apart).
+        let unusable = |ids: &[[u32; 3]], bit: u8| {
+            ids.par_iter()
+                .enumerate()
+                .filter(|&(k, i)| i[0] == NO_INDEX && given(k, bit))
+                .count()
+        };
+        corners.bad_normals += unusable(&normal_ids, ALL_NORMALS);
+        corners.bad_uvs += unusable(&uv_ids, ALL_UVS);
+        triangle_read += count;
+        let fates = |fate: MaterialId| {
+            scene.triangles[start..]
+                .par_iter()
+                .filter(|t| t.material == fate)
+                .count()
+        };
+        let (degenerate, far) = (fates(DEGENERATE), fates(TOO_FAR));
+        dropped += degenerate;
+        too_far += far;
+        let kept = count - degenerate - far;
+        // Materials are added on first use, so a scene lists only what it shows.
+        let material = (kept > 0).then(|| match (req.material_override, mesh.material_id) {
+            (Some(id), _) => id,
+            (None, Some(i)) if i < mtl_materials.len() => *mtl_ids[i].get_or_insert_with(|| {
+                mtl_material(scene, req, &mtl_materials[i], &mtl_texts, &mut warnings)
+            }),
+            (None, _) => scene.default_material(),
+        });
+        if kept < count {
+            // Rare: keep the placed ones, in order, with their corner indices.
+            let mut w = 0;
+            for k in 0..count {
+                if scene.triangles[start + k].material == PLACED {
+                    scene.triangles[start + w] = scene.triangles[start + k];
+                    for ids in [&mut normal_ids, &mut uv_ids] {
+                        if !ids.is_empty() {
+                            ids[w] = ids[k];
+                        }
                     }
-                    (None, _) => scene.default_material(),
-                });
-            scene.triangles.push(Triangle {
-                vertices: v,
-                material: id,
-                object: req.object,
-            });
-            corners.normals.push(ni.unwrap_or([NO_INDEX; 3]));
-            corners.uvs.push(ti.unwrap_or([NO_INDEX; 3]));
-            added += 1;
+                    w += 1;
+                }
+            }
+            scene.triangles.truncate(start + w);
+            normal_ids.truncate(w);
+            uv_ids.truncate(w);
         }
+        if let Some(material) = material {
+            scene.triangles[start..]
+                .par_iter_mut()
+                .for_each(|t| t.material = material);
+        }
+        for (list, ids) in [
+            (&mut corners.normals, normal_ids),
+            (&mut corners.uvs, uv_ids),
+        ] {
+            if ids.is_empty() {
+                continue;
+            }
+            if list.is_empty() && added == 0 {
+                *list = ids;
+            } else {
+                list.resize(added, [NO_INDEX; 3]);
+                list.extend_from_slice(&ids);
+            }
+        }
+        added += kept;
+    }
+    if added < scene.triangles.capacity() / 2 {
+        scene.triangles.shrink_to_fit();
     }
     let textured = scene.triangles[first_triangle..].iter().any(|t| {
         scene.material(t.material).diffuse_map.is_some()
@@ -618,7 +706,81 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     Ok(added)
 }
 
-/// The normal and texture-coordinate indices of a mesh's kept triangles, while it loads.
+/// One model's faces, to be placed in parallel: the model, the placement, and the mesh's
+/// normals and texture coordinates so far with the index of this model's first (when its faces
+/// give them).
+struct Faces<'a> {
+    mesh: &'a tobj::Mesh,
+    linear: Mat3,
+    translate: Vec3,
+    mirrors: bool,
+    normals: Option<(&'a [Vec3], u32)>,
+    uvs: Option<(&'a [Vec2], u32)>,
+}
+
+/// The material of a placed triangle until its model's material is known.
+const PLACED: MaterialId = MaterialId(u32::MAX);
+/// The material of a triangle to drop: zero area or not finite.
+const DEGENERATE: MaterialId = MaterialId(u32::MAX - 1);
+/// The material of a triangle to drop: beyond the scene-size limit.
+const TOO_FAR: MaterialId = MaterialId(u32::MAX - 2);
+
+impl Faces<'_> {
+    /// Face `k` placed: its corners transformed (two swapped when the placement mirrors),
+    /// marked [`PLACED`], [`DEGENERATE`] or [`TOO_FAR`] in place of its material.
+    fn triangle(&self, k: usize, object: ObjectId) -> Triangle {
+        let mesh = self.mesh;
+        let corner = |index: u32| {
+            let i = index as usize * 3;
+            mesh.positions
+                .get(i..i + 3)
+                .map_or(Vec3::NAN, |p| Vec3::new(p[0], p[1], p[2]))
+        };
+        let face = &mesh.indices[3 * k..3 * k + 3];
+        let mut v = [face[0], face[1], face[2]].map(|i| self.linear * corner(i) + self.translate);
+        if self.mirrors {
+            v.swap(1, 2);
+        }
+        let material = if !is_visible_triangle(&v) {
+            DEGENERATE
+        } else if v.iter().any(|p| p.abs().max_element() > MAX_COORDINATE) {
+            TOO_FAR
+        } else {
+            PLACED
+        };
+        Triangle {
+            vertices: v,
+            material,
+            object,
+        }
+    }
+
+    /// The mesh's normal or texture-coordinate indices of face `k` (swapped as its corners),
+    /// from `(the model's index list, the model's first in the mesh's list, how many the model
+    /// has)`; [`NO_INDEX`]`× 3` when one is out of range or names a value that is not `usable`.
+    fn corner_ids(
+        &self,
+        k: usize,
+        (indices, base, count): (&[u32], u32, u32),
+        usable: &(impl Fn(u32) -> bool + Sync),
+    ) -> [u32; 3] {
+        let Some(idx) = indices.get(3 * k..3 * k + 3) else {
+            return [NO_INDEX; 3];
+        };
+        let mut idx = [idx[0], idx[1], idx[2]];
+        if !idx.iter().all(|&i| i < count && usable(base + i)) {
+            return [NO_INDEX; 3];
+        }
+        if self.mirrors {
+            idx.swap(1, 2);
+        }
+        idx.map(|i| base + i)
+    }
+}
+
+/// The normal and texture-coordinate indices of a mesh's kept triangles, while it loads; each
+/// list is empty until a model gives some, then as long as the triangles kept up to that
+/// model's end ([`finish_attributes`] pads it to the mesh's end).
 #[derive(Default)]
 struct Corners {
     normals: Vec<[u32; 3]>,
@@ -679,6 +841,12 @@ fn finish_attributes(
             req.label,
             plural(n)
         ));
+    }
+    let mut corners = corners;
+    for list in [&mut corners.normals, &mut corners.uvs] {
+        if !list.is_empty() {
+            list.resize(count, [NO_INDEX; 3]);
+        }
     }
     match req.normals {
         NormalsMode::Flat => attrs.normals.clear(),
@@ -770,15 +938,19 @@ pub fn smooth_normals(triangles: &[Triangle], crease_angle_deg: f32) -> (Vec<Vec
     (normals, indices)
 }
 
-/// `usemtl` names that no loaded library defines: tobj silently gives those faces no material.
-fn warn_unknown_usemtl(req: &MeshRequest, known: &[tobj::Material], warnings: &mut Vec<String>) {
-    let unknown: BTreeSet<&str> = req
-        .text
-        .lines()
-        .filter_map(|line| line.trim_start().strip_prefix("usemtl"))
-        .filter(|rest| rest.starts_with([' ', '\t']))
-        .map(str::trim)
-        .filter(|name| !name.is_empty() && !known.iter().any(|m| m.name == *name))
+/// `usemtl` names ([`Facts::usemtl`]) that no loaded library defines: tobj silently gives
+/// those faces no material.
+fn warn_unknown_usemtl(
+    label: &str,
+    facts: &Facts,
+    known: &[tobj::Material],
+    warnings: &mut Vec<String>,
+) {
+    let unknown: Vec<&str> = facts
+        .usemtl
+        .iter()
+        .map(String::as_str)
+        .filter(|name| !known.iter().any(|m| m.name == *name))
         .collect();
     if !unknown.is_empty() {
         // A handful of names, so that the warning stays one readable sentence.
@@ -791,8 +963,7 @@ fn warn_unknown_usemtl(req: &MeshRequest, known: &[tobj::Material], warnings: &m
             names.push(format!("{} more", unknown.len() - 5));
         }
         warnings.push(format!(
-            "{}: `usemtl` names materials that no material library defines ({}); their faces use the default material.",
-            req.label,
+            "{label}: `usemtl` names materials that no material library defines ({}); their faces use the default material.",
             list_and(&names)
         ));
     }
@@ -1057,9 +1228,14 @@ mod tests {
         assert_eq!(obj_counts("f 1 2 3 4 5\nl 1 2\nf 1\nv 1 1 1\n"), (1, 4));
         let (stripped, n) = without_polylines("v 0 0 0\n l 1 2 3\nf 1 1 1\n");
         assert_eq!((stripped.as_ref(), n), ("v 0 0 0\n#\nf 1 1 1\n", 1));
-        assert!(check_mesh_memory(&Scene::default(), &text, &limit).is_ok());
+        let check = |text: &str| {
+            let facts = obj_parse::scan(text, Polylines::Skip).expect("the fast reader takes it");
+            assert_eq!(*facts.facts(), slow_facts(text));
+            check_mesh_memory(&Scene::default(), text.len(), facts.facts(), &limit)
+        };
+        assert!(check(&text).is_ok());
         text += &"f 1 2 3\n".repeat(3000);
-        let e = check_mesh_memory(&Scene::default(), &text, &limit).expect_err("over 1 MiB");
+        let e = check(&text).expect_err("over 1 MiB");
         assert_eq!(
             e,
             "its 3 vertices and 3000 triangles would need about 1.3 MiB, more than the memory \

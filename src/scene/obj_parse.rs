@@ -12,13 +12,19 @@
 //! at those statements and renumbers each model's vertices in first-use order, as tobj does,
 //! with flat lookup tables instead of hash maps.
 //!
+//! The same pass counts what the loader needs before it builds anything ([`Facts`]: vertices
+//! and triangles for the memory budget, `vn` and `vt` for the attributes' share, polylines, and
+//! the `usemtl` names for the unknown-material warning), so [`super::obj`] never scans the text
+//! again: [`scan`] reads the chunks, the loader checks the budget with the facts, and
+//! [`Scanned::assemble`] builds the models.
+//!
 //! Whatever this reader does not handle exactly as tobj does makes it give up ([`None`]), and
 //! the caller then runs tobj: negative (relative) and zero indices, `v` lines with a `w` or
 //! vertex colours, every line tobj would reject (a bad number, too few numbers, a corner out
 //! of range, an empty `usemtl`), which also keeps tobj's error messages. Unknown statements
 //! are skipped, as tobj skips them.
 
-use std::collections::HashMap;
+use std::collections::{BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
@@ -52,8 +58,58 @@ struct Chunk {
     normals: Vec<f32>,
     /// `(v, vt, vn)` of every triangle corner, 0-based, [`MISSING`] where absent.
     corners: Vec<[u32; 3]>,
-    /// With chunk-local counts until [`parse`] makes them global.
+    /// With chunk-local counts until [`scan`] makes them global.
     events: Vec<Event>,
+    /// Triangles of `f` lines (not of polylines read as faces).
+    face_triangles: u64,
+    /// `l` lines skipped ([`Polylines::Skip`]).
+    polylines: u64,
+    /// `usemtl` names as the loader's warning names them (see [`Facts::usemtl`]).
+    usemtl: Vec<String>,
+}
+
+/// What to do with polyline (`l`) statements.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Polylines {
+    /// Read as faces, as tobj reads them (`l 1 2 3` is a triangle).
+    AsFaces,
+    /// Skipped and counted, as if each were a comment: what the loader wants (a line has no
+    /// surface), the same result as tobj on the text with its `l` lines commented out.
+    Skip,
+}
+
+/// What the one pass of [`scan`] counted.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Facts {
+    /// `v` statements.
+    pub vertices: u64,
+    /// `vt` statements.
+    pub texcoords: u64,
+    /// `vn` statements.
+    pub normals: u64,
+    /// Triangles of the `f` statements after triangulation (a face of one or two corners is
+    /// one degenerate triangle, as tobj makes it).
+    pub triangles: u64,
+    /// `l` statements skipped ([`Polylines::Skip`]; 0 with [`Polylines::AsFaces`]).
+    pub polylines: u64,
+    /// The names of `usemtl` lines that start (after leading whitespace) with `usemtl` and a
+    /// space or tab, trimmed, without empty ones.
+    pub usemtl: BTreeSet<String>,
+}
+
+/// The text read in chunks by [`scan`], not yet made into models.
+pub struct Scanned {
+    chunks: Vec<Chunk>,
+    facts: Facts,
+}
+
+impl std::fmt::Debug for Scanned {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Scanned")
+            .field("chunks", &self.chunks.len())
+            .field("facts", &self.facts)
+            .finish()
+    }
 }
 
 /// Words split at the whitespace `str::split_whitespace` knows in ASCII (space, tab, line
@@ -91,18 +147,26 @@ impl<'a> Iterator for AsciiWords<'a> {
 
 /// Reads OBJ text as tobj would (see the module documentation), calling `load_mtl` for each
 /// `mtllib` in file order; `None` when tobj must read it instead. `load_mtl` may have been
-/// called before `None` is returned.
+/// called before `None` is returned. Polylines are read as faces, as tobj reads them.
 pub fn parse(
     text: &str,
-    mut load_mtl: impl FnMut(&Path) -> tobj::MTLLoadResult,
+    load_mtl: impl FnMut(&Path) -> tobj::MTLLoadResult,
 ) -> Option<tobj::LoadResult> {
+    scan(text, Polylines::AsFaces)?.assemble(load_mtl)
+}
+
+/// The parallel pass over `text`: every chunk read and counted; `None` when a line is one for
+/// tobj (see the module documentation). Nothing is allocated beyond the chunks' own lists
+/// (at most a few times the text's size); [`Scanned::assemble`] makes the models.
+pub fn scan(text: &str, polylines: Polylines) -> Option<Scanned> {
     let mut chunks: Vec<Chunk> = split_lines(text)
         .par_iter()
-        .map(|part| parse_chunk(part))
+        .map(|part| parse_chunk(part, polylines))
         .collect::<Option<Vec<Chunk>>>()?;
 
-    // Chunk-local counts to whole-file ones, then everything in one list each.
+    // Chunk-local counts to whole-file ones.
     let mut base = (0usize, [0usize; 3]);
+    let mut facts = Facts::default();
     for chunk in &mut chunks {
         for e in &mut chunk.events {
             e.corner += base.0;
@@ -114,97 +178,124 @@ pub fn parse(
         base.1[0] += chunk.positions.len() / 3;
         base.1[1] += chunk.texcoords.len() / 2;
         base.1[2] += chunk.normals.len() / 3;
+        facts.triangles += chunk.face_triangles;
+        facts.polylines += chunk.polylines;
+        facts.usemtl.extend(std::mem::take(&mut chunk.usemtl));
     }
-    let totals = base.1;
-    let join = |pick: fn(&Chunk) -> &Vec<f32>, chunks: &[Chunk]| -> Vec<f32> {
-        let mut out = Vec::with_capacity(chunks.iter().map(|c| pick(c).len()).sum());
+    facts.vertices = base.1[0] as u64;
+    facts.texcoords = base.1[1] as u64;
+    facts.normals = base.1[2] as u64;
+    Some(Scanned { chunks, facts })
+}
+
+impl Scanned {
+    /// What the pass counted.
+    pub fn facts(&self) -> &Facts {
+        &self.facts
+    }
+
+    /// The models and materials, exactly as tobj gives them, calling `load_mtl` for each
+    /// `mtllib` in file order; `None` when a face names a vertex out of range (tobj's error).
+    pub fn assemble(
+        self,
+        mut load_mtl: impl FnMut(&Path) -> tobj::MTLLoadResult,
+    ) -> Option<tobj::LoadResult> {
+        let chunks = self.chunks;
+        let totals = [
+            self.facts.vertices as usize,
+            self.facts.texcoords as usize,
+            self.facts.normals as usize,
+        ];
+        let join = |pick: fn(&Chunk) -> &Vec<f32>, chunks: &[Chunk]| -> Vec<f32> {
+            let mut out = Vec::with_capacity(chunks.iter().map(|c| pick(c).len()).sum());
+            for c in chunks {
+                out.extend_from_slice(pick(c));
+            }
+            out
+        };
+        let positions = join(|c| &c.positions, &chunks);
+        let texcoords = join(|c| &c.texcoords, &chunks);
+        let normals = join(|c| &c.normals, &chunks);
+        // The corners stay in their chunks (a copy would cost time and memory).
+        let mut events = Vec::new();
+        let mut parts = Vec::with_capacity(chunks.len());
         for c in chunks {
-            out.extend_from_slice(pick(c));
+            events.extend(c.events);
+            parts.push(c.corners);
         }
-        out
-    };
-    let positions = join(|c| &c.positions, &chunks);
-    let texcoords = join(|c| &c.texcoords, &chunks);
-    let normals = join(|c| &c.normals, &chunks);
-    // The corners stay in their chunks (a copy would cost time and memory).
-    let mut events = Vec::new();
-    let mut parts = Vec::with_capacity(chunks.len());
-    for c in chunks {
-        events.extend(c.events);
-        parts.push(c.corners);
-    }
-    let corners = Corners::new(parts);
-    let mut out = Assembly {
-        positions: &positions,
-        texcoords: &texcoords,
-        normals: &normals,
-        maps: [
-            vec![MISSING; totals[0]],
-            vec![MISSING; totals[1]],
-            vec![MISSING; totals[2]],
-        ],
-        models: Vec::new(),
-    };
-    let mut name = "unnamed_object".to_string();
-    let mut mat_id: Option<usize> = None;
-    let mut materials: Vec<tobj::Material> = Vec::new();
-    let mut mat_map: HashMap<String, usize> = HashMap::new();
-    let mut mtl_error: Option<tobj::LoadError> = None;
-    let mut start = 0;
-    for e in events {
-        match e.kind {
-            EventKind::Name(n) => {
-                if e.corner > start {
-                    out.pop(
-                        corners.range(start, e.corner),
-                        e.corner - start,
-                        e.counts,
-                        &name,
-                        mat_id,
-                    )?;
-                    start = e.corner;
-                }
-                name = n;
-            }
-            EventKind::MtlLib(path) => match load_mtl(&path) {
-                Ok((mut mats, map)) => {
-                    let offset = materials.len();
-                    materials.append(&mut mats);
-                    for (k, v) in map {
-                        mat_map.insert(k, v + offset);
+        let corners = Corners::new(parts);
+        let mut out = Assembly {
+            positions: &positions,
+            texcoords: &texcoords,
+            normals: &normals,
+            maps: [
+                vec![MISSING; totals[0]],
+                vec![MISSING; totals[1]],
+                vec![MISSING; totals[2]],
+            ],
+            models: Vec::new(),
+        };
+        let mut name = "unnamed_object".to_string();
+        let mut mat_id: Option<usize> = None;
+        let mut materials: Vec<tobj::Material> = Vec::new();
+        let mut mat_map: HashMap<String, usize> = HashMap::new();
+        let mut mtl_error: Option<tobj::LoadError> = None;
+        let mut start = 0;
+        for e in events {
+            match e.kind {
+                EventKind::Name(n) => {
+                    if e.corner > start {
+                        out.pop(
+                            corners.range(start, e.corner),
+                            e.corner - start,
+                            e.counts,
+                            &name,
+                            mat_id,
+                        )?;
+                        start = e.corner;
                     }
+                    name = n;
                 }
-                Err(err) => mtl_error = Some(err),
-            },
-            EventKind::UseMtl(m) => {
-                let new = mat_map.get(&m).copied();
-                if mat_id != new && e.corner > start {
-                    out.pop(
-                        corners.range(start, e.corner),
-                        e.corner - start,
-                        e.counts,
-                        &name,
-                        mat_id,
-                    )?;
-                    start = e.corner;
+                EventKind::MtlLib(path) => match load_mtl(&path) {
+                    Ok((mut mats, map)) => {
+                        let offset = materials.len();
+                        materials.append(&mut mats);
+                        for (k, v) in map {
+                            mat_map.insert(k, v + offset);
+                        }
+                    }
+                    Err(err) => mtl_error = Some(err),
+                },
+                EventKind::UseMtl(m) => {
+                    let new = mat_map.get(&m).copied();
+                    if mat_id != new && e.corner > start {
+                        out.pop(
+                            corners.range(start, e.corner),
+                            e.corner - start,
+                            e.counts,
+                            &name,
+                            mat_id,
+                        )?;
+                        start = e.corner;
+                    }
+                    mat_id = new;
                 }
-                mat_id = new;
             }
         }
+        // tobj always ends with a model, empty or not.
+        out.pop(
+            corners.range(start, corners.len),
+            corners.len - start,
+            totals,
+            &name,
+            mat_id,
+        )?;
+        let materials = match (materials.is_empty(), mtl_error) {
+            (true, Some(err)) => Err(err),
+            _ => Ok(materials),
+        };
+        Some(Ok((out.models, materials)))
     }
-    // tobj always ends with a model, empty or not.
-    out.pop(
-        corners.range(start, corners.len),
-        corners.len - start,
-        totals,
-        &name,
-        mat_id,
-    )?;
-    let materials = match (materials.is_empty(), mtl_error) {
-        (true, Some(err)) => Err(err),
-        _ => Ok(materials),
-    };
-    Some(Ok((out.models, materials)))
 }
 
 /// The text cut after line ends into pieces of at least about 1 MiB, at most four per thread
@@ -230,7 +321,7 @@ fn split_lines(text: &str) -> Vec<&str> {
     out
 }
 
-fn parse_chunk(text: &str) -> Option<Chunk> {
+fn parse_chunk(text: &str, polylines: Polylines) -> Option<Chunk> {
     let mut chunk = Chunk::default();
     for line in text.split('\n') {
         let mut words = AsciiWords { line, at: 0 };
@@ -239,9 +330,9 @@ fn parse_chunk(text: &str) -> Option<Chunk> {
             // Unicode whitespace may hide in a non-ASCII first word (`\u{a0}v`); such a line
             // is split as tobj splits it. In the numbers, it makes them unreadable (`None`).
             Some(first) if !first.is_ascii() => {
-                parse_line(line, line.split_whitespace(), &mut chunk)?;
+                parse_line(line, line.split_whitespace(), polylines, &mut chunk)?;
             }
-            Some(_) => parse_line(line, AsciiWords { line, at: 0 }, &mut chunk)?,
+            Some(_) => parse_line(line, AsciiWords { line, at: 0 }, polylines, &mut chunk)?,
         }
     }
     Some(chunk)
@@ -307,6 +398,7 @@ fn corner(word: &str) -> Option<[u32; 3]> {
 fn parse_line<'a>(
     line: &'a str,
     mut words: impl Iterator<Item = &'a str>,
+    polylines: Polylines,
     chunk: &mut Chunk,
 ) -> Option<()> {
     let Some(first) = words.next() else {
@@ -322,24 +414,13 @@ fn parse_line<'a>(
         }
         "vt" => numbers(&mut words, 2, &mut chunk.texcoords)?,
         "vn" => numbers(&mut words, 3, &mut chunk.normals)?,
-        "f" | "l" => {
-            let a = corner(words.next()?)?;
-            let Some(word) = words.next() else {
-                chunk.corners.extend([a, a, a]);
-                return Some(());
-            };
-            let mut b = corner(word)?;
-            let mut any = false;
-            for word in words {
-                let c = corner(word)?;
-                chunk.corners.extend([a, b, c]);
-                b = c;
-                any = true;
-            }
-            if !any {
-                chunk.corners.extend([a, b, b]);
-            }
+        "l" if polylines == Polylines::Skip => chunk.polylines += 1,
+        "f" => {
+            let before = chunk.corners.len();
+            face(words, &mut chunk.corners)?;
+            chunk.face_triangles += ((chunk.corners.len() - before) / 3) as u64;
         }
+        "l" => face(words, &mut chunk.corners)?,
         "o" | "g" => {
             let size = line.chars().next().map_or(1, char::len_utf8);
             let name = line.get(size..).unwrap_or("").trim();
@@ -359,9 +440,38 @@ fn parse_line<'a>(
             if name.is_empty() {
                 return None;
             }
+            // The loader warns about names no library defines, named as this finds them.
+            if let Some(rest) = line.trim_start().strip_prefix("usemtl")
+                && rest.starts_with([' ', '\t'])
+                && !rest.trim().is_empty()
+            {
+                chunk.usemtl.push(rest.trim().to_string());
+            }
             push_event(chunk, EventKind::UseMtl(name.to_string()));
         }
         _ => {}
+    }
+    Some(())
+}
+
+/// The triangles of a face's corner `words`, fanned as tobj fans them (one corner: one
+/// triangle `a a a`; two: `a b b`); `None` for no corners or a bad one.
+fn face<'a>(mut words: impl Iterator<Item = &'a str>, out: &mut Vec<[u32; 3]>) -> Option<()> {
+    let a = corner(words.next()?)?;
+    let Some(word) = words.next() else {
+        out.extend([a, a, a]);
+        return Some(());
+    };
+    let mut b = corner(word)?;
+    let mut any = false;
+    for word in words {
+        let c = corner(word)?;
+        out.extend([a, b, c]);
+        b = c;
+        any = true;
+    }
+    if !any {
+        out.extend([a, b, b]);
     }
     Some(())
 }

@@ -88,9 +88,92 @@ pub fn same(a: &tobj::LoadResult, b: &tobj::LoadResult) -> Result<(), String> {
 }
 
 /// Reads `text` with both readers (MTL files through `mtl`) and checks: the fast reader never
-/// panics; where it gives a result, tobj gives the same; where tobj fails, it gives none.
-/// Returns whether the fast reader took the text.
+/// panics; where it gives a result, tobj gives the same; where tobj fails, it gives none. The
+/// loader's way too ([`check_loader_pass`]). Returns whether the fast reader took the text.
 pub fn check(text: &str, mtl: &dyn Fn(&Path) -> tobj::MTLLoadResult) -> bool {
+    check_loader_pass(text, mtl);
+    check_tobj_pass(text, mtl)
+}
+
+/// The text with each polyline (`l`) line made a comment, as the loader reads it.
+pub fn without_polylines(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for line in text.lines() {
+        if line.split_whitespace().next() == Some("l") {
+            out.push('#');
+        } else {
+            out.push_str(line);
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// What the loader's single pass must count, counted line by line here: `v`, `vt`, `vn`,
+/// triangles of `f` (one for a face of fewer than three corners), `l` lines, and the names of
+/// `usemtl` followed by a space or tab.
+pub fn facts_by_lines(text: &str) -> raytree::scene::obj_parse::Facts {
+    let mut f = raytree::scene::obj_parse::Facts::default();
+    for line in text.lines() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => f.vertices += 1,
+            Some("vt") => f.texcoords += 1,
+            Some("vn") => f.normals += 1,
+            Some("l") => f.polylines += 1,
+            Some("f") => f.triangles += (words.count() as u64).saturating_sub(2).max(1),
+            _ => {}
+        }
+        if let Some(rest) = line.trim_start().strip_prefix("usemtl")
+            && rest.starts_with([' ', '\t'])
+            && !rest.trim().is_empty()
+        {
+            f.usemtl.insert(rest.trim().to_string());
+        }
+    }
+    f
+}
+
+/// The loader's pass (`scan` with polylines skipped, then `assemble`): never panics; where it
+/// takes the text, its facts are the line-by-line counts and its models what tobj reads from
+/// the text with its polylines commented out. Returns whether it took the text.
+pub fn check_loader_pass(text: &str, mtl: &dyn Fn(&Path) -> tobj::MTLLoadResult) -> bool {
+    use raytree::scene::obj_parse::{Polylines, scan};
+    let scanned = catch_unwind(AssertUnwindSafe(|| scan(text, Polylines::Skip)))
+        .unwrap_or_else(|_| panic!("the fast reader's scan panicked on {text:?}"));
+    let Some(scanned) = scanned else {
+        return false;
+    };
+    assert_eq!(
+        *scanned.facts(),
+        facts_by_lines(text),
+        "the facts of {:?}",
+        short(text)
+    );
+    let fast = catch_unwind(AssertUnwindSafe(|| scanned.assemble(mtl)))
+        .unwrap_or_else(|_| panic!("the fast reader panicked on {text:?}"));
+    let plain = without_polylines(text);
+    let slow = catch_unwind(AssertUnwindSafe(|| {
+        tobj::load_obj_buf(&mut plain.as_bytes(), &options(), mtl)
+    }));
+    match (fast, slow) {
+        (Some(f), Ok(s)) => {
+            assert!(f.is_ok(), "the fast reader gives only successes");
+            if let Err(e) = same(&f, &s) {
+                panic!(
+                    "the readers differ without polylines ({e}) on {:?}",
+                    short(text)
+                );
+            }
+            true
+        }
+        (Some(_), Err(_)) => true,
+        (None, _) => false,
+    }
+}
+
+/// [`check`] for the reader as tobj reads (polylines as faces).
+pub fn check_tobj_pass(text: &str, mtl: &dyn Fn(&Path) -> tobj::MTLLoadResult) -> bool {
     let fast = catch_unwind(AssertUnwindSafe(|| {
         raytree::scene::obj_parse::parse(text, mtl)
     }))

@@ -25,12 +25,12 @@ use obvhs::{
     BvhBuildParams,
     aabb::Aabb,
     bvh2::{Bvh2, node::Bvh2Node, reinsertion::ReinsertionOptimizer},
-    ploc::PlocBuilder,
+    ploc::{PlocBuilder, PlocSearchDistance},
 };
 use rayon::prelude::*;
 
 use super::{Bvh, LEAF, MAX_LEAF, MAX_PRIMS, NODE_PAD_REL, Node, Packet, SPHERE, STACK_SIZE};
-use crate::accel::{Prim, Shape};
+use crate::accel::{Prim, Prims, Shape};
 use crate::geometry::Triangles4;
 
 /// More primitives than this with exactly the same box centre (duplicates, concentric spheres)
@@ -77,44 +77,55 @@ const PACKET_COST: f32 = 1.5;
 const SPHERE_COST: f32 = 1.0;
 
 impl Bvh {
+    /// The tree over a list of primitives (the unit tests' way).
+    #[cfg(test)]
     pub(in crate::accel) fn build(prims: Vec<Prim>) -> Bvh {
+        Self::build_from(&prims[..])
+    }
+
+    /// The tree over `prims`. Memory: while `obvhs` builds, only its own lists and the binary
+    /// tree exist (the leaves' boxes are its node list, filled here; no list of boxes or of
+    /// primitives beside it); the primitives are read again for the leaves.
+    pub(in crate::accel) fn build_from<P: Prims + ?Sized>(prims: &P) -> Bvh {
+        Self::build_split(prims, SPLIT_BUILD_MIN_PRIMS)
+    }
+
+    /// [`Bvh::build_from`] with the two-tree build from `split_min` primitives on (at least
+    /// 4; the tests lower it).
+    fn build_split<P: Prims + ?Sized>(prims: &P, split_min: usize) -> Bvh {
+        let n = prims.count();
         // Loaded scenes stay far below (the file-size caps and the memory budget bound them);
         // beyond this, ids would not fit a leaf word.
-        assert!(prims.len() <= MAX_PRIMS, "more than 2^28 primitives");
-        let bounds = |prims: &[Prim]| -> Vec<Aabb> {
-            prims
-                .par_iter()
-                .map(|p| {
-                    let (lo, hi) = p.bounds();
-                    Aabb::new(lo.into(), hi.into())
-                })
-                .collect()
+        assert!(n <= MAX_PRIMS, "more than 2^28 primitives");
+        let bounds = |i: usize| {
+            let (lo, hi) = prims.get(i).bounds();
+            Aabb::new(lo.into(), hi.into())
         };
-        let params = build_params(prims.len());
+        let params = build_params(n);
         let mut built = None;
-        let mut boxes = bounds(&prims);
-        if max_stacked(&boxes) <= MAX_STACKED {
-            boxes
-                .par_iter_mut()
-                .enumerate()
-                .for_each(|(i, b)| *b = jitter(b, i));
-            let mut bvh2 = PlocBuilder::with_capacity(boxes.len()).build(
-                params.ploc_search_distance,
-                &boxes,
-                (0..boxes.len() as u32).collect(),
-                params.sort_precision,
-                params.search_depth_threshold,
-            );
-            ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
-            // Peak memory: the boxes are not needed by the collapse (the fallback below makes
-            // its own, unjittered).
-            drop(boxes);
-            built = collapse(bvh2, &prims).filter(|b| stack_need(&b.nodes) + 3 <= STACK_SIZE);
-        } else {
-            drop(boxes);
+        if max_stacked(n, &bounds) <= MAX_STACKED {
+            let flat = if n >= split_min.max(4) {
+                split_ploc(n, &bounds, &params)
+            } else {
+                let leaves: Vec<Bvh2Node> = (0..n)
+                    .into_par_iter()
+                    .map(|i| Bvh2Node::new(jitter(&bounds(i), i), 1, i as u32))
+                    .collect();
+                let mut bvh2 = ploc(leaves, &params);
+                ReinsertionOptimizer::default().run(
+                    &mut bvh2,
+                    params.reinsertion_batch_ratio,
+                    None,
+                );
+                preorder(&bvh2)
+            };
+            built = flat
+                .and_then(|flat| collapse_flat(flat, prims))
+                .filter(|b| stack_need(&b.nodes) + 3 <= STACK_SIZE);
         }
         built.unwrap_or_else(|| {
-            let b = collapse(median_bvh2(&bounds(&prims)), &prims).unwrap_or_else(|| Bvh {
+            let boxes: Vec<Aabb> = (0..n).into_par_iter().map(bounds).collect();
+            let b = collapse(median_bvh2(&boxes), prims).unwrap_or_else(|| Bvh {
                 nodes: Vec::new(),
                 packets: Vec::new(),
                 spheres: Vec::new(),
@@ -126,6 +137,114 @@ impl Bvh {
             b
         })
     }
+}
+
+/// From this many primitives on, the binary tree is built as two PLOC trees, one after the
+/// other, under a root that splits the primitives at the median of their centres along the
+/// widest axis: obvhs' PLOC needs about 210 bytes per primitive while it builds (its node
+/// lists of 48-byte nodes: the leaves, their sorted copy and the tree of `2N − 1`), so halves
+/// built one at a time halve that peak. Below this size the peak is small and one tree keeps
+/// the whole build to PLOC.
+pub const SPLIT_BUILD_MIN_PRIMS: usize = 500_000;
+
+/// The pre-order binary tree of [`SPLIT_BUILD_MIN_PRIMS`]: a root whose children are the PLOC
+/// trees (each optimised by reinsertion) of the lower and upper halves of the primitives
+/// ordered by their box centres along the widest axis of those centres (ties by index).
+fn split_ploc(
+    n: usize,
+    bounds: &(impl Fn(usize) -> Aabb + Sync),
+    params: &BvhBuildParams,
+) -> Option<Vec<FlatNode>> {
+    let centers = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let c = bounds(i).center();
+            Aabb::new(c, c)
+        })
+        .reduce(Aabb::empty, |a, b| a.union(&b));
+    let axis = centers.largest_axis();
+    let mut ids: Vec<u32> = (0..n as u32).collect();
+    {
+        let keys: Vec<f32> = (0..n)
+            .into_par_iter()
+            .map(|i| bounds(i).center()[axis])
+            .collect();
+        ids.select_nth_unstable_by(n / 2, |&a, &b| {
+            keys[a as usize]
+                .total_cmp(&keys[b as usize])
+                .then(a.cmp(&b))
+        });
+    }
+    let (low, high) = ids.split_at_mut(n / 2);
+    let mut flat: Vec<FlatNode> = Vec::with_capacity(2 * n - 1);
+    flat.push(FlatNode {
+        min: [0.0; 3],
+        max: [0.0; 3],
+        link: 0,
+    });
+    let mut root = Aabb::empty();
+    for (k, part) in [low, high].into_iter().enumerate() {
+        // In index order: neighbours in the input are often neighbours in space.
+        part.par_sort_unstable();
+        let leaves: Vec<Bvh2Node> = part
+            .par_iter()
+            .enumerate()
+            .map(|(local, &i)| {
+                Bvh2Node::new(jitter(&bounds(i as usize), i as usize), 1, local as u32)
+            })
+            .collect();
+        let mut bvh2 = ploc(leaves, params);
+        ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
+        root = root.union(&bvh2.nodes[0].aabb);
+        if k == 1 {
+            flat[0].link = flat.len() as u32;
+        }
+        preorder_into(&bvh2, part, &mut flat, 2)?;
+    }
+    flat[0].min = root.min.to_array();
+    flat[0].max = root.max.to_array();
+    Some(flat)
+}
+
+/// obvhs' PLOC over `leaves` (one primitive each, primitive `i` at `i`), as
+/// `PlocBuilder::build` makes it from the leaves' boxes: the same tree, without the list of
+/// boxes beside the builder's own node lists.
+fn ploc(leaves: Vec<Bvh2Node>, params: &BvhBuildParams) -> Bvh2 {
+    let n = leaves.len();
+    let total = leaves
+        .par_iter()
+        .map(|l| l.aabb)
+        .reduce(Aabb::empty, |a, b| a.union(&b));
+    let mut bvh = Bvh2::zeroed(n);
+    bvh.reset_for_reuse(n, Some((0..n as u32).collect()));
+    if n == 0 {
+        return bvh;
+    }
+    let mut builder = PlocBuilder::new();
+    builder.current_nodes = leaves;
+    let (precision, threshold) = (params.sort_precision, params.search_depth_threshold);
+    let b = &mut builder;
+    match params.ploc_search_distance {
+        PlocSearchDistance::Minimum => {
+            b.build_ploc_from_leaves::<1, false>(&mut bvh, total, precision, threshold)
+        }
+        PlocSearchDistance::VeryLow => {
+            b.build_ploc_from_leaves::<2, false>(&mut bvh, total, precision, threshold)
+        }
+        PlocSearchDistance::Low => {
+            b.build_ploc_from_leaves::<6, false>(&mut bvh, total, precision, threshold)
+        }
+        PlocSearchDistance::Medium => {
+            b.build_ploc_from_leaves::<14, false>(&mut bvh, total, precision, threshold)
+        }
+        PlocSearchDistance::High => {
+            b.build_ploc_from_leaves::<24, false>(&mut bvh, total, precision, threshold)
+        }
+        PlocSearchDistance::VeryHigh => {
+            b.build_ploc_from_leaves::<32, false>(&mut bvh, total, precision, threshold)
+        }
+    }
+    bvh
 }
 
 /// The box of a binary node, padded by [`NODE_PAD_REL`] of its largest magnitude.
@@ -173,8 +292,17 @@ fn preorder(bvh2: &Bvh2) -> Option<Vec<FlatNode>> {
         return None;
     }
     let mut flat: Vec<FlatNode> = Vec::with_capacity(bvh2.nodes.len());
+    let ids: Vec<u32> = Vec::new();
+    preorder_into(bvh2, &ids, &mut flat, 1)?;
+    Some(flat)
+}
+
+/// Appends `bvh2` (not empty) in pre-order to `flat`, its root at depth `depth`; a leaf's
+/// primitive `p` becomes `ids[p]` (`p` itself when `ids` is empty). `None` when deeper than
+/// [`MAX_BVH2_DEPTH`].
+fn preorder_into(bvh2: &Bvh2, ids: &[u32], flat: &mut Vec<FlatNode>, depth: usize) -> Option<()> {
     // (binary node, pre-order index of the parent whose right child it is, depth)
-    let mut todo = vec![(0u32, u32::MAX, 1usize)];
+    let mut todo = vec![(0u32, u32::MAX, depth)];
     while let Some((i, parent, d)) = todo.pop() {
         if d > MAX_BVH2_DEPTH {
             return None;
@@ -191,37 +319,36 @@ fn preorder(bvh2: &Bvh2) -> Option<Vec<FlatNode>> {
             todo.push((node.first_index, u32::MAX, d + 1));
         } else {
             assert!(node.prim_count == 1, "binary leaves hold one primitive");
+            let p = bvh2.primitive_indices[node.first_index as usize];
+            let p = if ids.is_empty() { p } else { ids[p as usize] };
             flat.push(FlatNode {
                 min,
                 max,
-                link: FLAT_LEAF | bvh2.primitive_indices[node.first_index as usize],
+                link: FLAT_LEAF | p,
             });
         }
     }
-    Some(flat)
+    Some(())
 }
 
 /// The 4-wide tree of a binary BVH whose leaves hold one primitive each (PLOC's and
 /// [`median_bvh2`]'s do); `None` for an empty tree or one deeper than [`MAX_BVH2_DEPTH`].
-fn collapse(bvh2: Bvh2, prims: &[Prim]) -> Option<Bvh> {
+fn collapse<P: Prims + ?Sized>(bvh2: Bvh2, prims: &P) -> Option<Bvh> {
     let flat = preorder(&bvh2)?;
     // The copy is all that is needed from here on.
     drop(bvh2);
+    collapse_flat(flat, prims)
+}
+
+/// The 4-wide tree of a binary tree in pre-order ([`preorder`]).
+fn collapse_flat<P: Prims + ?Sized>(flat: Vec<FlatNode>, prims: &P) -> Option<Bvh> {
     let n = flat.len();
     let right = |i: usize| flat[i].link as usize;
     // Bottom up (reverse pre-order): primitives under each node and the surface-area cost of
     // its best subtree; `leaf[i]` when the node's subtree is cheaper as one leaf.
     // `Accel` lists the spheres first: an index tells the kind without reading the primitive
     // (reading them in tree order misses the cache on every one).
-    let sphere_count = prims
-        .iter()
-        .take_while(|p| matches!(p.shape, Shape::Sphere { .. }))
-        .count();
-    debug_assert!(
-        prims[sphere_count..]
-            .iter()
-            .all(|p| matches!(p.shape, Shape::Triangle(_)))
-    );
+    let sphere_count = prims.spheres();
     let is_sphere = |i: usize| i < sphere_count;
     let mut count = vec![0u32; n];
     let mut spheres = vec![0u32; n];
@@ -310,7 +437,7 @@ fn collapse(bvh2: Bvh2, prims: &[Prim]) -> Option<Bvh> {
             node.valid |= 1 << slot;
             if leaf[s] && spheres[s] == 1 {
                 node.child[slot] = LEAF | SPHERE | sphere_leaves.len() as u32;
-                sphere_leaves.push(prims[flat[s].prim() as usize]);
+                sphere_leaves.push(prims.get(flat[s].prim() as usize));
             } else if leaf[s] {
                 // The subtree's triangles, left to right: the leaves of its run of
                 // `2·count − 1` nodes, as one packet.
@@ -339,10 +466,16 @@ fn collapse(bvh2: Bvh2, prims: &[Prim]) -> Option<Bvh> {
     }
     drop(flat);
     nodes.shrink_to_fit();
-    let triangle = |i: u32| match prims[i as usize].shape {
-        Shape::Triangle(v) => (v, prims[i as usize].id),
+    let triangle = |i: u32| match prims.get(i as usize) {
+        Prim {
+            shape: Shape::Triangle(v),
+            id,
+        } => (v, id),
         // Leaves hold no spheres (`spheres[s] == 0`).
-        Shape::Sphere { .. } => unreachable!("a sphere in a triangle leaf"),
+        Prim {
+            shape: Shape::Sphere { .. },
+            ..
+        } => unreachable!("a sphere in a triangle leaf"),
     };
     // Random reads of the primitives: split over the threads.
     let packets = leaf_prims
@@ -411,12 +544,12 @@ fn bvh2_depth(bvh: &Bvh2) -> usize {
     max
 }
 
-/// The largest number of boxes sharing exactly the same centre.
-fn max_stacked(boxes: &[Aabb]) -> usize {
-    let mut keys: Vec<[u32; 3]> = boxes
-        .par_iter()
-        .map(|b| {
-            let c = b.center();
+/// The largest number of the `n` boxes `bounds(i)` sharing exactly the same centre.
+fn max_stacked(n: usize, bounds: &(impl Fn(usize) -> Aabb + Sync)) -> usize {
+    let mut keys: Vec<[u32; 3]> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let c = bounds(i).center();
             [c.x.to_bits(), c.y.to_bits(), c.z.to_bits()]
         })
         .collect();
@@ -496,6 +629,199 @@ fn median_bvh2(boxes: &[Aabb]) -> Bvh2 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::accel::{Closest, Visitor};
+    use crate::geometry::{Methods, Ray};
+
+    /// The surface-area cost of a wide tree, relative to its root's box: every child box's
+    /// area times the cost of visiting it (node, triangle leaf, sphere).
+    fn sah_cost(bvh: &Bvh) -> f64 {
+        let area = |lo: Vec3, hi: Vec3| {
+            let d = (hi - lo).max(Vec3::ZERO);
+            f64::from((d.x + d.y) * d.z + d.x * d.y)
+        };
+        let (mut total, mut lo, mut hi) = (0.0, Vec3::INFINITY, Vec3::NEG_INFINITY);
+        for node in &bvh.nodes {
+            for slot in 0..4 {
+                if node.valid & (1 << slot) == 0 {
+                    continue;
+                }
+                let a = Vec3::new(
+                    node.planes[0][slot],
+                    node.planes[2][slot],
+                    node.planes[4][slot],
+                );
+                let b = Vec3::new(
+                    node.planes[1][slot],
+                    node.planes[3][slot],
+                    node.planes[5][slot],
+                );
+                let child = node.child[slot];
+                let cost = if child & LEAF == 0 {
+                    NODE_COST
+                } else if child & SPHERE != 0 {
+                    SPHERE_COST
+                } else {
+                    PACKET_COST
+                };
+                total += f64::from(cost) * area(a, b);
+                if std::ptr::eq(node, &bvh.nodes[0]) {
+                    (lo, hi) = (lo.min(a), hi.max(b));
+                }
+            }
+        }
+        total / area(lo, hi)
+    }
+
+    /// A bumpy torus of about `n` triangles (a surface like the benchmark's), as primitives.
+    fn torus(n: usize) -> Vec<Prim> {
+        let (nu, nv) = (
+            (n as f32 / 8.0).sqrt() as usize * 4,
+            (n as f32 / 8.0).sqrt() as usize,
+        );
+        let p = |i: usize, j: usize| {
+            let (u, v) = (
+                std::f32::consts::TAU * (i % nu) as f32 / nu as f32,
+                std::f32::consts::TAU * (j % nv) as f32 / nv as f32,
+            );
+            let r = 0.5 * (1.0 + 0.12 * (9.0 * u).sin() * (6.0 * v).sin());
+            Vec3::new(
+                (1.35 + r * v.cos()) * u.cos(),
+                r * v.sin(),
+                (1.35 + r * v.cos()) * u.sin(),
+            )
+        };
+        let mut prims = Vec::new();
+        for i in 0..nu {
+            for j in 0..nv {
+                for v in [
+                    [p(i, j), p(i, j + 1), p(i + 1, j + 1)],
+                    [p(i, j), p(i + 1, j + 1), p(i + 1, j)],
+                ] {
+                    prims.push(Prim {
+                        shape: Shape::Triangle(v),
+                        id: prims.len() as u32,
+                    });
+                }
+            }
+        }
+        prims
+    }
+
+    /// The two-tree build (forced at a small size here) finds what brute force finds, and
+    /// its tree costs about what one PLOC tree costs (surface-area cost within 3 %).
+    /// `n` small triangles in clusters scattered in a box (uneven, unlike the torus).
+    fn clusters(n: usize) -> Vec<Prim> {
+        let mut seed = 99u32;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed as f32 / u32::MAX as f32
+        };
+        let mut prims = Vec::new();
+        while prims.len() < n {
+            let c = Vec3::new(rnd() * 8.0 - 4.0, rnd() * 2.0, rnd() * 3.0);
+            for _ in 0..1 + (rnd() * 200.0) as usize {
+                let a = c + Vec3::new(rnd(), rnd(), rnd()) * 0.5;
+                let v = [
+                    a,
+                    a + Vec3::new(rnd(), rnd(), 0.0) * 0.05,
+                    a + Vec3::Z * 0.03,
+                ];
+                prims.push(Prim {
+                    shape: Shape::Triangle(v),
+                    id: prims.len() as u32,
+                });
+            }
+        }
+        prims
+    }
+
+    /// On uneven input the two-tree build costs a little more than one PLOC tree, but not much.
+    #[test]
+    fn the_two_tree_build_costs_about_the_same_on_uneven_input() {
+        let prims = clusters(40_000);
+        let whole = Bvh::build_split(&prims[..], usize::MAX);
+        let split = Bvh::build_split(&prims[..], 0);
+        let (a, b) = (sah_cost(&whole), sah_cost(&split));
+        eprintln!("clusters, surface-area cost: two trees {b:.3}, one tree {a:.3}");
+        assert!(b < a * 1.05, "split {b:.2} against whole {a:.2}");
+    }
+
+    #[test]
+    fn the_two_tree_build_finds_the_same_hits_at_about_the_same_cost() {
+        let mut prims = torus(40_000);
+        // Spheres first, as `Accel` lists them.
+        for (k, c) in [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.35, 0.0, 0.0)]
+            .into_iter()
+            .enumerate()
+        {
+            prims.insert(
+                k,
+                Prim {
+                    shape: Shape::Sphere {
+                        center: c,
+                        radius: 0.3,
+                    },
+                    id: 0,
+                },
+            );
+        }
+        for (id, p) in prims.iter_mut().enumerate() {
+            p.id = id as u32;
+        }
+        let n = prims.len();
+        let bounds = |i: usize| {
+            let (lo, hi) = prims[i].bounds();
+            Aabb::new(lo.into(), hi.into())
+        };
+        assert!(
+            max_stacked(n, &bounds) <= MAX_STACKED,
+            "PLOC, not the median split"
+        );
+        let params = build_params(n);
+        let leaves: Vec<Bvh2Node> = (0..n)
+            .map(|i| Bvh2Node::new(jitter(&bounds(i), i), 1, i as u32))
+            .collect();
+        let mut bvh2 = ploc(leaves, &params);
+        ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
+        let whole = collapse_flat(preorder(&bvh2).expect("shallow"), &prims[..]).expect("a tree");
+        let split = collapse_flat(
+            split_ploc(n, &bounds, &params).expect("shallow"),
+            &prims[..],
+        )
+        .expect("a tree");
+        assert!(stack_need(&split.nodes) + 3 <= STACK_SIZE);
+        // `build_split` takes this path too.
+        let built = Bvh::build_split(&prims[..], 0);
+        assert_eq!(built.nodes.len(), split.nodes.len());
+        let (a, b) = (sah_cost(&whole), sah_cost(&split));
+        eprintln!("surface-area cost: two trees {b:.3}, one tree {a:.3}");
+        assert!(b < a * 1.03, "split {b:.2} against whole {a:.2}");
+        assert!(split.spheres.len() == 2 && split.packets.len() > 40_000 / 4);
+        let m = Methods::default();
+        let mut seed = 7u32;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed as f32 / u32::MAX as f32 * 2.0 - 1.0
+        };
+        let mut hits = 0;
+        for _ in 0..3000 {
+            let o = Vec3::new(rnd(), rnd(), rnd()) * 3.0;
+            let ray = Ray::new(o, (Vec3::new(rnd(), rnd(), rnd()) * 0.5 - o).normalize());
+            let mut brute = Closest::new(&m, &ray, 0.0, f32::INFINITY);
+            for p in &prims {
+                brute.visit(p);
+            }
+            let mut found = Closest::new(&m, &ray, 0.0, f32::INFINITY);
+            split.walk(&ray, 0.0, &mut found);
+            assert_eq!(found.hit(), brute.hit());
+            hits += usize::from(brute.hit().is_some());
+        }
+        assert!(hits > 1000, "{hits}");
+    }
 
     #[test]
     fn the_preset_follows_the_scene_size() {
