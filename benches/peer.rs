@@ -340,12 +340,12 @@ fn write_peer_scene(scene: &Scene, path: &Path) {
         u(&mut b, s.material.0);
     }
     u(&mut b, scene.triangles.len() as u32);
-    for t in &scene.triangles {
+    for t in scene.triangles.iter() {
         for v in t.vertices {
             v3(&mut b, v);
         }
     }
-    for t in &scene.triangles {
+    for t in scene.triangles.iter() {
         u(&mut b, t.material.0);
     }
     std::fs::write(path, b).expect("write the peer scene");

@@ -304,7 +304,7 @@ fn scenes_load_the_same_through_either_reader() {
             "{:?}",
             slow.warnings
         );
-        for (a, b) in fast.triangles.iter().zip(&slow.triangles) {
+        for (a, b) in fast.triangles.iter().zip(slow.triangles.iter()) {
             assert_eq!(a.vertices, b.vertices);
             assert_eq!(a.material, b.material);
         }

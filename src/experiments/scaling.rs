@@ -134,7 +134,8 @@ pub fn scaling_scene(triangles_wanted: usize, width: u32, height: u32) -> Scene 
                 material: MaterialId(0),
                 object: ObjectId(0),
             })
-            .collect(),
+            .collect::<Vec<_>>()
+            .into(),
         ..Scene::default()
     };
     scene.render.width = width;

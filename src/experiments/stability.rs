@@ -613,7 +613,8 @@ pub fn bad_triangles(fraction: f32, n_rays: usize, rng: &mut Pcg) -> BadTriangle
                     material: MaterialId(0),
                     object: ObjectId(0),
                 })
-                .collect();
+                .collect::<Vec<_>>()
+                .into();
             let tracer = Tracer::new(
                 Arc::new(scene),
                 TraceSettings {
@@ -1178,7 +1179,8 @@ pub fn smooth_mesh_scene(
             material: MaterialId(0),
             object: ObjectId(0),
         })
-        .collect();
+        .collect::<Vec<_>>()
+        .into();
     scene.attributes.push(Arc::new(MeshAttributes {
         first_triangle: 0,
         triangle_count: tris.len() as u32,

@@ -389,7 +389,7 @@ impl SceneBuilder<'_> {
         }
         rules::check_triangle(&vertices).map_err(|v| s.verdict(&v))?;
         let material = self.add_object(s, name, ObjectSource::Triangle)?;
-        self.scene.triangles.push(Triangle {
+        std::sync::Arc::make_mut(&mut self.scene.triangles).push(Triangle {
             vertices,
             material,
             object,

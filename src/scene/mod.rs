@@ -341,7 +341,10 @@ pub struct Scene {
     pub materials: Vec<Material>,
     pub objects: Vec<Object>,
     pub spheres: Vec<Sphere>,
-    pub triangles: Vec<Triangle>,
+    /// Shared, not copied, by every render of the scene (a camera move in the viewer makes a
+    /// new `Scene` with the same triangles); changed only while loading, through
+    /// `Arc::make_mut`.
+    pub triangles: Arc<Vec<Triangle>>,
     /// Vertex normals and texture coordinates of the meshes that have them, in the order of
     /// their triangles (so a triangle's are found by binary search).
     pub attributes: Vec<Arc<MeshAttributes>>,
@@ -411,7 +414,7 @@ impl Scene {
             lo = lo.min(s.center - Vec3::splat(s.radius));
             hi = hi.max(s.center + Vec3::splat(s.radius));
         }
-        for t in &self.triangles {
+        for t in self.triangles.iter() {
             for v in t.vertices {
                 lo = lo.min(v);
                 hi = hi.max(v);

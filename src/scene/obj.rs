@@ -534,7 +534,7 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
         false => &[],
     };
     let mut triangle_read = 0;
-    scene.triangles.reserve(triangles_read);
+    Arc::make_mut(&mut scene.triangles).reserve(triangles_read);
     for model in &models {
         let mesh = &model.mesh;
         // Per-face normal and texture indices exist only when every face gives them.
@@ -574,7 +574,7 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
         let given = |k: usize, bit: u8| explicit.get(first_read + k).is_none_or(|f| f & bit != 0);
         let start = scene.triangles.len();
         let object = req.object;
-        scene.triangles.par_extend(
+        Arc::make_mut(&mut scene.triangles).par_extend(
             (0..count)
                 .into_par_iter()
                 .map(|k| faces.triangle(k, object)),
@@ -641,10 +641,11 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
         });
         if kept < count {
             // Rare: keep the placed ones, in order, with their corner indices.
+            let triangles = Arc::make_mut(&mut scene.triangles);
             let mut w = 0;
             for k in 0..count {
-                if scene.triangles[start + k].material == PLACED {
-                    scene.triangles[start + w] = scene.triangles[start + k];
+                if triangles[start + k].material == PLACED {
+                    triangles[start + w] = triangles[start + k];
                     for ids in [&mut normal_ids, &mut uv_ids] {
                         if !ids.is_empty() {
                             ids[w] = ids[k];
@@ -653,12 +654,12 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
                     w += 1;
                 }
             }
-            scene.triangles.truncate(start + w);
+            triangles.truncate(start + w);
             normal_ids.truncate(w);
             uv_ids.truncate(w);
         }
         if let Some(material) = material {
-            scene.triangles[start..]
+            Arc::make_mut(&mut scene.triangles)[start..]
                 .par_iter_mut()
                 .for_each(|t| t.material = material);
         }
@@ -679,7 +680,7 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
         added += kept;
     }
     if added < scene.triangles.capacity() / 2 {
-        scene.triangles.shrink_to_fit();
+        Arc::make_mut(&mut scene.triangles).shrink_to_fit();
     }
     let textured = scene.triangles[first_triangle..].iter().any(|t| {
         scene.material(t.material).diffuse_map.is_some()

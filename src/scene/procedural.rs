@@ -196,10 +196,10 @@ pub fn bench_scene_frame() -> Scene {
                 object: ObjectId(4),
             },
         ],
-        triangles: vec![
+        triangles: std::sync::Arc::new(vec![
             floor([corners[0], corners[1], corners[2]], 1),
             floor([corners[0], corners[2], corners[3]], 2),
-        ],
+        ]),
         ..Scene::default()
     }
 }

@@ -333,7 +333,7 @@ pub fn check_scene(s: &Scene, geometry: bool) -> Result<(), String> {
                 }
             }
         }
-        for t in &s.triangles {
+        for t in s.triangles.iter() {
             if let Err(v) = check_triangle(&t.vertices) {
                 note(t.object, "object", v);
             }

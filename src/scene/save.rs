@@ -66,7 +66,7 @@ pub fn scene_to_toml(scene: &Scene) -> String {
         }
     }
     let mut triangle_of = vec![None; scene.objects.len()];
-    for t in &scene.triangles {
+    for t in scene.triangles.iter() {
         if let Some(slot) = triangle_of.get_mut(t.object.0 as usize) {
             slot.get_or_insert(t);
         }

@@ -78,7 +78,7 @@ impl Build {
             [corners[0], corners[1], corners[2]],
             [corners[0], corners[2], corners[3]],
         ] {
-            self.0.triangles.push(Triangle {
+            std::sync::Arc::make_mut(&mut self.0.triangles).push(Triangle {
                 vertices,
                 material: MaterialId(material),
                 object,
@@ -93,7 +93,7 @@ impl Build {
             name: name.into(),
             source: ObjectSource::Triangle,
         });
-        self.0.triangles.push(Triangle {
+        std::sync::Arc::make_mut(&mut self.0.triangles).push(Triangle {
             vertices,
             material: MaterialId(material),
             object,

@@ -75,7 +75,7 @@ pub fn check_invariants(scene: &Scene) -> Result<(), String> {
         ensure((s.material.0 as usize) < n_materials, "sphere material id")?;
         ensure((s.object.0 as usize) < n_objects, "sphere object id")?;
     }
-    for t in &scene.triangles {
+    for t in scene.triangles.iter() {
         let [a, b, c] = t.vertices;
         let cross = (b - a).cross(c - a);
         ensure(finite(a) && finite(b) && finite(c), "triangle finite")?;
