@@ -302,6 +302,7 @@ fn a_moved_camera_moves_the_headlight_without_a_rebuild() {
         app.scene().camera.position
     );
     let accel = app.accel() as *const _;
+    let triangles = app.scene().triangles.clone();
     app.edit.camera.orbit(0.8, 0.1);
     app.command(Command::MoveCamera);
     app.apply();
@@ -319,6 +320,10 @@ fn a_moved_camera_moves_the_headlight_without_a_rebuild() {
     assert!(
         std::ptr::eq(accel, app.accel()),
         "the accelerator was kept (no rebuild)"
+    );
+    assert!(
+        std::sync::Arc::ptr_eq(&triangles, &app.scene().triangles),
+        "the moved camera's scene shares the triangles (no copy on the UI thread)"
     );
     // The tree sees it there too.
     app.command(Command::Pick(48, 36));
