@@ -197,3 +197,54 @@ fn a_reload_is_read_and_parsed_off_the_ui_thread() {
     );
     assert_eq!(app.scene().camera, camera, "the viewer's camera stays");
 }
+
+/// Writes a `w`×1 PNG of one colour.
+fn png(path: &Path, w: u32, rgb: [u8; 3]) {
+    image::RgbImage::from_pixel(w, 1, image::Rgb(rgb))
+        .save(path)
+        .expect("png");
+}
+
+#[test]
+fn the_used_texture_reloads_and_other_images_beside_it_do_not() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let obj = dir.path().join("quad.obj");
+    std::fs::write(
+        &obj,
+        "mtllib quad.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl tex\nf 1/1 2/2 3/3 4/4\n",
+    )
+    .expect("obj");
+    std::fs::write(
+        dir.path().join("quad.mtl"),
+        "newmtl tex\nKd 1 1 1\nmap_Kd wood.png\n",
+    )
+    .expect("mtl");
+    png(&dir.path().join("wood.png"), 2, [200, 100, 50]);
+    let scene = load_scene_file(&obj).expect("loads");
+    assert_eq!(scene.textures.len(), 1, "{:?}", scene.warnings);
+    let mut app = ViewerApp::headless(scene, "quad".into()).expect("the viewer starts");
+    assert!(poll_until(&mut app, ViewerApp::is_finished));
+    let reloads = |app: &ViewerApp| {
+        app.messages
+            .iter()
+            .filter(|(e, m)| !e && m.starts_with("reloaded "))
+            .count()
+    };
+    // A screenshot saved beside the model is not part of the scene: no reload.
+    png(&dir.path().join("screenshot.png"), 3, [1, 2, 3]);
+    let quiet = Instant::now() + Duration::from_millis(800);
+    while Instant::now() < quiet {
+        app.poll_session();
+        app.apply();
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    assert_eq!(reloads(&app), 0, "{:?}", app.messages);
+    assert!(!app.reload_pending());
+    // The texture the material uses: reloaded with its new colour.
+    png(&dir.path().join("wood.png"), 2, [10, 200, 30]);
+    assert!(
+        poll_until(&mut app, |a| reloads(a) == 1 && a.is_finished()),
+        "the texture's save was not reloaded: {:?}",
+        app.messages
+    );
+}

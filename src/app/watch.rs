@@ -1,5 +1,6 @@
-//! Reload on save: the open scene file, the meshes it names and the files beside them (material
-//! libraries, textures) are watched with `notify`; a burst of changes (an editor writes a
+//! Reload on save: the open scene file, the meshes it names, the material libraries beside them
+//! and the textures the scene uses are watched with `notify` (other images in those folders,
+//! such as screenshots saved there, are not); a burst of changes (an editor writes a
 //! temporary file, renames it over the old one, touches it again) settles for [`DEBOUNCE`]
 //! before one reload is asked for.
 //!
@@ -18,15 +19,17 @@ use crate::scene::{ObjectSource, Scene};
 /// Quiet time after the last change before the reload.
 pub const DEBOUNCE: Duration = Duration::from_millis(200);
 
-/// Extensions of the files beside a mesh that change what it looks like.
-const COMPANIONS: &[&str] = &["mtl", "png", "jpg", "jpeg"];
+/// Extensions of the files beside a mesh that change what it looks like, whatever their name
+/// (a material library the OBJ names, or one it may name after the next save). Textures count
+/// by name: the ones the scene uses are in its file list.
+const COMPANIONS: &[&str] = &["mtl"];
 
 pub struct SceneWatch {
     _watcher: notify::RecommendedWatcher,
     events: Receiver<notify::Result<notify::Event>>,
-    /// The scene file and its meshes, as the watcher reports them (absolute).
+    /// The scene file, its meshes and its textures, as the watcher reports them (absolute).
     files: BTreeSet<PathBuf>,
-    /// Folders of the meshes, where material libraries and textures count too.
+    /// Folders of the meshes, where material libraries count too.
     mesh_folders: BTreeSet<PathBuf>,
     /// The last relevant change not yet acted upon.
     changed: Option<Instant>,
@@ -44,14 +47,26 @@ fn absolute(p: &Path) -> PathBuf {
     std::fs::canonicalize(p).unwrap_or_else(|_| std::path::absolute(p).unwrap_or(p.to_path_buf()))
 }
 
-/// The files a scene loaded from `source` reads: itself and its meshes.
+/// The files a scene loaded from `source` reads: itself, its meshes and the textures it uses
+/// (their MTL paths are relative to the mesh's folder, or absolute).
 pub fn scene_files(scene: &Scene, source: &Path) -> Vec<PathBuf> {
     let folder = source.parent().unwrap_or(Path::new(""));
     let mut out = vec![source.to_path_buf()];
+    let mut mesh_folders = BTreeSet::new();
     for o in &scene.objects {
         if let ObjectSource::Mesh { file, .. } = &o.source {
-            out.push(folder.join(file));
+            let mesh = folder.join(file);
+            mesh_folders.insert(mesh.parent().unwrap_or(folder).to_path_buf());
+            out.push(mesh);
         }
+    }
+    for texture in &scene.textures {
+        out.extend(
+            mesh_folders
+                .iter()
+                .map(|f| f.join(&texture.name))
+                .filter(|p| p.is_file()),
+        );
     }
     out
 }
