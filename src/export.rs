@@ -63,6 +63,22 @@ pub fn srgb8_bytes(image: &Image) -> Vec<u8> {
 }
 
 /// Writes `path` through a temporary file in the same folder, then renames it into place.
+/// Whether a file can be written at `path` (its folder exists and takes a new file), asked
+/// before a long render so that a typo in the folder fails at once, with the sentence the
+/// write itself would give.
+pub fn check_writable(path: &Path) -> Result<(), ExportError> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    tempfile::Builder::new()
+        .prefix(".raytree-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map(drop)
+        .map_err(|e| export_error(path, e))
+}
+
 pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut BufWriter<&std::fs::File>) -> Result<(), String>,

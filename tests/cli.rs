@@ -221,6 +221,32 @@ fn unwritable_output_fails_cleanly() {
         .args(["-o", "/nonexistent-folder/x.png"])
         .output()
         .expect("runs");
+    // Refused before the render: 65536 samples a pixel of the default scene would take hours.
+    let mut long = std::process::Command::new(env!("CARGO_BIN_EXE_raytree"))
+        .args(["render", "default", "--samples", "65536", "-q"])
+        .args(["-o", "/nonexistent-folder/long.png"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("runs");
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
+    let status = loop {
+        if let Some(status) = long.try_wait().expect("waits") {
+            break status;
+        }
+        if std::time::Instant::now() > deadline {
+            let _ = long.kill();
+            panic!("the unwritable output was not refused before the render");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    assert!(!status.success());
+    let mut stderr = String::new();
+    std::io::Read::read_to_string(&mut long.stderr.take().expect("stderr"), &mut stderr)
+        .expect("reads");
+    assert!(
+        stderr.starts_with("error: cannot write /nonexistent-folder/long.png"),
+        "{stderr}"
+    );
     assert!(!output.status.success());
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(

@@ -112,6 +112,7 @@ pub fn run_render(args: &RenderArgs) -> Result<()> {
             args.output.display()
         );
     }
+    export::check_writable(&args.output)?;
     let (width, height) = (scene.render.width, scene.render.height);
     let region = match (args.region, args.tile) {
         (Some(r), _) => check_region(r, width, height)?,
