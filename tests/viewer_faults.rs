@@ -325,8 +325,18 @@ fn opening_each_refused_hostile_file_keeps_the_scene() {
             continue;
         };
         refused += 1;
+        let messages = app.messages.len();
         app.command(Command::OpenFile(path.clone()));
         app.apply();
+        // The open runs in the background: its sentence comes when it ends.
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
+        while app.opening().is_some() && std::time::Instant::now() < deadline {
+            app.poll_session();
+            app.apply();
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        assert!(app.opening().is_none(), "{}: still opening", path.display());
+        assert_eq!(app.messages.len(), messages + 1, "{:?}", app.messages);
         let (error, message) = app.messages.last().cloned().expect("a message");
         assert!(error, "{}: {message}", path.display());
         assert_eq!(message, e.to_string());
