@@ -67,6 +67,12 @@ pub fn srgb8_bytes(image: &Image) -> Vec<u8> {
 /// before a long render so that a typo in the folder fails at once, with the sentence the
 /// write itself would give.
 pub fn check_writable(path: &Path) -> Result<(), ExportError> {
+    temp_beside(path).map(drop)
+}
+
+/// A new private temporary file in `path`'s folder (the current one for a bare name), where
+/// [`write_atomically`] writes before renaming it over `path`.
+fn temp_beside(path: &Path) -> Result<tempfile::NamedTempFile, ExportError> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -75,7 +81,6 @@ pub fn check_writable(path: &Path) -> Result<(), ExportError> {
         .prefix(".raytree-")
         .suffix(".tmp")
         .tempfile_in(dir)
-        .map(drop)
         .map_err(|e| export_error(path, e))
 }
 
@@ -83,15 +88,7 @@ pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut BufWriter<&std::fs::File>) -> Result<(), String>,
 ) -> Result<(), ExportError> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let tmp = tempfile::Builder::new()
-        .prefix(".raytree-")
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .map_err(|e| export_error(path, e))?;
+    let tmp = temp_beside(path)?;
     {
         let mut out = BufWriter::new(tmp.as_file());
         write(&mut out).map_err(|e| export_error(path, e))?;

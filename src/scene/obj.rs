@@ -809,39 +809,38 @@ fn finish_attributes(
     let first = attrs.first_triangle as usize;
     let count = scene.triangles.len() - first;
     attrs.triangle_count = count as u32;
-    let plural = |n: usize| if n == 1 { "" } else { "s" };
-    let faces_give = |n: usize| if n == 1 { "face gives" } else { "faces give" };
-    if corners.bad_normals > 0 {
-        let n = corners.bad_normals;
-        warnings.push(format!(
-            "{}: {n} face{} name normals (`vn`) that are out of range, zero or not finite; they are shaded flat.",
-            req.label,
-            plural(n)
-        ));
-    }
-    if corners.partial_normals > 0 {
-        let n = corners.partial_normals;
-        warnings.push(format!(
-            "{}: {n} {} normals (`vn`) at some corners only; they are shaded flat.",
-            req.label,
-            faces_give(n)
-        ));
-    }
-    if corners.partial_uvs > 0 && textured {
-        let n = corners.partial_uvs;
-        warnings.push(format!(
-            "{}: {n} {} texture coordinates (`vt`) at some corners only; they are not textured.",
-            req.label,
-            faces_give(n)
-        ));
-    }
-    if corners.bad_uvs > 0 && textured {
-        let n = corners.bad_uvs;
-        warnings.push(format!(
-            "{}: {n} face{} name texture coordinates (`vt`) that are out of range or not finite; they are not textured.",
-            req.label,
-            plural(n)
-        ));
+    // (count, whether it applies, what those faces do, what becomes of them), one warning each.
+    let problems = [
+        (
+            corners.bad_normals,
+            true,
+            ["face name", "faces name"],
+            "normals (`vn`) that are out of range, zero or not finite; they are shaded flat",
+        ),
+        (
+            corners.partial_normals,
+            true,
+            ["face gives", "faces give"],
+            "normals (`vn`) at some corners only; they are shaded flat",
+        ),
+        (
+            corners.partial_uvs,
+            textured,
+            ["face gives", "faces give"],
+            "texture coordinates (`vt`) at some corners only; they are not textured",
+        ),
+        (
+            corners.bad_uvs,
+            textured,
+            ["face name", "faces name"],
+            "texture coordinates (`vt`) that are out of range or not finite; they are not textured",
+        ),
+    ];
+    for (n, applies, [one, many], what) in problems {
+        if n > 0 && applies {
+            let faces = if n == 1 { one } else { many };
+            warnings.push(format!("{}: {n} {faces} {what}.", req.label));
+        }
     }
     let mut corners = corners;
     for list in [&mut corners.normals, &mut corners.uvs] {
