@@ -579,6 +579,8 @@ impl Tracer {
     }
 
     /// Hit point, its error bound, normals, object, material, barycentrics and texture.
+    /// Inlined into its two callers: returned by value, its result is otherwise copied.
+    #[inline(always)]
     fn surface(&self, ray: &Ray, hit: &PrimHit) -> (SurfaceHit, Vec3) {
         let scene = &self.scene;
         let n_spheres = scene.spheres.len();
@@ -714,7 +716,8 @@ impl Tracer {
     ) -> Option<(Vec3, Vec3, Vec3)> {
         let (p, ng) = (surface.point, surface.geometric_normal);
         let robust = self.methods().shading_normals == ShadingNormals::Robust;
-        let (Some(ns), Some(b), true) = (surface.vertex_normals, surface.barycentric, robust)
+        // By reference: the three vertex normals are not copied for flat surfaces.
+        let (true, Some(ns), Some(b)) = (robust, &surface.vertex_normals, surface.barycentric)
         else {
             return Some((p, error, l));
         };
@@ -724,7 +727,7 @@ impl Tracer {
         // to the visible side: a light behind the surface is then reached only past its edge
         // (N3), never through it.
         let in_front = ng.dot(l) > 0.0;
-        match terminator_origin(v, &ns, b, p, error, ng) {
+        match terminator_origin(v, ns, b, p, error, ng) {
             Some((q, q_error, clear)) if in_front || clear => Some((q, q_error, ng)),
             _ => in_front.then_some((p, error, l)),
         }

@@ -53,7 +53,7 @@ pub const NORMAL_SCALED_EPSILON: f32 = 1e-5;
 ///
 /// With [`OffsetMethod::ErrorBound`] the new ray is meant to be traced with `t_min = 0`
 /// (exclusive): the origin is already outside the surface's error region.
-#[inline]
+#[inline(always)]
 pub fn offset_ray_origin(method: OffsetMethod, p: Vec3, p_error: Vec3, n: Vec3, dir: Vec3) -> Vec3 {
     // The side of the surface the new ray travels to (tangent rays go to the +n side).
     let n_out = if dir.dot(n) < 0.0 { -n } else { n };

@@ -37,7 +37,7 @@ crate::choice::choice!(SphereMethod {
 /// The near root is taken when it lies above `t_min`; otherwise the far root (the ray starts
 /// inside the sphere, e.g. after refraction). The result never depends on `t_max` other than
 /// through the final range check, so accelerators that shrink `t_max` see the same `t`.
-#[inline]
+#[inline(always)]
 pub fn intersect_sphere(
     method: SphereMethod,
     center: Vec3,
@@ -71,7 +71,7 @@ fn lecture_roots(center: Vec3, radius: f32, ray: &Ray) -> Option<(f32, f32)> {
 ///
 /// `a = u·u` is kept (it is `1 ± 2⁻²³` for a normalised `f32` direction) so the roots stay
 /// within a few ulp of the exact roots of the `f32` ray, not of an idealised unit ray.
-#[inline]
+#[inline(always)]
 fn robust_roots(center: Vec3, radius: f32, ray: &Ray) -> Option<(f32, f32)> {
     let u = ray.dir;
     let f = ray.origin - center;
@@ -96,7 +96,7 @@ fn robust_roots(center: Vec3, radius: f32, ray: &Ray) -> Option<(f32, f32)> {
 }
 
 /// The nearest of `t0 ≤ t1` strictly inside `(t_min, t_max)`.
-#[inline]
+#[inline(always)]
 fn pick_root(t0: f32, t1: f32, t_min: f32, t_max: f32) -> Option<f32> {
     if t0 > t_min {
         (t0 < t_max).then_some(t0)
