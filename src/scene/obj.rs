@@ -171,12 +171,13 @@ fn quietly<T>(f: impl FnOnce() -> T) -> Result<T, ()> {
 /// `tobj`, faster), or `tobj` itself on the text without its polylines when that reader left it
 /// to tobj; with panics caught, since hostile files must never take the program down (SPEC
 /// §9). Each `mtllib` reaches `load_mtl` once, even when the fast reader gives up after it:
-/// tobj then gets the recorded results.
+/// tobj then gets the recorded results. The flag says whether the models are the fast
+/// reader's.
 fn load_obj(
     text: &str,
     scanned: Option<Scanned>,
     load_mtl: impl Fn(&Path) -> tobj::MTLLoadResult,
-) -> Result<tobj::LoadResult, String> {
+) -> Result<(tobj::LoadResult, bool), String> {
     let failed = |()| "the OBJ reader failed on this file".to_string();
     let recorded = RefCell::new(std::collections::VecDeque::new());
     if let Some(scanned) = scanned {
@@ -191,7 +192,7 @@ fn load_obj(
         })
         .map_err(failed)?;
         if let Some(loaded) = fast {
-            return Ok(loaded);
+            return Ok((loaded, true));
         }
     }
     let replay = |path: &Path| {
@@ -205,14 +206,16 @@ fn load_obj(
         }
     };
     let (text, _) = without_polylines(text);
-    quietly(|| tobj::load_obj_buf(&mut text.as_bytes(), &load_options(), replay)).map_err(failed)
+    quietly(|| tobj::load_obj_buf(&mut text.as_bytes(), &load_options(), replay))
+        .map(|loaded| (loaded, false))
+        .map_err(failed)
 }
 
 /// Reads OBJ text without polylines, as [`add_mesh`] reads it (the error search's reader).
 fn read_plain(text: &str) -> Result<tobj::LoadResult, String> {
     let scanned = quietly(|| obj_parse::scan(text, Polylines::Skip))
         .map_err(|()| "the OBJ reader failed on this file".to_string())?;
-    load_obj(text, scanned, |_| Ok(Default::default()))
+    load_obj(text, scanned, |_| Ok(Default::default())).map(|(loaded, _)| loaded)
 }
 
 /// MTL text as `tobj` can take it, or the line and the reason it cannot. The MTL format lets
@@ -411,11 +414,13 @@ fn error_line(text: &str) -> Option<usize> {
 pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, ObjProblem> {
     // One pass of the parallel reader counts what the budget and the warnings need; only a
     // text it leaves to tobj is counted line by line.
-    let scanned =
+    let mut scanned =
         quietly(|| obj_parse::scan(req.text, Polylines::Skip)).map_err(|()| ObjProblem {
             line: None,
             reason: "the OBJ reader failed on this file".into(),
         })?;
+    // Which faces give `vn`/`vt` at every corner, as that pass saw them.
+    let fast_corners = scanned.as_mut().map(Scanned::take_face_corners);
     let facts = match &scanned {
         Some(s) => s.facts().clone(),
         None => slow_facts(req.text),
@@ -472,9 +477,9 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
         })
     };
     let polylines = facts.polylines;
-    let (models, mtl_materials) = match load_obj(req.text, scanned, load_mtl) {
-        Ok(Ok(loaded)) => loaded,
-        Ok(Err(e)) => {
+    let ((models, mtl_materials), fast) = match load_obj(req.text, scanned, load_mtl) {
+        Ok((Ok(loaded), fast)) => (loaded, fast),
+        Ok((Err(e), _)) => {
             return Err(ObjProblem {
                 line: error_line(req.text),
                 reason: e.to_string(),
@@ -490,14 +495,15 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
             n || !m.mesh.normals.is_empty(),
         )
     });
-    let face_corners = match uvs_in_file || normals_in_file {
-        true => super::obj_corners::face_corners(req.text, uvs_in_file, normals_in_file).map_err(
-            |(line, reason)| ObjProblem {
+    // The fast reader's pass found them; a file read by tobj is read again for them.
+    let face_corners = match (uvs_in_file || normals_in_file, fast_corners) {
+        (false, _) => Default::default(),
+        (true, Some(found)) if fast => found.only(uvs_in_file, normals_in_file),
+        (true, _) => super::obj_corners::face_corners(req.text, uvs_in_file, normals_in_file)
+            .map_err(|(line, reason)| ObjProblem {
                 line: Some(line),
                 reason: reason.into(),
-            },
-        )?,
-        false => Default::default(),
+            })?,
     };
     let mut warnings = mtl_warnings.into_inner();
     let mtl_texts = mtl_texts.into_inner();

@@ -29,6 +29,8 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
+use super::obj_corners::{ALL_NORMALS, ALL_UVS, FaceCorners};
+
 /// An absent `vt` or `vn` in a face corner (`1//3`, `1`).
 const MISSING: u32 = u32::MAX;
 
@@ -66,6 +68,11 @@ struct Chunk {
     polylines: u64,
     /// `usemtl` names as the loader's warning names them (see [`Facts::usemtl`]).
     usemtl: Vec<String>,
+    /// For every triangle of an `f` line: [`ALL_UVS`] and [`ALL_NORMALS`] when its face gives
+    /// `vt` (`vn`) at every corner.
+    given: Vec<u8>,
+    /// `f` lines that give `vt` (`vn`) at some corners but not all.
+    partial: [usize; 2],
 }
 
 /// What to do with polyline (`l`) statements.
@@ -192,6 +199,24 @@ impl Scanned {
     /// What the pass counted.
     pub fn facts(&self) -> &Facts {
         &self.facts
+    }
+
+    /// Which faces of the `f` lines give `vt` and `vn` at every corner, and how many give them
+    /// at some corners only: what [`super::obj_corners::face_corners`] finds by reading the
+    /// text again, for a file with both lists (see [`FaceCorners::only`]). Taken out: a second
+    /// call gives nothing. With [`Polylines::AsFaces`] the polylines' triangles are not in it.
+    pub(crate) fn take_face_corners(&mut self) -> FaceCorners {
+        let mut out = FaceCorners {
+            triangles: Vec::with_capacity(self.chunks.iter().map(|c| c.given.len()).sum()),
+            partial_uvs: 0,
+            partial_normals: 0,
+        };
+        for chunk in &mut self.chunks {
+            out.triangles.append(&mut chunk.given);
+            out.partial_uvs += std::mem::take(&mut chunk.partial[0]);
+            out.partial_normals += std::mem::take(&mut chunk.partial[1]);
+        }
+        out
     }
 
     /// The models and materials, exactly as tobj gives them, calling `load_mtl` for each
@@ -417,10 +442,23 @@ fn parse_line<'a>(
         "l" if polylines == Polylines::Skip => chunk.polylines += 1,
         "f" => {
             let before = chunk.corners.len();
-            face(words, &mut chunk.corners)?;
-            chunk.face_triangles += ((chunk.corners.len() - before) / 3) as u64;
+            let (corners, given) = face(words, &mut chunk.corners)?;
+            let triangles = (chunk.corners.len() - before) / 3;
+            chunk.face_triangles += triangles as u64;
+            // The same facts as [`super::obj_corners`] finds by reading the line again.
+            let mut flags = 0;
+            for (list, bit) in [(0, ALL_UVS), (1, ALL_NORMALS)] {
+                if given[list] == corners {
+                    flags |= bit;
+                } else if given[list] > 0 {
+                    chunk.partial[list] += 1;
+                }
+            }
+            chunk.given.extend(std::iter::repeat_n(flags, triangles));
         }
-        "l" => face(words, &mut chunk.corners)?,
+        "l" => {
+            face(words, &mut chunk.corners)?;
+        }
         "o" | "g" => {
             let size = line.chars().next().map_or(1, char::len_utf8);
             let name = line.get(size..).unwrap_or("").trim();
@@ -455,25 +493,35 @@ fn parse_line<'a>(
 }
 
 /// The triangles of a face's corner `words`, fanned as tobj fans them (one corner: one
-/// triangle `a a a`; two: `a b b`); `None` for no corners or a bad one.
-fn face<'a>(mut words: impl Iterator<Item = &'a str>, out: &mut Vec<[u32; 3]>) -> Option<()> {
-    let a = corner(words.next()?)?;
+/// triangle `a a a`; two: `a b b`); `None` for no corners or a bad one. Returns the face's
+/// corners and how many of them give a `vt` and a `vn`.
+fn face<'a>(
+    mut words: impl Iterator<Item = &'a str>,
+    out: &mut Vec<[u32; 3]>,
+) -> Option<(usize, [usize; 2])> {
+    let mut given = [0usize; 2];
+    let mut count = |c: [u32; 3]| {
+        given[0] += usize::from(c[1] != MISSING);
+        given[1] += usize::from(c[2] != MISSING);
+        c
+    };
+    let a = count(corner(words.next()?)?);
     let Some(word) = words.next() else {
         out.extend([a, a, a]);
-        return Some(());
+        return Some((1, given));
     };
-    let mut b = corner(word)?;
-    let mut any = false;
+    let mut b = count(corner(word)?);
+    let mut corners = 2;
     for word in words {
-        let c = corner(word)?;
+        let c = count(corner(word)?);
         out.extend([a, b, c]);
         b = c;
-        any = true;
+        corners += 1;
     }
-    if !any {
+    if corners == 2 {
         out.extend([a, b, b]);
     }
-    Some(())
+    Some((corners, given))
 }
 
 fn push_event(chunk: &mut Chunk, kind: EventKind) {
