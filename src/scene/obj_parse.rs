@@ -68,9 +68,10 @@ struct Chunk {
     polylines: u64,
     /// `usemtl` names as the loader's warning names them (see [`Facts::usemtl`]).
     usemtl: Vec<String>,
-    /// For every triangle of an `f` line: [`ALL_UVS`] and [`ALL_NORMALS`] when its face gives
-    /// `vt` (`vn`) at every corner.
-    given: Vec<u8>,
+    /// For the triangles of the `f` lines, in runs of equal flags (most files have one run):
+    /// [`ALL_UVS`] and [`ALL_NORMALS`] when the face gives `vt` (`vn`) at every corner, and
+    /// how many triangles in a row have them.
+    given: Vec<(u8, usize)>,
     /// `f` lines that give `vt` (`vn`) at some corners but not all.
     partial: [usize; 2],
 }
@@ -207,12 +208,14 @@ impl Scanned {
     /// call gives nothing. With [`Polylines::AsFaces`] the polylines' triangles are not in it.
     pub(crate) fn take_face_corners(&mut self) -> FaceCorners {
         let mut out = FaceCorners {
-            triangles: Vec::with_capacity(self.chunks.iter().map(|c| c.given.len()).sum()),
+            triangles: Vec::with_capacity(self.facts.triangles as usize),
             partial_uvs: 0,
             partial_normals: 0,
         };
         for chunk in &mut self.chunks {
-            out.triangles.append(&mut chunk.given);
+            for (flags, n) in std::mem::take(&mut chunk.given) {
+                out.triangles.extend(std::iter::repeat_n(flags, n));
+            }
             out.partial_uvs += std::mem::take(&mut chunk.partial[0]);
             out.partial_normals += std::mem::take(&mut chunk.partial[1]);
         }
@@ -446,15 +449,15 @@ fn parse_line<'a>(
             let triangles = (chunk.corners.len() - before) / 3;
             chunk.face_triangles += triangles as u64;
             // The same facts as [`super::obj_corners`] finds by reading the line again.
-            let mut flags = 0;
-            for (list, bit) in [(0, ALL_UVS), (1, ALL_NORMALS)] {
-                if given[list] == corners {
-                    flags |= bit;
-                } else if given[list] > 0 {
-                    chunk.partial[list] += 1;
-                }
+            let all = |list: usize| given[list] == corners;
+            let flags = (u8::from(all(0)) * ALL_UVS) | (u8::from(all(1)) * ALL_NORMALS);
+            for (partial, given) in chunk.partial.iter_mut().zip(given) {
+                *partial += usize::from(given > 0 && given < corners);
             }
-            chunk.given.extend(std::iter::repeat_n(flags, triangles));
+            match chunk.given.last_mut() {
+                Some((f, n)) if *f == flags => *n += triangles,
+                _ => chunk.given.push((flags, triangles)),
+            }
         }
         "l" => {
             face(words, &mut chunk.corners)?;
