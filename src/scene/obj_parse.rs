@@ -602,87 +602,53 @@ impl Assembly<'_> {
             indices: Vec::with_capacity(n),
             ..Default::default()
         };
-        let has_tex = counts[1] > 0;
-        let has_norm = counts[2] > 0;
-        if has_tex {
-            mesh.texcoord_indices.reserve(n);
-        }
-        if has_norm {
-            mesh.normal_indices.reserve(n);
-        }
         let [pos_map, tex_map, norm_map] = &mut self.maps;
-        let mut used: [Vec<u32>; 3] = Default::default();
+        let mut positions = List {
+            all: self.positions,
+            width: 3,
+            count: counts[0],
+            map: pos_map,
+            values: &mut mesh.positions,
+            indices: &mut mesh.indices,
+            used: Vec::new(),
+        };
+        // The indices into a list the file does not have (yet) are ignored, as tobj ignores them.
+        let mut texcoords = (counts[1] > 0).then(|| List {
+            all: self.texcoords,
+            width: 2,
+            count: counts[1],
+            map: tex_map,
+            values: &mut mesh.texcoords,
+            indices: &mut mesh.texcoord_indices,
+            used: Vec::new(),
+        });
+        let mut normals = (counts[2] > 0).then(|| List {
+            all: self.normals,
+            width: 3,
+            count: counts[2],
+            map: norm_map,
+            values: &mut mesh.normals,
+            indices: &mut mesh.normal_indices,
+            used: Vec::new(),
+        });
+        for list in [&mut texcoords, &mut normals].into_iter().flatten() {
+            list.indices.reserve(n);
+        }
         let result = (|| {
             for [v, vt, vn] in corners {
-                mesh.indices.push(remap(
-                    v,
-                    counts[0],
-                    3,
-                    self.positions,
-                    pos_map,
-                    &mut mesh.positions,
-                    &mut used[0],
-                )?);
-                if has_tex {
-                    let i = if vt != MISSING {
-                        remap(
-                            vt,
-                            counts[1],
-                            2,
-                            self.texcoords,
-                            tex_map,
-                            &mut mesh.texcoords,
-                            &mut used[1],
-                        )?
-                    } else if let Some(&last) = mesh.texcoord_indices.last() {
-                        last
-                    } else {
-                        // tobj: the model's first corner without one takes the file's first.
-                        remap(
-                            0,
-                            counts[1],
-                            2,
-                            self.texcoords,
-                            tex_map,
-                            &mut mesh.texcoords,
-                            &mut used[1],
-                        )?
-                    };
-                    mesh.texcoord_indices.push(i);
+                positions.push(v)?;
+                if let Some(list) = &mut texcoords {
+                    list.push_or_repeat(vt)?;
                 }
-                if has_norm {
-                    let i = if vn != MISSING {
-                        remap(
-                            vn,
-                            counts[2],
-                            3,
-                            self.normals,
-                            norm_map,
-                            &mut mesh.normals,
-                            &mut used[2],
-                        )?
-                    } else if let Some(&last) = mesh.normal_indices.last() {
-                        last
-                    } else {
-                        remap(
-                            0,
-                            counts[2],
-                            3,
-                            self.normals,
-                            norm_map,
-                            &mut mesh.normals,
-                            &mut used[2],
-                        )?
-                    };
-                    mesh.normal_indices.push(i);
+                if let Some(list) = &mut normals {
+                    list.push_or_repeat(vn)?;
                 }
             }
             Some(())
         })();
-        for (map, used) in [pos_map, tex_map, norm_map].into_iter().zip(&used) {
-            for &i in used {
-                map[i as usize] = MISSING;
-            }
+        positions.reset();
+        for list in [texcoords, normals].iter_mut().flatten() {
+            list.reset();
         }
         result?;
         self.models.push(tobj::Model::new(mesh, name.to_string()));
@@ -690,25 +656,59 @@ impl Assembly<'_> {
     }
 }
 
-/// The model's index of file element `i` (of `width` floats, `count` read so far), copying the
-/// element into `out` on first use.
-fn remap(
-    i: u32,
-    count: usize,
+/// One of a model's lists (positions, texture coordinates or normals) while it is assembled.
+struct List<'a> {
+    /// The whole file's values, `width` floats each, of which the model may use the first
+    /// `count` (those read before it ends).
+    all: &'a [f32],
     width: usize,
-    all: &[f32],
-    map: &mut [u32],
-    out: &mut Vec<f32>,
-    used: &mut Vec<u32>,
-) -> Option<u32> {
-    let slot = map.get_mut(i as usize).filter(|_| (i as usize) < count)?;
-    if *slot == MISSING {
-        *slot = (out.len() / width) as u32;
-        let from = i as usize * width;
-        out.extend_from_slice(all.get(from..from + width)?);
-        used.push(i);
+    count: usize,
+    /// The model's index of each file index it uses, [`MISSING`] elsewhere.
+    map: &'a mut [u32],
+    /// The model's values, copied on first use, and its corners' indices into them.
+    values: &'a mut Vec<f32>,
+    indices: &'a mut Vec<u32>,
+    /// The file indices set in `map`.
+    used: Vec<u32>,
+}
+
+impl List<'_> {
+    /// Adds a corner's file index `i`; `None` when it is out of range.
+    fn push(&mut self, i: u32) -> Option<()> {
+        let slot = self
+            .map
+            .get_mut(i as usize)
+            .filter(|_| (i as usize) < self.count)?;
+        if *slot == MISSING {
+            *slot = (self.values.len() / self.width) as u32;
+            let from = i as usize * self.width;
+            self.values
+                .extend_from_slice(self.all.get(from..from + self.width)?);
+            self.used.push(i);
+        }
+        self.indices.push(*slot);
+        Some(())
     }
-    Some(*slot)
+
+    /// Adds a corner's `vt` or `vn` index `i` as tobj does: an absent one ([`MISSING`]) repeats
+    /// the previous corner's, and the model's first corner without one takes the file's first.
+    fn push_or_repeat(&mut self, i: u32) -> Option<()> {
+        match (i, self.indices.last()) {
+            (MISSING, Some(&last)) => {
+                self.indices.push(last);
+                Some(())
+            }
+            (MISSING, None) => self.push(0),
+            (i, _) => self.push(i),
+        }
+    }
+
+    /// Clears `map` for the next model.
+    fn reset(&mut self) {
+        for &i in &self.used {
+            self.map[i as usize] = MISSING;
+        }
+    }
 }
 
 #[cfg(test)]
