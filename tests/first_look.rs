@@ -4,6 +4,7 @@
 //! mean luminance in a readable band and few saturated pixels; the room's camera stands inside
 //! its bounds, the outdoor model's outside.
 
+use std::ops::Range;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -20,54 +21,32 @@ fn room(materials: bool) -> String {
         out += "mtllib kitchen.mtl\nusemtl wall\n";
     }
     let mut base = 0;
-    let mut block = |out: &mut String, lo: Vec3, hi: Vec3, inward: bool| {
-        for i in 0..8 {
-            let p = |bit: usize, l: f32, h: f32| if i & bit != 0 { h } else { l };
-            *out += &format!(
-                "v {} {} {}\n",
-                p(4, lo.x, hi.x),
-                p(2, lo.y, hi.y),
-                p(1, lo.z, hi.z)
-            );
-        }
-        // Outward quads of the cube of corners 1..8 (x: 4, y: 2, z: 1).
-        for q in [
-            [1, 2, 4, 3],
-            [5, 7, 8, 6],
-            [1, 5, 6, 2],
-            [3, 4, 8, 7],
-            [1, 3, 7, 5],
-            [2, 6, 8, 4],
-        ] {
-            let [a, b, c, d] = q.map(|i| i + base);
-            if inward {
-                *out += &format!("f {a} {c} {b}\nf {a} {d} {c}\n");
-            } else {
-                *out += &format!("f {a} {b} {c}\nf {a} {c} {d}\n");
-            }
-        }
-        base += 8;
-    };
-    block(
+    cuboid(
         &mut out,
+        &mut base,
         Vec3::new(-3.0, 0.0, -4.0),
         Vec3::new(3.0, 4.0, 4.0),
         true,
+        &[],
     );
     if materials {
         out += "usemtl wood\n";
     }
-    block(
+    cuboid(
         &mut out,
+        &mut base,
         Vec3::new(-1.0, 0.0, -1.0),
         Vec3::new(1.0, 0.8, 0.5),
         false,
+        &[],
     );
-    block(
+    cuboid(
         &mut out,
+        &mut base,
         Vec3::new(-2.9, 0.0, -3.9),
         Vec3::new(-1.5, 2.0, -2.5),
         false,
+        &[],
     );
     out
 }
@@ -76,27 +55,38 @@ fn room(materials: bool) -> String {
 const BLENDER_MTL: &str = "newmtl wall\nNs 225\nKa 1.000000 1.000000 1.000000\nKd 0.800000 0.800000 0.800000\nKs 0.500000 0.500000 0.500000\nNi 1.45\nd 1.000000\nillum 2\n\nnewmtl wood\nNs 225\nKa 1.000000 1.000000 1.000000\nKd 0.600000 0.350000 0.150000\nKs 0.500000 0.500000 0.500000\nNi 1.45\nd 1.000000\nillum 2\n";
 
 /// Mean luminance (of the displayed, clamped linear colour) and the fraction of pixels with a
-/// channel at 1 or more.
-fn look(scene: Scene) -> (f32, f32, Scene) {
-    let mut scene = scene;
-    scene.render.width = 160;
-    scene.render.height = 120;
-    let tracer = Tracer::new(Arc::new(scene.clone()), TraceSettings::default());
-    let (image, _) = render(&tracer, 1, 0, &|_, _| {}).expect("renders");
-    let n = image.pixels.len() as f32;
+/// channel at 1 or more, of the scene rendered at 160×120.
+fn look(scene: &Scene) -> (f32, f32) {
+    let image = pixels(scene);
+    let n = image.len() as f32;
     let lum = |c: Vec3| {
         let c = c.clamp(Vec3::ZERO, Vec3::ONE);
         0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
     };
-    let mean = image.pixels.iter().map(|&c| lum(c)).sum::<f32>() / n;
-    let saturated = image
-        .pixels
-        .iter()
-        .filter(|c| c.max_element() >= 1.0)
-        .count() as f32
-        / n;
+    let mean = image.iter().map(|&c| lum(c)).sum::<f32>() / n;
+    let saturated = image.iter().filter(|c| c.max_element() >= 1.0).count() as f32 / n;
     eprintln!("mean luminance {mean:.3}, saturated {saturated:.3}");
-    (mean, saturated, scene)
+    (mean, saturated)
+}
+
+/// The scene `name` renders readably: its mean luminance in `mean`, fewer than
+/// `max_saturated` of its pixels saturated.
+fn assert_readable(scene: &Scene, name: &str, mean: Range<f32>, max_saturated: f32) {
+    let (m, saturated) = look(scene);
+    assert!(mean.contains(&m), "{name}: mean luminance {m}");
+    assert!(
+        saturated < max_saturated,
+        "{name}: {saturated} of the pixels saturated"
+    );
+}
+
+/// The scene `name` has a warning that contains every one of `needles`.
+fn assert_warned(scene: &Scene, name: &str, needles: &[&str]) {
+    assert!(
+        (scene.warnings.iter()).any(|w| needles.iter().all(|n| w.contains(n))),
+        "{name}: {needles:?} in {:?}",
+        scene.warnings
+    );
 }
 
 fn inside(p: Vec3, scene: &Scene) -> bool {
@@ -121,20 +111,8 @@ fn a_bare_room_and_a_blender_room_are_readable_from_inside() {
             "{name}: camera outside the room"
         );
         assert!(scene.render.ambient_light.max_element() <= 0.1 + 1e-6);
-        assert!(
-            scene
-                .warnings
-                .iter()
-                .any(|w| w.contains("the camera starts inside it")),
-            "{name}: {:?}",
-            scene.warnings
-        );
-        let (mean, saturated, scene) = look(scene);
-        assert!((0.2..0.75).contains(&mean), "{name}: mean luminance {mean}");
-        assert!(
-            saturated < 0.1,
-            "{name}: {saturated} of the pixels saturated"
-        );
+        assert_warned(&scene, name, &["the camera starts inside it"]);
+        assert_readable(&scene, name, 0.2..0.75, 0.1);
         if name == "kitchen.obj" {
             let wall = scene
                 .materials
@@ -142,12 +120,7 @@ fn a_bare_room_and_a_blender_room_are_readable_from_inside() {
                 .find(|m| m.name.ends_with("/wall"))
                 .expect("wall");
             assert_eq!(wall.ambient, wall.diffuse, "`Ka 1` read as `Kd`");
-            assert!(
-                scene
-                    .warnings
-                    .iter()
-                    .any(|w| w.contains("`Ka 1` (Blender's default)"))
-            );
+            assert_warned(&scene, name, &["`Ka 1` (Blender's default)"]);
         }
     }
 }
@@ -170,10 +143,8 @@ fn an_outdoor_model_is_framed_from_outside_and_readable() {
         ["key", "headlight"]
     );
     assert_eq!(scene.lights[1].position, scene.camera.position);
-    let (mean, saturated, _) = look(scene);
     // A model on black: darker on average than a room, but lit.
-    assert!((0.03..0.6).contains(&mean), "mean luminance {mean}");
-    assert!(saturated < 0.1, "{saturated} of the pixels saturated");
+    assert_readable(&scene, "torus.obj", 0.03..0.6, 0.1);
 }
 
 // ---- Traits of real files (issue 14's "Done when"), each reproduced on a small generated
@@ -245,20 +216,11 @@ fn a_room_whose_middle_is_a_bed_is_seen_from_inside_and_not_from_inside_the_bed(
     assert!(inside(p, &scene), "camera at {p}, outside the room");
     let in_bed = p.cmpgt(bed.0).all() && p.cmplt(bed.1).all();
     assert!(!in_bed, "camera at {p}, inside the bed");
-    assert!(
-        scene
-            .warnings
-            .iter()
-            .any(|w| w.contains("the camera starts inside it")),
-        "{:?}",
-        scene.warnings
-    );
+    assert_warned(&scene, "bedroom.obj", &["the camera starts inside it"]);
     let key = scene.lights[0].position;
     assert!(inside(key, &scene), "key light at {key}, outside the room");
-    let (mean, saturated, _) = look(scene);
     // Darker than an empty room: the bed fills much of the view and shades the floor.
-    assert!((0.15..0.75).contains(&mean), "mean luminance {mean}");
-    assert!(saturated < 0.02, "{saturated} of the pixels saturated");
+    assert_readable(&scene, "bedroom.obj", 0.15..0.75, 0.02);
 }
 
 #[test]
@@ -281,9 +243,7 @@ fn walls_without_a_ceiling_are_seen_from_above_outside() {
     assert!(!inside(p, &scene), "camera at {p}, inside");
     assert!(p.y > hi.y, "camera at {p}, not above the walls");
     assert!(forward(&scene).y < -0.3, "looks down into the room");
-    let (mean, saturated, _) = look(scene);
-    assert!((0.1..0.75).contains(&mean), "mean luminance {mean}");
-    assert!(saturated < 0.02, "{saturated} of the pixels saturated");
+    assert_readable(&scene, "kitchen.obj", 0.1..0.75, 0.02);
 }
 
 /// Cornell-box colours: white, red and green walls of `Kd 1` (no `Ka`).
@@ -327,19 +287,10 @@ fn a_box_open_on_one_side_is_seen_through_its_opening_without_clipping_white() {
         scene.camera.position
     );
     assert!(forward(&scene).z > 0.99, "looks in: {}", forward(&scene));
-    assert!(
-        scene
-            .warnings
-            .iter()
-            .any(|w| w.contains("open on one side")),
-        "{:?}",
-        scene.warnings
-    );
+    assert_warned(&scene, "cornell.obj", &["open on one side"]);
     let key = scene.lights[0].position;
     assert!(inside(key, &scene), "key light at {key}, outside the box");
-    let (mean, saturated, _) = look(scene);
-    assert!((0.15..0.75).contains(&mean), "mean luminance {mean}");
-    assert!(saturated < 0.01, "{saturated} of the pixels saturated");
+    assert_readable(&scene, "cornell.obj", 0.15..0.75, 0.01);
 }
 
 /// An octagonal prism around the `up` axis (a corner, not a face, towards the other
@@ -403,9 +354,7 @@ fn a_bust_standing_on_z_is_seen_upright_and_a_y_up_one_keeps_y() {
             "{name}: {}",
             forward(&scene)
         );
-        let (mean, saturated, _) = look(scene);
-        assert!((0.03..0.6).contains(&mean), "{name}: mean luminance {mean}");
-        assert!(saturated < 0.02, "{name}: {saturated} saturated");
+        assert_readable(&scene, name, 0.03..0.6, 0.02);
     }
 }
 
@@ -427,21 +376,9 @@ fn meshlab_tr_1_is_opaque_and_ns_0_no_wash_of_specular() {
     // Its `Ns 0` (exponent 0: all of `Ks` wherever light falls) shows no highlight.
     assert_eq!(m("/material_0").specular, Vec3::ZERO);
     assert_eq!(m("/glass").specular, Vec3::ONE, "no `Ns`: kept");
-    assert!(
-        scene
-            .warnings
-            .iter()
-            .any(|w| w.contains("`Ns 0` in `material_0`"))
-    );
+    assert_warned(&scene, "bottle.obj", &["`Ns 0` in `material_0`"]);
     assert_eq!(m("/glass").transparency, Vec3::ONE, "glass keeps `Tr 1`");
-    assert!(
-        scene
-            .warnings
-            .iter()
-            .any(|w| w.contains("`Tr 1`") && w.contains("material_0")),
-        "{:?}",
-        scene.warnings
-    );
+    assert_warned(&scene, "bottle.obj", &["`Tr 1`", "material_0"]);
 }
 
 #[test]

@@ -3,7 +3,9 @@
 //! render exactly, refuses parts that do not belong together with one sentence naming the
 //! part and writes nothing then; turntable frames are named and turned.
 
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
+use std::process::Output;
 
 use assert_cmd::Command;
 use raytree::export::{Pixels, StampedImage, read_stamped};
@@ -25,21 +27,41 @@ const SCENE: &[&str] = &[
     "-q",
 ];
 
-fn render(dir: &Path, name: &str, extra: &[&str]) -> PathBuf {
-    let out = dir.join(name);
-    let output = raytree()
-        .arg("render")
-        .args(SCENE)
-        .args(extra)
+/// Runs `raytree COMMAND ARGS -o OUT`.
+fn run(command: &str, args: &[&OsStr], out: &Path) -> Output {
+    raytree()
+        .arg(command)
+        .args(args)
         .arg("-o")
-        .arg(&out)
+        .arg(out)
         .output()
-        .expect("runs");
+        .expect("runs")
+}
+
+/// Runs `raytree render ARGS -o OUT`, expecting success.
+fn rendered(args: &[&str], out: &Path) {
+    let args: Vec<&OsStr> = args.iter().map(OsStr::new).collect();
+    let output = run("render", &args, out);
     assert!(
         output.status.success(),
-        "render {name} {extra:?}: {}",
+        "render {args:?}: {}",
         String::from_utf8_lossy(&output.stderr)
     );
+}
+
+/// Expects `output` to be a failure of one line that contains `needle`, and no `out` written.
+fn one_line_refusal(output: &Output, out: &Path, needle: &str) {
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "must fail: `{needle}`");
+    assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
+    assert!(stderr.contains(needle), "`{needle}` in: {stderr}");
+    assert!(!out.exists(), "nothing written on refusal: {stderr}");
+}
+
+/// Renders [`SCENE`] with `extra` arguments to `dir/name`.
+fn render(dir: &Path, name: &str, extra: &[&str]) -> PathBuf {
+    let out = dir.join(name);
+    rendered(&[SCENE, extra].concat(), &out);
     out
 }
 
@@ -60,13 +82,7 @@ fn linear(image: &StampedImage) -> Vec<[u32; 3]> {
 /// Runs `raytree merge PARTS -o out`, expecting success.
 fn merge(dir: &Path, parts: &[&Path], out: &str) -> PathBuf {
     let out = dir.join(out);
-    let output = raytree()
-        .arg("merge")
-        .args(parts)
-        .arg("-o")
-        .arg(&out)
-        .output()
-        .expect("runs");
+    let output = run("merge", &os(parts), &out);
     assert!(
         output.status.success(),
         "{}",
@@ -80,20 +96,19 @@ fn merge(dir: &Path, parts: &[&Path], out: &str) -> PathBuf {
 fn refused(dir: &Path, parts: &[&Path], needle: &str) {
     let before: Vec<_> = std::fs::read_dir(dir).expect("list").collect();
     let out = dir.join("refused.exr");
-    let output = raytree()
-        .arg("merge")
-        .args(parts)
-        .arg("-o")
-        .arg(&out)
-        .output()
-        .expect("runs");
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(!output.status.success(), "merge of {parts:?} must fail");
-    assert_eq!(stderr.lines().count(), 1, "one line: {stderr}");
-    assert!(stderr.contains(needle), "`{needle}` in: {stderr}");
-    assert!(!out.exists(), "nothing written on refusal");
+    let output = run("merge", &os(parts), &out);
+    one_line_refusal(&output, &out, needle);
     let after: Vec<_> = std::fs::read_dir(dir).expect("list").collect();
-    assert_eq!(before.len(), after.len(), "no file left: {stderr}");
+    assert_eq!(
+        before.len(),
+        after.len(),
+        "no file left: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+}
+
+fn os<'a>(paths: &[&'a Path]) -> Vec<&'a OsStr> {
+    paths.iter().map(|p| p.as_os_str()).collect()
 }
 
 #[test]
@@ -196,82 +211,37 @@ fn parts_that_do_not_make_one_image_are_refused() {
     // Overlapping parts.
     let over = render(d, "over.exr", &["--region", "0,10,97,10"]);
     refused(d, &[&t[0], &over, &t[1], &t[2]], "over.exr overlaps");
-    // Another scene, another size, other samples.
-    let glass = d.join("glass.exr");
-    let status = raytree()
-        .args([
-            "render",
+    // Another scene, another size, other samples: the scene of the others with one value
+    // changed.
+    for (name, from, to, needle) in [
+        (
+            "glass.exr",
+            "quiz",
             "glass",
-            "--width",
-            "97",
-            "--height",
+            "glass.exr was rendered with a different",
+        ),
+        (
+            "taller.exr",
             "61",
-            "--samples",
-            "3",
-            "-q",
-            "--tile",
-            "1/3",
-            "-o",
-        ])
-        .arg(&glass)
-        .output()
-        .expect("runs");
-    assert!(status.status.success());
-    refused(
-        d,
-        &[&t[0], &glass, &t[2]],
-        "glass.exr was rendered with a different",
-    );
-    let taller = d.join("taller.exr");
-    let status = raytree()
-        .args([
-            "render",
-            "quiz",
-            "--width",
-            "97",
-            "--height",
             "62",
-            "--samples",
+            "taller.exr is part of a 97x62 image",
+        ),
+        (
+            "fewer.exr",
             "3",
-            "-q",
-            "--tile",
-            "1/3",
-            "-o",
-        ])
-        .arg(&taller)
-        .output()
-        .expect("runs");
-    assert!(status.status.success());
-    refused(
-        d,
-        &[&t[0], &taller, &t[2]],
-        "taller.exr is part of a 97x62 image",
-    );
-    let fewer = d.join("fewer.exr");
-    let status = raytree()
-        .args([
-            "render",
-            "quiz",
-            "--width",
-            "97",
-            "--height",
-            "61",
-            "--samples",
             "2",
-            "-q",
-            "--tile",
-            "1/3",
-            "-o",
-        ])
-        .arg(&fewer)
-        .output()
-        .expect("runs");
-    assert!(status.status.success());
-    refused(
-        d,
-        &[&t[0], &fewer, &t[2]],
-        "fewer.exr was rendered with a different samples",
-    );
+            "fewer.exr was rendered with a different samples",
+        ),
+    ] {
+        assert_eq!(SCENE.iter().filter(|&&a| a == from).count(), 1, "{from}");
+        let args: Vec<&str> = (SCENE.iter())
+            .map(|&a| if a == from { to } else { a })
+            .chain(["--tile", "1/3"])
+            .collect();
+        let part = d.join(name);
+        rendered(&args, &part);
+        refused(d, &[&t[0], &part, &t[2]], needle);
+    }
     // Not a part at all, and a file that is not there.
     let plain = d.join("plain.exr");
     raytree::export::write_exr(&plain, &raytree::render::Image::new(4, 4)).expect("write");
@@ -297,19 +267,8 @@ fn a_region_outside_the_image_or_a_tile_out_of_range_is_refused() {
         ),
     ] {
         let out = dir.path().join("x.png");
-        let output = raytree()
-            .arg("render")
-            .args(SCENE)
-            .args(args)
-            .arg("-o")
-            .arg(&out)
-            .output()
-            .expect("runs");
-        let stderr = String::from_utf8_lossy(&output.stderr);
-        assert!(!output.status.success(), "{args:?} must fail");
-        assert_eq!(stderr.lines().count(), 1, "{stderr}");
-        assert!(stderr.contains(needle), "`{needle}` in {stderr}");
-        assert!(!out.exists());
+        let args: Vec<&OsStr> = SCENE.iter().chain(&args).map(OsStr::new).collect();
+        one_line_refusal(&run("render", &args, &out), &out, needle);
     }
 }
 
@@ -318,19 +277,8 @@ fn turntable_frames_are_numbered_and_turn_the_camera() {
     let dir = tempfile::tempdir().expect("temp dir");
     let d = dir.path();
     let spin = |name: &str, extra: &[&str]| {
-        let output = raytree()
-            .args([
-                "render", "default", "--width", "48", "--height", "32", "-q", "-o",
-            ])
-            .arg(d.join(name))
-            .args(extra)
-            .output()
-            .expect("runs");
-        assert!(
-            output.status.success(),
-            "{}",
-            String::from_utf8_lossy(&output.stderr)
-        );
+        let base = ["default", "--width", "48", "--height", "32", "-q"];
+        rendered(&[&base[..], extra].concat(), &d.join(name));
     };
     spin("spin.exr", &["--turntable", "4", "--frame-range", "1..3"]);
     spin("half_{frame}.exr", &["--turntable", "2", "--frame", "1"]);
@@ -378,16 +326,16 @@ fn turntable_frames_are_numbered_and_turn_the_camera() {
         "the camera is part of the scene's fingerprint"
     );
     // A frame past the turntable's end.
-    let output = raytree()
-        .arg("render")
-        .args(SCENE)
-        .args(["--turntable", "4", "--frame", "4", "-o"])
-        .arg(d.join("x.png"))
-        .output()
-        .expect("runs");
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(!output.status.success());
-    assert!(stderr.contains("--frame 4 does not exist"), "{stderr}");
+    let out = d.join("x.png");
+    let args: Vec<&OsStr> = (SCENE.iter())
+        .chain(&["--turntable", "4", "--frame", "4"])
+        .map(OsStr::new)
+        .collect();
+    one_line_refusal(
+        &run("render", &args, &out),
+        &out,
+        "--frame 4 does not exist",
+    );
 }
 
 #[test]

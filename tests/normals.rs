@@ -288,7 +288,7 @@ f 1//1 2//2 3//1\nf 2 4 3\nf 2//1 5 4//2\nf 1//2 2//2 3//2 4//1\n";
     assert_eq!(has, [true, false, false, true, true]);
     assert_eq!(
         scene.warnings,
-        ["m.obj: 1 face gives normals (`vn`) at some corners only; they are shaded flat."]
+        ["m.obj: 1 face gives normals (`vn`) at some corners only; it is shaded flat."]
     );
     // The same under `normals = "flat"` and `"smooth"`: no warning about the file's `vn`.
     for mode in ["flat", "smooth"] {
@@ -360,7 +360,7 @@ f 1/1 2/2 3/3\nf 2 4 3\nf 2/2 4 3/3\n",
     assert_eq!(
         scene.warnings,
         [format!(
-            "{label}: 1 face gives texture coordinates (`vt`) at some corners only; they are not textured."
+            "{label}: 1 face gives texture coordinates (`vt`) at some corners only; it is not textured."
         )]
     );
 }

@@ -345,3 +345,85 @@ fn the_loader_pass_counts_what_the_budget_and_warnings_need() {
     assert_eq!(corners(as_faces), corners(scanned) + 3 * 40);
     assert!(obj_compare::check(&text, &|_| Ok(Default::default())));
 }
+
+/// Faces that give `vn` and `vt` at every corner, at some, or at none, mixed in one file read
+/// in several chunks: the loader's fast path (whose reading pass flags the faces) and its tobj
+/// path (which reads the face lines again for them) keep the same faces' normals and texture
+/// coordinates, and give the same warnings.
+#[test]
+fn faces_with_mixed_corners_are_flagged_alike_on_either_path() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let checker = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models/checker.png");
+    std::fs::copy(checker, dir.path().join("checker.png")).expect("copy the texture");
+    std::fs::write(
+        dir.path().join("m.mtl"),
+        "newmtl t\nKd 1 1 1\nmap_Kd checker.png\n",
+    )
+    .expect("write");
+    let mut x = 12_345u32;
+    let mut rnd = move |n: u32| {
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        x % n
+    };
+    let mut text = String::from("mtllib m.mtl\nusemtl t\n");
+    for k in 0..400 {
+        let a = k as f32 * 0.01;
+        let _ = writeln!(text, "v {a} {} 0\nvt {a} 0.5\nvn 0 {a} 1", a * a);
+    }
+    while text.len() < 3 << 20 {
+        let corners = 3 + rnd(3);
+        text.push('f');
+        // Mostly faces that give both everywhere, so that the others are scattered.
+        let whole = rnd(3) > 0;
+        for _ in 0..corners {
+            let (v, t, n) = (1 + rnd(400), 1 + rnd(400), 1 + rnd(400));
+            let _ = match if whole { 3 } else { rnd(4) } {
+                0 => write!(text, " {v}"),
+                1 => write!(text, " {v}/{t}"),
+                2 => write!(text, " {v}//{n}"),
+                _ => write!(text, " {v}/{t}/{n}"),
+            };
+        }
+        text.push('\n');
+    }
+    let path = dir.path().join("m.obj");
+    std::fs::write(&path, &text).expect("write");
+    assert!(raytree::scene::obj_parse::parse(&text, |_| Ok(Default::default())).is_some());
+    let fast = raytree::scene::load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
+    // A negative index sends the whole file to tobj; its face adds one triangle, flat.
+    let slow_text = format!("{text}f -1 -2 -3\n");
+    assert!(raytree::scene::obj_parse::parse(&slow_text, |_| Ok(Default::default())).is_none());
+    std::fs::write(&path, &slow_text).expect("write");
+    let slow = raytree::scene::load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
+
+    assert_eq!(slow.triangles.len(), fast.triangles.len() + 1);
+    assert_eq!((fast.attributes.len(), slow.attributes.len()), (1, 1));
+    let (a, b) = (&fast.attributes[0], &slow.attributes[0]);
+    let (mut normals, mut uvs) = ([0usize; 2], [0usize; 2]);
+    for i in 0..fast.triangles.len() {
+        assert_eq!(a.normals_of(i), b.normals_of(i), "triangle {i}: normals");
+        assert_eq!(
+            a.uvs_of(i),
+            b.uvs_of(i),
+            "triangle {i}: texture coordinates"
+        );
+        normals[usize::from(a.normals_of(i).is_some())] += 1;
+        uvs[usize::from(a.uvs_of(i).is_some())] += 1;
+    }
+    let last = fast.triangles.len();
+    assert_eq!((b.normals_of(last), b.uvs_of(last)), (None, None));
+    // Both kinds of face, many of each.
+    assert!(
+        normals.iter().chain(&uvs).all(|&n| n > 1000),
+        "{normals:?} {uvs:?}"
+    );
+    assert_eq!(fast.warnings, slow.warnings);
+    // The faces that repeat a vertex are dropped after the flags are read: the flags of the
+    // faces after them must still be theirs.
+    assert_eq!(fast.warnings.len(), 3, "{:?}", fast.warnings);
+    assert!(fast.warnings[0].contains("normals (`vn`) at some corners only"));
+    assert!(fast.warnings[1].contains("texture coordinates (`vt`) at some corners only"));
+    assert!(fast.warnings[2].contains("degenerate triangles"));
+}

@@ -229,13 +229,13 @@ fn coarse_preview_is_bit_identical() {
 
 /// The packet traversal's node test eight rays wide (AVX2, chosen at run time) and four wide
 /// (SSE, the fallback) give the single-ray image bit for bit, on every built-in scene and the
-/// bench scene; on a CPU with AVX2 (this project's machines) asking for it uses it. The choice
-/// is process-wide: the other tests of this file hold under either.
+/// bench scene; on a CPU with AVX2 (this project's machines) asking for it uses it, and off
+/// x86-64 every choice is the four-wide test. The choice is process-wide: the other tests of
+/// this file hold under either.
 #[test]
 fn avx2_and_sse_node_tests_are_bit_identical() {
     use raytree::accel::{PacketSimd, packet_uses_avx2, set_packet_simd};
-    let has_avx2 =
-        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma");
+    let has_avx2 = cpu_has_avx2_and_fma();
     let dir = tempfile::tempdir().expect("temp dir");
     let path = raytree::scene::procedural::write_bench_scene(dir.path(), 3000).expect("write");
     let mut bench = raytree::scene::load_scene_file(&path).expect("load");
@@ -265,6 +265,19 @@ fn avx2_and_sse_node_tests_are_bit_identical() {
         }
     }
     set_packet_simd(PacketSimd::Auto);
+}
+
+/// Whether this CPU has AVX2 and FMA (the eight-wide node test's needs).
+#[cfg(target_arch = "x86_64")]
+fn cpu_has_avx2_and_fma() -> bool {
+    std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+}
+
+/// Off x86-64 there is no eight-wide node test: asking for it gives the four-wide one, which
+/// the test above still checks against the single-ray image.
+#[cfg(not(target_arch = "x86_64"))]
+fn cpu_has_avx2_and_fma() -> bool {
+    false
 }
 
 /// A tiny xorshift generator: the packets' rays.

@@ -171,12 +171,13 @@ fn quietly<T>(f: impl FnOnce() -> T) -> Result<T, ()> {
 /// `tobj`, faster), or `tobj` itself on the text without its polylines when that reader left it
 /// to tobj; with panics caught, since hostile files must never take the program down (SPEC
 /// §9). Each `mtllib` reaches `load_mtl` once, even when the fast reader gives up after it:
-/// tobj then gets the recorded results.
+/// tobj then gets the recorded results. The flag says whether the models are the fast
+/// reader's.
 fn load_obj(
     text: &str,
     scanned: Option<Scanned>,
     load_mtl: impl Fn(&Path) -> tobj::MTLLoadResult,
-) -> Result<tobj::LoadResult, String> {
+) -> Result<(tobj::LoadResult, bool), String> {
     let failed = |()| "the OBJ reader failed on this file".to_string();
     let recorded = RefCell::new(std::collections::VecDeque::new());
     if let Some(scanned) = scanned {
@@ -191,7 +192,7 @@ fn load_obj(
         })
         .map_err(failed)?;
         if let Some(loaded) = fast {
-            return Ok(loaded);
+            return Ok((loaded, true));
         }
     }
     let replay = |path: &Path| {
@@ -205,14 +206,16 @@ fn load_obj(
         }
     };
     let (text, _) = without_polylines(text);
-    quietly(|| tobj::load_obj_buf(&mut text.as_bytes(), &load_options(), replay)).map_err(failed)
+    quietly(|| tobj::load_obj_buf(&mut text.as_bytes(), &load_options(), replay))
+        .map(|loaded| (loaded, false))
+        .map_err(failed)
 }
 
 /// Reads OBJ text without polylines, as [`add_mesh`] reads it (the error search's reader).
 fn read_plain(text: &str) -> Result<tobj::LoadResult, String> {
     let scanned = quietly(|| obj_parse::scan(text, Polylines::Skip))
         .map_err(|()| "the OBJ reader failed on this file".to_string())?;
-    load_obj(text, scanned, |_| Ok(Default::default()))
+    load_obj(text, scanned, |_| Ok(Default::default())).map(|(loaded, _)| loaded)
 }
 
 /// MTL text as `tobj` can take it, or the line and the reason it cannot. The MTL format lets
@@ -411,11 +414,13 @@ fn error_line(text: &str) -> Option<usize> {
 pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, ObjProblem> {
     // One pass of the parallel reader counts what the budget and the warnings need; only a
     // text it leaves to tobj is counted line by line.
-    let scanned =
+    let mut scanned =
         quietly(|| obj_parse::scan(req.text, Polylines::Skip)).map_err(|()| ObjProblem {
             line: None,
             reason: "the OBJ reader failed on this file".into(),
         })?;
+    // Which faces give `vn`/`vt` at every corner, as that pass saw them.
+    let fast_corners = scanned.as_mut().map(Scanned::take_face_corners);
     let facts = match &scanned {
         Some(s) => s.facts().clone(),
         None => slow_facts(req.text),
@@ -472,9 +477,9 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
         })
     };
     let polylines = facts.polylines;
-    let (models, mtl_materials) = match load_obj(req.text, scanned, load_mtl) {
-        Ok(Ok(loaded)) => loaded,
-        Ok(Err(e)) => {
+    let ((models, mtl_materials), fast) = match load_obj(req.text, scanned, load_mtl) {
+        Ok((Ok(loaded), fast)) => (loaded, fast),
+        Ok((Err(e), _)) => {
             return Err(ObjProblem {
                 line: error_line(req.text),
                 reason: e.to_string(),
@@ -490,14 +495,15 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
             n || !m.mesh.normals.is_empty(),
         )
     });
-    let face_corners = match uvs_in_file || normals_in_file {
-        true => super::obj_corners::face_corners(req.text, uvs_in_file, normals_in_file).map_err(
-            |(line, reason)| ObjProblem {
+    // The fast reader's pass found them; a file read by tobj is read again for them.
+    let face_corners = match (uvs_in_file || normals_in_file, fast_corners) {
+        (false, _) => Default::default(),
+        (true, Some(found)) if fast => found.only(uvs_in_file, normals_in_file),
+        (true, _) => super::obj_corners::face_corners(req.text, uvs_in_file, normals_in_file)
+            .map_err(|(line, reason)| ObjProblem {
                 line: Some(line),
                 reason: reason.into(),
-            },
-        )?,
-        false => Default::default(),
+            })?,
     };
     let mut warnings = mtl_warnings.into_inner();
     let mtl_texts = mtl_texts.into_inner();
@@ -809,37 +815,47 @@ fn finish_attributes(
     let first = attrs.first_triangle as usize;
     let count = scene.triangles.len() - first;
     attrs.triangle_count = count as u32;
-    // (count, whether it applies, what those faces do, what becomes of them), one warning each.
+    // (count, whether it applies, the verb for one face and for several, what those faces do,
+    // and what becomes of them), one warning each.
     let problems = [
         (
             corners.bad_normals,
             true,
-            ["face name", "faces name"],
-            "normals (`vn`) that are out of range, zero or not finite; they are shaded flat",
+            ["names", "name"],
+            "normals (`vn`) that are out of range, zero or not finite",
+            "shaded flat",
         ),
         (
             corners.partial_normals,
             true,
-            ["face gives", "faces give"],
-            "normals (`vn`) at some corners only; they are shaded flat",
+            ["gives", "give"],
+            "normals (`vn`) at some corners only",
+            "shaded flat",
         ),
         (
             corners.partial_uvs,
             textured,
-            ["face gives", "faces give"],
-            "texture coordinates (`vt`) at some corners only; they are not textured",
+            ["gives", "give"],
+            "texture coordinates (`vt`) at some corners only",
+            "not textured",
         ),
         (
             corners.bad_uvs,
             textured,
-            ["face name", "faces name"],
-            "texture coordinates (`vt`) that are out of range or not finite; they are not textured",
+            ["names", "name"],
+            "texture coordinates (`vt`) that are out of range or not finite",
+            "not textured",
         ),
     ];
-    for (n, applies, [one, many], what) in problems {
+    for (n, applies, [verb_one, verb_many], what, fate) in problems {
         if n > 0 && applies {
-            let faces = if n == 1 { one } else { many };
-            warnings.push(format!("{}: {n} {faces} {what}.", req.label));
+            warnings.push(faces_warning(
+                req.label,
+                n,
+                [verb_one, verb_many],
+                what,
+                fate,
+            ));
         }
     }
     let mut corners = corners;
@@ -874,6 +890,16 @@ fn finish_attributes(
     if count > 0 && (!attrs.normal_indices.is_empty() || !attrs.uv_indices.is_empty()) {
         scene.attributes.push(Arc::new(attrs));
     }
+}
+
+/// `LABEL: N face(s) VERB WHAT; it is (they are) FATE.`, singular for one face, plural for
+/// several (`verb` for one and for several).
+fn faces_warning(label: &str, n: usize, verb: [&str; 2], what: &str, fate: &str) -> String {
+    let (faces, verb, they) = match n {
+        1 => ("face", verb[0], "it is"),
+        _ => ("faces", verb[1], "they are"),
+    };
+    format!("{label}: {n} {faces} {verb} {what}; {they} {fate}.")
 }
 
 /// Area-weighted vertex normals for `triangles` (SPEC §3b `normals = "smooth"`): at each corner,
@@ -1162,6 +1188,65 @@ pub fn material_from_mtl(
 
 #[cfg(test)]
 mod tests {
+
+    /// The mesh warnings' sentences agree in number for one face and for two.
+    #[test]
+    fn face_warnings_agree_in_number() {
+        // Through the loader: one (two) faces with a zero normal, and one (two) with `vn` at
+        // some corners only.
+        for (n, faces, verb, they) in [
+            (1, "face", ["names", "gives"], "it is"),
+            (2, "faces", ["name", "give"], "they are"),
+        ] {
+            let mut obj = String::from("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 0 0\n");
+            for _ in 0..n {
+                obj += "f 1//2 2//2 3//2\nf 1//1 2 3//1\n";
+            }
+            let scene = crate::scene::load_scene_str_with(
+                "[[mesh]]\nfile = \"m.obj\"\n",
+                "t.toml",
+                &|_: &str| Ok(obj.clone()),
+            )
+            .unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(
+                scene.warnings,
+                [
+                    format!(
+                        "m.obj: {n} {faces} {} normals (`vn`) that are out of range, zero or \
+                         not finite; {they} shaded flat.",
+                        verb[0]
+                    ),
+                    format!(
+                        "m.obj: {n} {faces} {} normals (`vn`) at some corners only; {they} \
+                         shaded flat.",
+                        verb[1]
+                    ),
+                ]
+            );
+        }
+        let what = "normals (`vn`) that are out of range, zero or not finite";
+        assert_eq!(
+            faces_warning("m.obj", 1, ["names", "name"], what, "shaded flat"),
+            "m.obj: 1 face names normals (`vn`) that are out of range, zero or not finite; \
+             it is shaded flat."
+        );
+        assert_eq!(
+            faces_warning("m.obj", 2, ["names", "name"], what, "shaded flat"),
+            "m.obj: 2 faces name normals (`vn`) that are out of range, zero or not finite; \
+             they are shaded flat."
+        );
+        let what = "texture coordinates (`vt`) at some corners only";
+        assert_eq!(
+            faces_warning("m.obj", 1, ["gives", "give"], what, "not textured"),
+            "m.obj: 1 face gives texture coordinates (`vt`) at some corners only; it is not \
+             textured."
+        );
+        assert_eq!(
+            faces_warning("m.obj", 2, ["gives", "give"], what, "not textured"),
+            "m.obj: 2 faces give texture coordinates (`vt`) at some corners only; they are not \
+             textured."
+        );
+    }
     use super::*;
 
     #[test]

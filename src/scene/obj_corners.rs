@@ -8,6 +8,10 @@
 //! would load as if it were valid. This pass reads the face lines again, in tobj's order of
 //! triangles, so that the loader shades such faces flat and refuses those indices as tobj
 //! refuses every other index out of range.
+//!
+//! The parallel reader ([`super::obj_parse`]) finds the same facts while it reads the faces
+//! ([`super::obj_parse::Scanned::take_face_corners`]) and never takes indices of 0 or relative
+//! ones, so this second pass only runs on files it leaves to tobj.
 
 /// A triangle's face gives a normal at every corner.
 pub(crate) const ALL_NORMALS: u8 = 1;
@@ -17,7 +21,7 @@ pub(crate) const ALL_UVS: u8 = 2;
 use rayon::prelude::*;
 
 /// What [`face_corners`] found.
-#[derive(Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub(crate) struct FaceCorners {
     /// For every triangle, in the order tobj makes them (faces in file order, a face of `n ≥ 4`
     /// corners fanned into `n − 2`, one of 1 to 3 corners one triangle): [`ALL_NORMALS`] and
@@ -27,6 +31,24 @@ pub(crate) struct FaceCorners {
     pub partial_normals: usize,
     /// Faces that give texture coordinates at some corners but not all.
     pub partial_uvs: usize,
+}
+
+impl FaceCorners {
+    /// The facts for a file that has `vt` only if `has_uvs` and `vn` only if `has_normals`
+    /// (as [`face_corners`] gives them), from those found with both lists present: the
+    /// indices into a list the file does not have are ignored, as tobj ignores them.
+    pub(crate) fn only(mut self, has_uvs: bool, has_normals: bool) -> Self {
+        let keep = match (has_uvs, has_normals) {
+            (true, true) => return self,
+            (true, false) => ALL_UVS,
+            (false, true) => ALL_NORMALS,
+            (false, false) => 0,
+        };
+        self.triangles.iter_mut().for_each(|f| *f &= keep);
+        self.partial_uvs *= usize::from(has_uvs);
+        self.partial_normals *= usize::from(has_normals);
+        self
+    }
 }
 
 /// The corners of every face of `text` (OBJ, polylines already removed, read by tobj without
@@ -110,16 +132,11 @@ struct Part {
 
 fn read_chunk(text: &str, lists: [bool; 2]) -> Part {
     let mut part = Part::default();
-    // Text with other whitespace than ASCII splits as tobj splits it (Unicode).
-    let ascii = text.is_ascii();
     for (i, line) in text.lines().enumerate() {
         part.lines = i + 1;
-        let read = if ascii {
-            read_line(line.split_ascii_whitespace(), i + 1, lists, &mut part)
-        } else {
-            read_line(line.split_whitespace(), i + 1, lists, &mut part)
-        };
-        if read.is_err() {
+        // Split as tobj splits (Unicode whitespace, which has the vertical tab that
+        // `split_ascii_whitespace` lacks).
+        if read_line(line.split_whitespace(), i + 1, lists, &mut part).is_err() {
             break;
         }
     }
@@ -265,5 +282,47 @@ mod tests {
         // A file without `vn` at all: its `vn` indices are ignored, as tobj ignores them.
         let c = face_corners("v 0 0 0\nf 1//0 1//0 1//0\n", false, false).expect("no vn at all");
         assert_eq!(c.triangles, [0]);
+    }
+
+    /// The parallel reader's pass gives, per face, what this pass gives: on a file of several
+    /// of its chunks whose faces give `vt` and `vn` at every corner, some, or none, with
+    /// polylines between them, for a file with both lists, one of them, or neither.
+    #[test]
+    fn the_fast_readers_pass_gives_the_same_faces() {
+        use super::super::obj_parse::{Polylines, scan};
+        let faces = [
+            "f 1/1/1 2/1/1 3/1/1\n",
+            "f 1 2 3 4\n",
+            "f 1//1 2 3//1\n",
+            "f 1/1 2/1 3/1 4/1 1/1\n",
+            "f 1/1/1 2//1 3/1\n",
+            "f 2\n",
+            "f 1/1 2\n",
+            "l 1 2 3\n",
+            "f 1/1/1 2/1/1 3/1/1 4/1\n",
+            "\tf  1//1 \x0b 2//1\x0c3//1\n",
+        ];
+        let mut text = String::from("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvn 0 0 1\n");
+        let mut seed = 7u32;
+        // More than 1 MiB: the reader cuts it into several chunks.
+        while text.len() < 3 << 20 {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            text += faces[(seed >> 16) as usize % faces.len()];
+        }
+        let found = scan(&text, Polylines::Skip)
+            .expect("the fast reader takes it")
+            .take_face_corners();
+        assert!(found.partial_normals > 1000 && found.partial_uvs > 1000);
+        for flags in [0, ALL_UVS, ALL_NORMALS, ALL_UVS | ALL_NORMALS] {
+            assert!(found.triangles.contains(&flags), "{flags}");
+        }
+        for (uvs, normals) in [(true, true), (true, false), (false, true), (false, false)] {
+            let again = face_corners(&text, uvs, normals).expect("valid");
+            let fast = found.clone().only(uvs, normals);
+            let first_difference =
+                (fast.triangles.iter().zip(&again.triangles)).position(|(a, b)| a != b);
+            assert_eq!(first_difference, None, "vt {uvs}, vn {normals}");
+            assert_eq!(fast, again, "vt {uvs}, vn {normals}");
+        }
     }
 }

@@ -29,6 +29,8 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
+use super::obj_corners::{ALL_NORMALS, ALL_UVS, FaceCorners};
+
 /// An absent `vt` or `vn` in a face corner (`1//3`, `1`).
 const MISSING: u32 = u32::MAX;
 
@@ -66,6 +68,12 @@ struct Chunk {
     polylines: u64,
     /// `usemtl` names as the loader's warning names them (see [`Facts::usemtl`]).
     usemtl: Vec<String>,
+    /// For the triangles of the `f` lines, in runs of equal flags (most files have one run):
+    /// [`ALL_UVS`] and [`ALL_NORMALS`] when the face gives `vt` (`vn`) at every corner, and
+    /// how many triangles in a row have them.
+    given: Vec<(u8, usize)>,
+    /// `f` lines that give `vt` (`vn`) at some corners but not all.
+    partial: [usize; 2],
 }
 
 /// What to do with polyline (`l`) statements.
@@ -192,6 +200,26 @@ impl Scanned {
     /// What the pass counted.
     pub fn facts(&self) -> &Facts {
         &self.facts
+    }
+
+    /// Which faces of the `f` lines give `vt` and `vn` at every corner, and how many give them
+    /// at some corners only: what [`super::obj_corners::face_corners`] finds by reading the
+    /// text again, for a file with both lists (see [`FaceCorners::only`]). Taken out: a second
+    /// call gives nothing. With [`Polylines::AsFaces`] the polylines' triangles are not in it.
+    pub(crate) fn take_face_corners(&mut self) -> FaceCorners {
+        let mut out = FaceCorners {
+            triangles: Vec::with_capacity(self.facts.triangles as usize),
+            partial_uvs: 0,
+            partial_normals: 0,
+        };
+        for chunk in &mut self.chunks {
+            for (flags, n) in std::mem::take(&mut chunk.given) {
+                out.triangles.extend(std::iter::repeat_n(flags, n));
+            }
+            out.partial_uvs += std::mem::take(&mut chunk.partial[0]);
+            out.partial_normals += std::mem::take(&mut chunk.partial[1]);
+        }
+        out
     }
 
     /// The models and materials, exactly as tobj gives them, calling `load_mtl` for each
@@ -417,10 +445,23 @@ fn parse_line<'a>(
         "l" if polylines == Polylines::Skip => chunk.polylines += 1,
         "f" => {
             let before = chunk.corners.len();
-            face(words, &mut chunk.corners)?;
-            chunk.face_triangles += ((chunk.corners.len() - before) / 3) as u64;
+            let (corners, given) = face(words, &mut chunk.corners)?;
+            let triangles = (chunk.corners.len() - before) / 3;
+            chunk.face_triangles += triangles as u64;
+            // The same facts as [`super::obj_corners`] finds by reading the line again.
+            let all = |list: usize| given[list] == corners;
+            let flags = (u8::from(all(0)) * ALL_UVS) | (u8::from(all(1)) * ALL_NORMALS);
+            for (partial, given) in chunk.partial.iter_mut().zip(given) {
+                *partial += usize::from(given > 0 && given < corners);
+            }
+            match chunk.given.last_mut() {
+                Some((f, n)) if *f == flags => *n += triangles,
+                _ => chunk.given.push((flags, triangles)),
+            }
         }
-        "l" => face(words, &mut chunk.corners)?,
+        "l" => {
+            face(words, &mut chunk.corners)?;
+        }
         "o" | "g" => {
             let size = line.chars().next().map_or(1, char::len_utf8);
             let name = line.get(size..).unwrap_or("").trim();
@@ -455,25 +496,35 @@ fn parse_line<'a>(
 }
 
 /// The triangles of a face's corner `words`, fanned as tobj fans them (one corner: one
-/// triangle `a a a`; two: `a b b`); `None` for no corners or a bad one.
-fn face<'a>(mut words: impl Iterator<Item = &'a str>, out: &mut Vec<[u32; 3]>) -> Option<()> {
-    let a = corner(words.next()?)?;
+/// triangle `a a a`; two: `a b b`); `None` for no corners or a bad one. Returns the face's
+/// corners and how many of them give a `vt` and a `vn`.
+fn face<'a>(
+    mut words: impl Iterator<Item = &'a str>,
+    out: &mut Vec<[u32; 3]>,
+) -> Option<(usize, [usize; 2])> {
+    let mut given = [0usize; 2];
+    let mut count = |c: [u32; 3]| {
+        given[0] += usize::from(c[1] != MISSING);
+        given[1] += usize::from(c[2] != MISSING);
+        c
+    };
+    let a = count(corner(words.next()?)?);
     let Some(word) = words.next() else {
         out.extend([a, a, a]);
-        return Some(());
+        return Some((1, given));
     };
-    let mut b = corner(word)?;
-    let mut any = false;
+    let mut b = count(corner(word)?);
+    let mut corners = 2;
     for word in words {
-        let c = corner(word)?;
+        let c = count(corner(word)?);
         out.extend([a, b, c]);
         b = c;
-        any = true;
+        corners += 1;
     }
-    if !any {
+    if corners == 2 {
         out.extend([a, b, b]);
     }
-    Some(())
+    Some((corners, given))
 }
 
 fn push_event(chunk: &mut Chunk, kind: EventKind) {
@@ -551,87 +602,53 @@ impl Assembly<'_> {
             indices: Vec::with_capacity(n),
             ..Default::default()
         };
-        let has_tex = counts[1] > 0;
-        let has_norm = counts[2] > 0;
-        if has_tex {
-            mesh.texcoord_indices.reserve(n);
-        }
-        if has_norm {
-            mesh.normal_indices.reserve(n);
-        }
         let [pos_map, tex_map, norm_map] = &mut self.maps;
-        let mut used: [Vec<u32>; 3] = Default::default();
+        let mut positions = List {
+            all: self.positions,
+            width: 3,
+            count: counts[0],
+            map: pos_map,
+            values: &mut mesh.positions,
+            indices: &mut mesh.indices,
+            used: Vec::new(),
+        };
+        // The indices into a list the file does not have (yet) are ignored, as tobj ignores them.
+        let mut texcoords = (counts[1] > 0).then(|| List {
+            all: self.texcoords,
+            width: 2,
+            count: counts[1],
+            map: tex_map,
+            values: &mut mesh.texcoords,
+            indices: &mut mesh.texcoord_indices,
+            used: Vec::new(),
+        });
+        let mut normals = (counts[2] > 0).then(|| List {
+            all: self.normals,
+            width: 3,
+            count: counts[2],
+            map: norm_map,
+            values: &mut mesh.normals,
+            indices: &mut mesh.normal_indices,
+            used: Vec::new(),
+        });
+        for list in [&mut texcoords, &mut normals].into_iter().flatten() {
+            list.indices.reserve(n);
+        }
         let result = (|| {
             for [v, vt, vn] in corners {
-                mesh.indices.push(remap(
-                    v,
-                    counts[0],
-                    3,
-                    self.positions,
-                    pos_map,
-                    &mut mesh.positions,
-                    &mut used[0],
-                )?);
-                if has_tex {
-                    let i = if vt != MISSING {
-                        remap(
-                            vt,
-                            counts[1],
-                            2,
-                            self.texcoords,
-                            tex_map,
-                            &mut mesh.texcoords,
-                            &mut used[1],
-                        )?
-                    } else if let Some(&last) = mesh.texcoord_indices.last() {
-                        last
-                    } else {
-                        // tobj: the model's first corner without one takes the file's first.
-                        remap(
-                            0,
-                            counts[1],
-                            2,
-                            self.texcoords,
-                            tex_map,
-                            &mut mesh.texcoords,
-                            &mut used[1],
-                        )?
-                    };
-                    mesh.texcoord_indices.push(i);
+                positions.push(v)?;
+                if let Some(list) = &mut texcoords {
+                    list.push_or_repeat(vt)?;
                 }
-                if has_norm {
-                    let i = if vn != MISSING {
-                        remap(
-                            vn,
-                            counts[2],
-                            3,
-                            self.normals,
-                            norm_map,
-                            &mut mesh.normals,
-                            &mut used[2],
-                        )?
-                    } else if let Some(&last) = mesh.normal_indices.last() {
-                        last
-                    } else {
-                        remap(
-                            0,
-                            counts[2],
-                            3,
-                            self.normals,
-                            norm_map,
-                            &mut mesh.normals,
-                            &mut used[2],
-                        )?
-                    };
-                    mesh.normal_indices.push(i);
+                if let Some(list) = &mut normals {
+                    list.push_or_repeat(vn)?;
                 }
             }
             Some(())
         })();
-        for (map, used) in [pos_map, tex_map, norm_map].into_iter().zip(&used) {
-            for &i in used {
-                map[i as usize] = MISSING;
-            }
+        positions.reset();
+        for list in [texcoords, normals].iter_mut().flatten() {
+            list.reset();
         }
         result?;
         self.models.push(tobj::Model::new(mesh, name.to_string()));
@@ -639,25 +656,59 @@ impl Assembly<'_> {
     }
 }
 
-/// The model's index of file element `i` (of `width` floats, `count` read so far), copying the
-/// element into `out` on first use.
-fn remap(
-    i: u32,
-    count: usize,
+/// One of a model's lists (positions, texture coordinates or normals) while it is assembled.
+struct List<'a> {
+    /// The whole file's values, `width` floats each, of which the model may use the first
+    /// `count` (those read before it ends).
+    all: &'a [f32],
     width: usize,
-    all: &[f32],
-    map: &mut [u32],
-    out: &mut Vec<f32>,
-    used: &mut Vec<u32>,
-) -> Option<u32> {
-    let slot = map.get_mut(i as usize).filter(|_| (i as usize) < count)?;
-    if *slot == MISSING {
-        *slot = (out.len() / width) as u32;
-        let from = i as usize * width;
-        out.extend_from_slice(all.get(from..from + width)?);
-        used.push(i);
+    count: usize,
+    /// The model's index of each file index it uses, [`MISSING`] elsewhere.
+    map: &'a mut [u32],
+    /// The model's values, copied on first use, and its corners' indices into them.
+    values: &'a mut Vec<f32>,
+    indices: &'a mut Vec<u32>,
+    /// The file indices set in `map`.
+    used: Vec<u32>,
+}
+
+impl List<'_> {
+    /// Adds a corner's file index `i`; `None` when it is out of range.
+    fn push(&mut self, i: u32) -> Option<()> {
+        let slot = self
+            .map
+            .get_mut(i as usize)
+            .filter(|_| (i as usize) < self.count)?;
+        if *slot == MISSING {
+            *slot = (self.values.len() / self.width) as u32;
+            let from = i as usize * self.width;
+            self.values
+                .extend_from_slice(self.all.get(from..from + self.width)?);
+            self.used.push(i);
+        }
+        self.indices.push(*slot);
+        Some(())
     }
-    Some(*slot)
+
+    /// Adds a corner's `vt` or `vn` index `i` as tobj does: an absent one ([`MISSING`]) repeats
+    /// the previous corner's, and the model's first corner without one takes the file's first.
+    fn push_or_repeat(&mut self, i: u32) -> Option<()> {
+        match (i, self.indices.last()) {
+            (MISSING, Some(&last)) => {
+                self.indices.push(last);
+                Some(())
+            }
+            (MISSING, None) => self.push(0),
+            (i, _) => self.push(i),
+        }
+    }
+
+    /// Clears `map` for the next model.
+    fn reset(&mut self) {
+        for &i in &self.used {
+            self.map[i as usize] = MISSING;
+        }
+    }
 }
 
 #[cfg(test)]
