@@ -149,34 +149,78 @@ pub const KEY_REGION: &str = "raytree.region";
 pub const KEY_FRAME: &str = "raytree.frame";
 
 /// A fingerprint of everything in the scene that shapes its pixels (render parameters, camera,
-/// lights, materials, objects, spheres, triangles; not the file's path nor its warnings): 16
-/// hex digits of a 64-bit FNV-1a hash. Parts of one render made on different machines from the
-/// same scene carry the same fingerprint.
+/// lights, materials, objects, spheres, triangles, the meshes' vertex normals and texture
+/// coordinates; not the file's path nor its warnings, and textures by their place in the scene,
+/// not their pixels): 16 hex digits of a 64-bit FNV-1a hash. Parts of one render made on
+/// different machines from the same scene carry the same fingerprint.
+///
+/// The small parts are hashed as their `Debug` text (which prints floats exactly: the
+/// shortest text that reads back to the same value); the triangles and mesh attributes, which
+/// can number millions, as the bits of their numbers, 32 bits a step (text would take most of
+/// a second for a million triangles).
 pub fn scene_hash(scene: &Scene) -> String {
+    const PRIME: u64 = 0x0000_0100_0000_01b3;
     struct Fnv(u64);
+    impl Fnv {
+        fn word(&mut self, w: u32) {
+            self.0 = (self.0 ^ u64::from(w)).wrapping_mul(PRIME);
+        }
+        fn vec3(&mut self, v: glam::Vec3) {
+            for c in v.to_array() {
+                self.word(c.to_bits());
+            }
+        }
+    }
     impl std::fmt::Write for Fnv {
         fn write_str(&mut self, s: &str) -> std::fmt::Result {
             for b in s.bytes() {
-                self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+                self.0 = (self.0 ^ u64::from(b)).wrapping_mul(PRIME);
             }
             Ok(())
         }
     }
     let mut h = Fnv(0xcbf2_9ce4_8422_2325);
-    // Debug prints floats exactly (the shortest text that reads back to the same value).
     let _ = std::fmt::Write::write_fmt(
         &mut h,
         format_args!(
-            "{:?}{:?}{:?}{:?}{:?}{:?}{:?}",
-            scene.render,
-            scene.camera,
-            scene.lights,
-            scene.materials,
-            scene.objects,
-            scene.spheres,
-            scene.triangles
+            "{:?}{:?}{:?}{:?}{:?}{:?}",
+            scene.render, scene.camera, scene.lights, scene.materials, scene.objects, scene.spheres,
         ),
     );
+    // Counts first, so lists of different lengths cannot run into each other.
+    h.word(scene.triangles.len() as u32);
+    for t in scene.triangles.iter() {
+        for v in t.vertices {
+            h.vec3(v);
+        }
+        h.word(t.material.0);
+        h.word(t.object.0);
+    }
+    h.word(scene.attributes.len() as u32);
+    for a in &scene.attributes {
+        for w in [
+            a.first_triangle,
+            a.triangle_count,
+            a.normals.len() as u32,
+            a.normal_indices.len() as u32,
+            a.uvs.len() as u32,
+            a.uv_indices.len() as u32,
+        ] {
+            h.word(w);
+        }
+        for &n in &a.normals {
+            h.vec3(n);
+        }
+        for uv in &a.uvs {
+            h.word(uv.x.to_bits());
+            h.word(uv.y.to_bits());
+        }
+        for idx in a.normal_indices.iter().chain(&a.uv_indices) {
+            for &i in idx {
+                h.word(i);
+            }
+        }
+    }
     format!("{:016x}", h.0)
 }
 
@@ -570,6 +614,36 @@ mod tests {
         // Below the linear segment's end: 12.92 · 0.002 = 0.02584 → 6.59 → 7.
         assert_eq!(to_srgb8(Vec3::splat(0.002)), [7, 7, 7]);
         assert_eq!(to_srgb8(Vec3::splat(f32::NAN)), [0, 0, 0]);
+    }
+
+    /// The fingerprint is the same for the same scene loaded twice, and changes with anything
+    /// that shapes pixels: one ulp of one vertex, one vertex normal, a triangle's material.
+    #[test]
+    fn scene_hash_follows_geometry_and_vertex_normals() {
+        let load = || crate::scene::builtin::load_builtin("smooth").expect("smooth");
+        let base = scene_hash(&load());
+        assert_eq!(base.len(), 16);
+        assert_eq!(scene_hash(&load()), base);
+
+        let mut moved = load();
+        let v = &mut std::sync::Arc::make_mut(&mut moved.triangles)[0].vertices[1];
+        v.x = crate::geometry::next_float_up(v.x);
+        assert_ne!(scene_hash(&moved), base, "one ulp of one vertex");
+
+        let mut bent = load();
+        let mesh = bent
+            .attributes
+            .iter_mut()
+            .find(|a| !a.normals.is_empty())
+            .expect("the smooth scene has vertex normals");
+        let n = &mut std::sync::Arc::make_mut(mesh).normals[0];
+        *n = (*n + Vec3::splat(0.01)).normalize();
+        assert_ne!(scene_hash(&bent), base, "one vertex normal");
+
+        let mut repainted = load();
+        let t = &mut std::sync::Arc::make_mut(&mut repainted.triangles)[0];
+        t.material = crate::scene::MaterialId(t.material.0 + 1);
+        assert_ne!(scene_hash(&repainted), base, "a triangle's material");
     }
 
     /// The stamp is pinned byte for byte: PNGs written before and after read the same.
