@@ -411,6 +411,12 @@ static int flush_denormals;
 
 static void *worker(void *arg) {
     Worker *w = arg;
+    /* Rays are counted on this thread's stack and stored once at the end: the workers' counts
+     * sit next to each other in one array, and incrementing them per ray from two threads
+     * made the cache line ping-pong between the cores whenever the array's placement put both
+     * in one line (Embree's frame then took 0.12 s instead of 0.07 s, in about one process in
+     * three, as the heap's address fell). */
+    Counts counts = {0};
     if (flush_denormals) {
         /* What Embree asks of every thread that traces (its verbose start-up warns without). */
 #if defined(__SSE3__)
@@ -433,12 +439,13 @@ static void *worker(void *arg) {
                 float cx = (2.0f * px / fw - 1.0f) * aspect * tan_half;
                 float cy = (1.0f - 2.0f * py / fh) * tan_half;
                 vec3 d = normalize(sub(add(scale(cx, cam_right), scale(cy, cam_up)), cam_back));
-                vec3 c = trace(S.cam_pos, d, PRIMARY, 0, &w->counts, &ctx);
+                vec3 c = trace(S.cam_pos, d, PRIMARY, 0, &counts, &ctx);
                 float *out = &image[3 * ((size_t)y * S.width + x)];
                 out[0] = c.x; out[1] = c.y; out[2] = c.z;
             }
         }
     }
+    w->counts = counts;
     return NULL;
 }
 
