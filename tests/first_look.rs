@@ -376,9 +376,41 @@ fn meshlab_tr_1_is_opaque_and_ns_0_no_wash_of_specular() {
     // Its `Ns 0` (exponent 0: all of `Ks` wherever light falls) shows no highlight.
     assert_eq!(m("/material_0").specular, Vec3::ZERO);
     assert_eq!(m("/glass").specular, Vec3::ONE, "no `Ns`: kept");
-    assert_warned(&scene, "bottle.obj", &["`Ns 0` in `material_0`"]);
+    assert_warned(&scene, "bottle.obj", &["`material_0` has `Ns 0`"]);
     assert_eq!(m("/glass").transparency, Vec3::ONE, "glass keeps `Tr 1`");
     assert_warned(&scene, "bottle.obj", &["`Tr 1`", "material_0"]);
+}
+
+/// The same MTL through a scene file's `[[mesh]]`: `Ns 0` shows no highlight there too (it
+/// used to be read only for a bare OBJ), with the same warning, and a mirror (`illum 3`) with
+/// `Ns 0` keeps its reflectivity.
+#[test]
+fn ns_0_shows_no_highlight_through_a_scene_file_too() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mtl = "newmtl material_0\nKd 1 1 1\nKs 1 1 1\nillum 2\nNs 0\n\nnewmtl chrome\nKd 0 0 0\nKs 0.9 0.9 0.9\nillum 3\nNs 0\n\nnewmtl shiny\nKd 1 1 1\nKs 1 1 1\nNs 50\n";
+    std::fs::write(dir.path().join("bottle.mtl"), mtl).expect("write");
+    let obj = "mtllib bottle.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl material_0\nf 1 2 3\nusemtl chrome\nf 1 2 3\nusemtl shiny\nf 1 2 3\n";
+    std::fs::write(dir.path().join("bottle.obj"), obj).expect("write");
+    let toml = "[camera]\nposition = [0.0, 0.0, 5.0]\nlook_at = [0.0, 0.0, 0.0]\n\n[[light]]\nposition = [0.0, 2.0, 5.0]\n\n[[mesh]]\nfile = \"bottle.obj\"\n";
+    let scene = load(dir.path(), "bottle.toml", toml);
+    let m = |n: &str| {
+        scene
+            .materials
+            .iter()
+            .find(|m| m.name.ends_with(n))
+            .unwrap_or_else(|| panic!("material {n} in {:?}", scene.materials))
+    };
+    assert_eq!(m("material_0").specular, Vec3::ZERO);
+    assert_eq!(m("chrome").specular, Vec3::ZERO, "no highlight");
+    assert_eq!(m("chrome").reflectivity, Vec3::splat(0.9), "still a mirror");
+    assert_eq!(m("shiny").specular, Vec3::ONE, "`Ns 50`: kept");
+    assert_warned(&scene, "bottle.toml", &["`material_0` has `Ns 0`"]);
+    assert_warned(&scene, "bottle.toml", &["`chrome` has `Ns 0`"]);
+    assert!(
+        !scene.warnings.iter().any(|w| w.contains("`shiny`")),
+        "{:?}",
+        scene.warnings
+    );
 }
 
 #[test]

@@ -75,22 +75,8 @@ pub(crate) fn load_obj_scene(
             list_and(&washed)
         ));
     }
-    // `Ns 0` with a `Ks` (MeshLab writes `Ns 0` and `Ks 1`): an exponent of 0 is no
-    // highlight but the whole `Ks` added wherever the light falls, which washes a model out.
-    let mut flat = Vec::new();
-    for m in &mut scene.materials {
-        if m.shininess == 0.0 && m.specular != Vec3::ZERO && m.name.starts_with(&format!("{name}/"))
-        {
-            m.specular = Vec3::ZERO;
-            flat.push(format!("`{}`", short(&m.name[name.len() + 1..])));
-        }
-    }
-    if !flat.is_empty() {
-        scene.warnings.push(format!(
-            "{label}: `Ns 0` in {} would add all of `Ks` wherever light falls; shown without a highlight (`Ks 0`).",
-            list_and(&flat)
-        ));
-    }
+    // `Ns 0` with a `Ks` is read where every MTL material is ([`super::obj::material_from_mtl`]),
+    // for a bare OBJ and a scene's `[[mesh]]` alike.
     let (lo, hi) = scene.bounds().unwrap_or((Vec3::ZERO, Vec3::ZERO));
     let up = up_axis(&scene.triangles, lo, hi);
     if up == Vec3::Z {

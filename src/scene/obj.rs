@@ -1144,6 +1144,10 @@ pub fn material_from_mtl(
         None => None,
     };
     let shininess = scalar(m.shininess, "Ns", |x| x >= 0.0, d.shininess).unwrap_or(d.shininess);
+    // `Ns 0` with a `Ks` (MeshLab writes `Ns 0` and `Ks 1` meaning "no highlight"): an
+    // exponent of 0 would add the whole `Ks` wherever the light falls and wash the model out.
+    // The highlight is dropped; a mirror's reflectivity (`Ks`, below) is kept.
+    let no_highlight = m.shininess.is_some() && shininess == 0.0 && specular != Vec3::ZERO;
     let ior = scalar(m.optical_density, "Ni", |x| x > 0.0, d.ior).unwrap_or(d.ior);
     let in_unit = |x: f32| (0.0..=1.0).contains(&x);
     let glass = matches!(m.illumination_model, Some(4 | 6 | 7));
@@ -1166,6 +1170,12 @@ pub fn material_from_mtl(
             short(&m.name)
         ));
     }
+    if no_highlight {
+        warnings.push(format!(
+            "{label}: material `{}` has `Ns 0`, which would add all of `Ks` wherever light falls; shown without a highlight (`Ks 0`).",
+            short(&m.name)
+        ));
+    }
     let mirror = glass || matches!(m.illumination_model, Some(3 | 5));
     let transparency = match dissolve {
         Some(dissolve) => 1.0 - dissolve,
@@ -1176,7 +1186,7 @@ pub fn material_from_mtl(
         name,
         ambient,
         diffuse,
-        specular,
+        specular: if no_highlight { Vec3::ZERO } else { specular },
         shininess,
         reflectivity: if mirror { specular } else { Vec3::ZERO },
         transparency: Vec3::splat(transparency),
