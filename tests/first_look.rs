@@ -413,6 +413,49 @@ fn ns_0_shows_no_highlight_through_a_scene_file_too() {
     );
 }
 
+/// A Blender export whose material is black in every colour (`Kd 0`, `Ka 0`, a bump map only)
+/// was invisible on the dark background: it is shown grey, with a note; a black material
+/// that is a mirror is left alone.
+#[test]
+fn a_black_material_of_a_bare_obj_is_shown_grey() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mtl = "newmtl body\nKa 0 0 0\nKd 0 0 0\nKs 0.5 0.5 0.5\nNs 100\nmap_Bump bump.png\nillum 2\n\nnewmtl chrome\nKa 0 0 0\nKd 0 0 0\nKs 0.9 0.9 0.9\nillum 3\n";
+    std::fs::write(dir.path().join("statue.mtl"), mtl).expect("write");
+    let mut text = String::from("mtllib statue.mtl\nusemtl body\n");
+    let mut base = 0;
+    cuboid(
+        &mut text,
+        &mut base,
+        Vec3::new(-1.0, 0.0, -1.0),
+        Vec3::new(1.0, 2.0, 1.0),
+        false,
+        &[],
+    );
+    text.push_str("usemtl chrome\nv 3 0 0\nv 4 0 0\nv 3 1 0\nf -3 -2 -1\n");
+    let scene = load(dir.path(), "statue.obj", &text);
+    let m = |n: &str| {
+        scene
+            .materials
+            .iter()
+            .find(|m| m.name.ends_with(n))
+            .unwrap_or_else(|| panic!("material {n} in {:?}", scene.materials))
+    };
+    assert_ne!(m("/body").diffuse, Vec3::ZERO, "shown grey");
+    assert_eq!(m("/body").diffuse, m("/body").ambient);
+    assert_eq!(
+        m("/chrome").diffuse,
+        Vec3::ZERO,
+        "a black mirror stays black"
+    );
+    assert_warned(&scene, "statue.obj", &["material `body` is black"]);
+    assert!(
+        !scene.warnings.iter().any(|w| w.contains("`chrome`")),
+        "{:?}",
+        scene.warnings
+    );
+    assert_readable(&scene, "statue.obj", 0.03..0.6, 0.02);
+}
+
 #[test]
 fn a_wide_model_fills_the_frame_and_nothing_is_cut_off() {
     // A long low model (a kitchen counter, a car): framing its bounding sphere left it a

@@ -75,6 +75,34 @@ pub(crate) fn load_obj_scene(
             list_and(&washed)
         ));
     }
+    // A material black in every colour it shows (`Kd 0` and `Ka 0` without a texture, neither
+    // mirror nor glass; Blender writes that for a model whose look was a node graph or a bump
+    // map only) leaves the model invisible on the dark background: shown in the default grey.
+    let mut black = Vec::new();
+    let grey = super::Material::default();
+    for m in &mut scene.materials {
+        let shows_nothing = m.diffuse == Vec3::ZERO
+            && m.ambient == Vec3::ZERO
+            && m.diffuse_map.is_none()
+            && m.ambient_map.is_none()
+            && m.reflectivity == Vec3::ZERO
+            && m.transparency == Vec3::ZERO;
+        if shows_nothing && m.name.starts_with(&format!("{name}/")) {
+            m.diffuse = grey.diffuse;
+            m.ambient = grey.diffuse;
+            black.push(format!("`{}`", short(&m.name[name.len() + 1..])));
+        }
+    }
+    if !black.is_empty() {
+        scene.warnings.push(format!(
+            "{label}: {} black in every colour (`Kd 0`, `Ka 0`, no texture): shown in grey so that the model can be seen.",
+            if black.len() == 1 {
+                format!("material {} is", black[0])
+            } else {
+                format!("materials {} are", list_and(&black))
+            }
+        ));
+    }
     // `Ns 0` with a `Ks` is read where every MTL material is ([`super::obj::material_from_mtl`]),
     // for a bare OBJ and a scene's `[[mesh]]` alike.
     let (lo, hi) = scene.bounds().unwrap_or((Vec3::ZERO, Vec3::ZERO));
