@@ -125,6 +125,97 @@ fn a_bare_room_and_a_blender_room_are_readable_from_inside() {
     }
 }
 
+/// The same room written z-up (3ds Max, SketchUp's z-up export): it is lower in z than in x
+/// and y, so it opens z-up, from inside, lit from under its ceiling; written y-up it stays y-up.
+#[test]
+fn a_z_up_room_opens_z_up_from_inside() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    // A quarter turn about x: y becomes z, z becomes −y.
+    let z_up: String = room(false)
+        .lines()
+        .map(|line| match line.strip_prefix("v ") {
+            Some(v) => {
+                let c: Vec<f32> = v
+                    .split_whitespace()
+                    .map(|t| t.parse().expect("number"))
+                    .collect();
+                format!("v {} {} {}\n", c[0], -c[2], c[1])
+            }
+            None => format!("{line}\n"),
+        })
+        .collect();
+    let scene = load(dir.path(), "room_z.obj", &z_up);
+    assert_eq!(scene.camera.up, Vec3::Z, "z-up");
+    assert!(inside(scene.camera.position, &scene), "camera inside");
+    assert_warned(&scene, "room_z.obj", &["+z is taken as up"]);
+    assert_warned(&scene, "room_z.obj", &["the camera starts inside it"]);
+    let key = scene
+        .lights
+        .iter()
+        .find(|l| l.name == "key")
+        .expect("key light");
+    let (lo, hi) = scene.bounds().expect("bounds");
+    assert!(
+        key.position.z > 0.5 * (lo.z + hi.z) && key.position.z < hi.z,
+        "the key light hangs under the ceiling: {} in {lo}..{hi}",
+        key.position
+    );
+    assert_readable(&scene, "room_z.obj", 0.2..0.75, 0.1);
+
+    let y_up = load(dir.path(), "room.obj", &room(false));
+    assert_eq!(y_up.camera.up, Vec3::Y, "the y-up room stays y-up");
+    assert!(
+        !y_up
+            .warnings
+            .iter()
+            .any(|w| w.contains("+z is taken as up")),
+        "{:?}",
+        y_up.warnings
+    );
+}
+
+/// A part with a hole through its middle (a rocker arm, a bearing) and a solid whose middle
+/// is a pocket (a low-poly hand): the hole's walls face the middle as a room's do, but they
+/// stand close around it, far from the model's outer shell, so the model is framed from
+/// outside, not from inside the hole.
+#[test]
+fn a_hole_through_a_part_is_not_a_room() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut text = String::new();
+    let mut base = 0;
+    // The outer walls of a 4-unit block (its ends left open) and the walls of a 1-unit square
+    // hole through it along z, facing into the hole.
+    cuboid(
+        &mut text,
+        &mut base,
+        Vec3::splat(-2.0),
+        Vec3::splat(2.0),
+        false,
+        &[4, 5],
+    );
+    cuboid(
+        &mut text,
+        &mut base,
+        Vec3::new(-0.5, -0.5, -2.0),
+        Vec3::new(0.5, 0.5, 2.0),
+        true,
+        &[4, 5],
+    );
+    let scene = load(dir.path(), "part.obj", &text);
+    assert!(
+        !scene.warnings.iter().any(|w| w.contains("(a room)")),
+        "{:?}",
+        scene.warnings
+    );
+    let (lo, hi) = scene.bounds().expect("bounds");
+    let p = scene.camera.position;
+    assert!(
+        p.cmplt(lo).any() || p.cmpgt(hi).any(),
+        "the camera stands outside the part, not in its hole: {p}"
+    );
+    assert_readable(&scene, "part.obj", 0.03..0.6, 0.1);
+}
+
 #[test]
 fn an_outdoor_model_is_framed_from_outside_and_readable() {
     let text = std::fs::read_to_string("assets/models/torus.obj").expect("the torus");

@@ -106,14 +106,32 @@ pub(crate) fn load_obj_scene(
     // `Ns 0` with a `Ks` is read where every MTL material is ([`super::obj::material_from_mtl`]),
     // for a bare OBJ and a scene's `[[mesh]]` alike.
     let (lo, hi) = scene.bounds().unwrap_or((Vec3::ZERO, Vec3::ZERO));
-    let up = up_axis(&scene.triangles, lo, hi);
+    let mut up = up_axis(&scene.triangles, lo, hi);
     if up == Vec3::Z {
         scene.warnings.push(format!(
             "{label}: the model stands on a flat base at its lowest z and is tallest in z: +z is taken as up."
         ));
     }
     let aspect = scene.render.width.max(1) as f32 / scene.render.height.max(1) as f32;
-    let look = first_view(&scene.triangles, lo, hi, up, aspect);
+    let mut look = first_view(&scene.triangles, lo, hi, up, aspect);
+    // A room is wider and longer than it is high. Seen y-up, a room whose z extent is clearly
+    // its lowest (below `ROOM_Z_UP` of its y extent) was written z-up (3ds Max, SketchUp's
+    // z-up exports, CAD): it is looked at again with +z up, and taken so if it is a room then.
+    let extent = hi - lo;
+    if up == Vec3::Y
+        && look.room.is_some()
+        && extent.z < ROOM_Z_UP * extent.y
+        && extent.z < ROOM_Z_UP * extent.x
+    {
+        let z_up = first_view(&scene.triangles, lo, hi, Vec3::Z, aspect);
+        if z_up.room.is_some() {
+            (up, look) = (Vec3::Z, z_up);
+            scene.warnings.push(format!(
+                "{label}: the room is lower in z ({}) than in x and y ({} and {}): +z is taken as up.",
+                extent.z, extent.x, extent.y
+            ));
+        }
+    }
     let camera = look.camera;
     if check_camera(&camera).is_err() {
         return Err(SceneError(format!(
@@ -167,6 +185,14 @@ pub const BARE_OBJ_AMBIENT: f32 = 0.1;
 /// clipped.
 const KEY: f32 = 0.65;
 const HEADLIGHT: f32 = 0.25;
+
+/// How far towards the bounds (a fraction of the way from the probe point) a wall must stand
+/// to count as a room's shell ([`Probe::far`]).
+const ROOM_SHELL: f32 = 0.5;
+
+/// A room seen y-up whose z extent is below this fraction of both its x and y extents is taken
+/// z-up (see `load_obj_scene`).
+const ROOM_Z_UP: f32 = 0.8;
 
 /// The up axis of a bare OBJ: +y (the OBJ convention, and what Blender, Maya and SketchUp
 /// write) unless the model clearly stands on z: a flat base at its lowest z (faces facing
@@ -234,6 +260,10 @@ struct Probe {
     front: usize,
     /// Rays whose first triangle faces away (the point is inside a closed solid).
     back: usize,
+    /// Of the `front` rays, those that met their triangle at least [`ROOM_SHELL`] of the way
+    /// to the model's bounds: the walls of a room are its outer shell, where a hole through a
+    /// part or a pocket of a solid is close around the point.
+    far: usize,
     /// The sum of the directions of the rays that met nothing (where the room is open).
     open: Vec3,
     /// Per direction, whether its ray met anything.
@@ -247,7 +277,9 @@ impl Probe {
     /// Walls on most sides, seen from inside: most rays meet something, and most of what
     /// they meet faces the point.
     fn in_room(&self) -> bool {
-        5 * self.hits() >= 3 * PROBE_DIRS && 4 * self.front >= 3 * self.hits()
+        5 * self.hits() >= 3 * PROBE_DIRS
+            && 4 * self.front >= 3 * self.hits()
+            && 2 * self.far >= self.front
     }
     /// How many of the rays within 60° of `up` met nothing (no ceiling).
     fn open_up(&self, dirs: &[Vec3], up: Vec3) -> usize {
@@ -286,7 +318,7 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
             points.push(center + axis * (sign * 0.5 * extent(axis)));
         }
     }
-    let probes = probe_points(triangles, &curve, &points, &dirs);
+    let probes = probe_points(triangles, &curve, &points, &dirs, (lo, hi));
     let room_probe = probes.iter().find(|p| p.in_room());
     let Some(room_probe) = room_probe else {
         return FirstView {
@@ -347,7 +379,7 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
         .collect();
     let mut points: Vec<Vec3> = candidates.iter().map(|c| c.0).collect();
     points.extend(&lights);
-    let free = probe_points(triangles, &curve, &points, &dirs);
+    let free = probe_points(triangles, &curve, &points, &dirs, (lo, hi));
     let light = lights
         .iter()
         .zip(&free[candidates.len()..])
@@ -452,12 +484,14 @@ fn directions(n: usize) -> Vec<Vec3> {
         .collect()
 }
 
-/// Rays from each of `points` in each of `dirs`: what each point's rays met first.
+/// Rays from each of `points` in each of `dirs`: what each point's rays met first; `bounds`
+/// are the model's (for [`Probe::far`]).
 fn probe_points(
     triangles: &[Triangle],
     order: &[u32],
     points: &[Vec3],
     dirs: &[Vec3],
+    (lo, hi): (Vec3, Vec3),
 ) -> Vec<Probe> {
     let rays: Vec<(Vec3, Vec3)> = points
         .iter()
@@ -465,7 +499,8 @@ fn probe_points(
         .collect();
     nearest(triangles, order, &rays)
         .chunks(dirs.len())
-        .map(|per_point| {
+        .zip(points)
+        .map(|(per_point, &p)| {
             let mut probe = Probe::default();
             for (&(dist, facing), &d) in per_point.iter().zip(dirs) {
                 probe.met.push(dist.is_finite());
@@ -473,6 +508,14 @@ fn probe_points(
                     probe.open += d;
                 } else if facing {
                     probe.front += 1;
+                    // How far the ray runs inside the bounds from `p`.
+                    let to_wall = (0..3)
+                        .filter(|&a| d[a] != 0.0)
+                        .map(|a| (if d[a] > 0.0 { hi[a] } else { lo[a] } - p[a]) / d[a])
+                        .fold(f32::INFINITY, f32::min);
+                    if dist >= ROOM_SHELL * to_wall {
+                        probe.far += 1;
+                    }
                 } else {
                     probe.back += 1;
                 }
