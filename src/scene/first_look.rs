@@ -127,8 +127,7 @@ pub(crate) fn load_obj_scene(
         if z_up.room.is_some() {
             (up, look) = (Vec3::Z, z_up);
             scene.warnings.push(format!(
-                "{label}: the room is lower in z ({}) than in x and y ({} and {}): +z is taken as up.",
-                extent.z, extent.x, extent.y
+                "{label}: the room is lower in z than it is wide and deep (in x and y): +z is taken as up."
             ));
         }
     }
