@@ -10,7 +10,7 @@ use std::sync::Arc;
 
 use glam::Vec3;
 use raytree::render::render;
-use raytree::scene::{Scene, load_scene_file};
+use raytree::scene::{Material, Scene, load_scene_file};
 use raytree::trace::{TraceSettings, Tracer};
 
 /// The walls of a closed box `[-3, 3] × [0, 4] × [-4, 4]`, counter-clockwise seen from inside,
@@ -89,6 +89,24 @@ fn assert_warned(scene: &Scene, name: &str, needles: &[&str]) {
     );
 }
 
+/// The scene `name` has no warning that contains `needle`.
+fn assert_not_warned(scene: &Scene, name: &str, needle: &str) {
+    assert!(
+        !scene.warnings.iter().any(|w| w.contains(needle)),
+        "{name}: no {needle:?} in {:?}",
+        scene.warnings
+    );
+}
+
+/// The scene's material whose name ends with `suffix`.
+fn material<'a>(scene: &'a Scene, suffix: &str) -> &'a Material {
+    scene
+        .materials
+        .iter()
+        .find(|m| m.name.ends_with(suffix))
+        .unwrap_or_else(|| panic!("material {suffix} in {:?}", scene.materials))
+}
+
 fn inside(p: Vec3, scene: &Scene) -> bool {
     let (lo, hi) = scene.bounds().expect("bounds");
     p.cmpgt(lo).all() && p.cmplt(hi).all()
@@ -114,11 +132,7 @@ fn a_bare_room_and_a_blender_room_are_readable_from_inside() {
         assert_warned(&scene, name, &["the camera starts inside it"]);
         assert_readable(&scene, name, 0.2..0.75, 0.1);
         if name == "kitchen.obj" {
-            let wall = scene
-                .materials
-                .iter()
-                .find(|m| m.name.ends_with("/wall"))
-                .expect("wall");
+            let wall = material(&scene, "/wall");
             assert_eq!(wall.ambient, wall.diffuse, "`Ka 1` read as `Kd`");
             assert_warned(&scene, name, &["`Ka 1` (Blender's default)"]);
         }
@@ -164,14 +178,7 @@ fn a_z_up_room_opens_z_up_from_inside() {
 
     let y_up = load(dir.path(), "room.obj", &room(false));
     assert_eq!(y_up.camera.up, Vec3::Y, "the y-up room stays y-up");
-    assert!(
-        !y_up
-            .warnings
-            .iter()
-            .any(|w| w.contains("+z is taken as up")),
-        "{:?}",
-        y_up.warnings
-    );
+    assert_not_warned(&y_up, "room.obj", "+z is taken as up");
 }
 
 /// A part with a hole through its middle (a rocker arm, a bearing) and a solid whose middle
@@ -202,11 +209,7 @@ fn a_hole_through_a_part_is_not_a_room() {
         &[4, 5],
     );
     let scene = load(dir.path(), "part.obj", &text);
-    assert!(
-        !scene.warnings.iter().any(|w| w.contains("(a room)")),
-        "{:?}",
-        scene.warnings
-    );
+    assert_not_warned(&scene, "part.obj", "(a room)");
     let (lo, hi) = scene.bounds().expect("bounds");
     let p = scene.camera.position;
     assert!(
@@ -456,13 +459,7 @@ fn meshlab_tr_1_is_opaque_and_ns_0_no_wash_of_specular() {
     std::fs::write(dir.path().join("bottle.mtl"), mtl).expect("write");
     let text = "mtllib bottle.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nv 3 0 0\nv 2 1 0\nusemtl material_0\nf 1 2 3\nusemtl glass\nf 4 5 6\n";
     let scene = load(dir.path(), "bottle.obj", text);
-    let m = |n: &str| {
-        scene
-            .materials
-            .iter()
-            .find(|m| m.name.ends_with(n))
-            .expect("material")
-    };
+    let m = |n: &str| material(&scene, n);
     assert_eq!(m("/material_0").transparency, Vec3::ZERO);
     // Its `Ns 0` (exponent 0: all of `Ks` wherever light falls) shows no highlight.
     assert_eq!(m("/material_0").specular, Vec3::ZERO);
@@ -484,24 +481,14 @@ fn ns_0_shows_no_highlight_through_a_scene_file_too() {
     std::fs::write(dir.path().join("bottle.obj"), obj).expect("write");
     let toml = "[camera]\nposition = [0.0, 0.0, 5.0]\nlook_at = [0.0, 0.0, 0.0]\n\n[[light]]\nposition = [0.0, 2.0, 5.0]\n\n[[mesh]]\nfile = \"bottle.obj\"\n";
     let scene = load(dir.path(), "bottle.toml", toml);
-    let m = |n: &str| {
-        scene
-            .materials
-            .iter()
-            .find(|m| m.name.ends_with(n))
-            .unwrap_or_else(|| panic!("material {n} in {:?}", scene.materials))
-    };
+    let m = |n: &str| material(&scene, n);
     assert_eq!(m("material_0").specular, Vec3::ZERO);
     assert_eq!(m("chrome").specular, Vec3::ZERO, "no highlight");
     assert_eq!(m("chrome").reflectivity, Vec3::splat(0.9), "still a mirror");
     assert_eq!(m("shiny").specular, Vec3::ONE, "`Ns 50`: kept");
     assert_warned(&scene, "bottle.toml", &["`material_0` has `Ns 0`"]);
     assert_warned(&scene, "bottle.toml", &["`chrome` has `Ns 0`"]);
-    assert!(
-        !scene.warnings.iter().any(|w| w.contains("`shiny`")),
-        "{:?}",
-        scene.warnings
-    );
+    assert_not_warned(&scene, "bottle.toml", "`shiny`");
 }
 
 /// A Blender export whose material is black in every colour (`Kd 0`, `Ka 0`, a bump map only)
@@ -524,13 +511,7 @@ fn a_black_material_of_a_bare_obj_is_shown_grey() {
     );
     text.push_str("usemtl chrome\nv 3 0 0\nv 4 0 0\nv 3 1 0\nf -3 -2 -1\n");
     let scene = load(dir.path(), "statue.obj", &text);
-    let m = |n: &str| {
-        scene
-            .materials
-            .iter()
-            .find(|m| m.name.ends_with(n))
-            .unwrap_or_else(|| panic!("material {n} in {:?}", scene.materials))
-    };
+    let m = |n: &str| material(&scene, n);
     assert_ne!(m("/body").diffuse, Vec3::ZERO, "shown grey");
     assert_eq!(m("/body").diffuse, m("/body").ambient);
     assert_eq!(
@@ -539,11 +520,7 @@ fn a_black_material_of_a_bare_obj_is_shown_grey() {
         "a black mirror stays black"
     );
     assert_warned(&scene, "statue.obj", &["material `body` is black"]);
-    assert!(
-        !scene.warnings.iter().any(|w| w.contains("`chrome`")),
-        "{:?}",
-        scene.warnings
-    );
+    assert_not_warned(&scene, "statue.obj", "`chrome`");
     assert_readable(&scene, "statue.obj", 0.03..0.6, 0.02);
 }
 
