@@ -28,6 +28,14 @@ const CORPUS: &str = "tests/fixtures/hostile";
 
 /// The corpus entries (MTL files are read through the OBJ files that name them, and the
 /// contents of the folder named like an OBJ are not scenes).
+/// The file name of a corpus entry, as the messages print it.
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .expect("name")
+        .to_string_lossy()
+        .to_string()
+}
+
 fn corpus() -> Vec<PathBuf> {
     let mut paths: Vec<PathBuf> = std::fs::read_dir(CORPUS)
         .expect("the hostile corpus")
@@ -98,11 +106,7 @@ fn hostile_corpus_gives_one_sentence_each() {
 fn cli_refuses_each_hostile_file_with_one_line_and_no_output() {
     let dir = tempfile::tempdir().expect("temp dir");
     for path in corpus() {
-        let name = path
-            .file_name()
-            .expect("name")
-            .to_string_lossy()
-            .to_string();
+        let name = file_name(&path);
         let out = dir.path().join(format!("{name}.png"));
         let output = raytree()
             // Depth 8: `glass_between_mirrors.toml` at its own 64 would take hours.
@@ -663,11 +667,7 @@ fn the_fast_reader_and_tobj_read_the_hostile_models_alike() {
     };
     let mut taken = Vec::new();
     for path in corpus() {
-        let name = path
-            .file_name()
-            .expect("name")
-            .to_string_lossy()
-            .to_string();
+        let name = file_name(&path);
         let is_model =
             name.starts_with("vn_") || name.starts_with("vt_") || name == "textures_hostile.obj";
         if !is_model {
