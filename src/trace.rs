@@ -20,7 +20,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::accel::{Accel, AccelKind, PrimHit, PrimSet, Visits};
 use crate::geometry::{
-    Methods, OffsetMethod, Ray, ShadingNormals, interpolate_normal, intersect_sphere, keep_side,
+    Methods, Ray, ShadingNormals, interpolate_normal, intersect_sphere, keep_side,
     offset_ray_origin, sphere_hit_point, terminator_origin, triangle_hit_point,
 };
 use crate::scene::{MaterialId, ObjectId, Scene};
@@ -268,8 +268,9 @@ struct Given {
     blocked: u64,
     /// What [`Tracer::light_ray`] gave for each of the first [`GIVEN_LIGHTS`] lights, so
     /// shading does not set the shadow rays up a second time (the terms, where it formed them,
-    /// are formed again: the same numbers); set when `surface` is.
-    lights: [LightRay; GIVEN_LIGHTS],
+    /// are formed again: the same numbers); set when `surface` is. `Option`s, so that a fresh
+    /// `Given` writes a tag per light instead of copying a whole placeholder.
+    lights: [Option<LightRay>; GIVEN_LIGHTS],
 }
 
 /// Lights whose shadow-ray setup a packet keeps for shading (the rest are set up again).
@@ -280,7 +281,7 @@ impl Given {
         found: Found::Nothing,
         surface: None,
         blocked: 0,
-        lights: [LightRay::NONE; GIVEN_LIGHTS],
+        lights: [None; GIVEN_LIGHTS],
     };
 
     #[inline(always)]
@@ -374,9 +375,19 @@ impl Tracer {
     }
 
     /// The closest object hit `hit` of `ray` (from the accelerator), or a visible light
-    /// before it.
-    #[inline]
+    /// before it. Inlined for the common scene without visible lights, where it only wraps
+    /// the hit.
+    #[inline(always)]
     fn with_lights(&self, ray: &Ray, hit: Option<PrimHit>) -> Found {
+        if self.visible_lights.is_empty() {
+            return hit.map_or(Found::Nothing, Found::Prim);
+        }
+        self.with_visible_lights(ray, hit)
+    }
+
+    /// [`Tracer::with_lights`] when the scene has visible lights.
+    #[inline(never)]
+    fn with_visible_lights(&self, ray: &Ray, hit: Option<PrimHit>) -> Found {
         let mut found = Found::Nothing;
         let mut t_max = f32::INFINITY;
         if let Some(hit) = hit {
@@ -520,18 +531,19 @@ impl Tracer {
                 g.surface = Some(self.surface(&rays[i], &hit));
             }
         }
+        let mut bases = [ShadowBase::default(); K];
         for (li, light) in scene.lights.iter().enumerate().take(64) {
             let mut shadow = [Ray::new(Vec3::ZERO, Vec3::Z); K];
             let mut lengths = [0.0; K];
             let mut cast = 0u32;
-            for (i, g) in given.iter_mut().enumerate() {
+            for ((i, g), base) in given.iter_mut().enumerate().zip(&mut bases) {
                 if let Some((surface, error)) = &g.surface {
                     let material = scene.material(surface.material);
                     let v = -rays[i].dir;
                     let mut terms = None;
                     let Found::Prim(hit) = g.found else { continue };
                     let lr = self.light_ray::<NoRecord>(
-                        surface, hit.prim, *error, material, v, light, &mut terms,
+                        surface, hit.prim, *error, material, v, light, base, &mut terms,
                     );
                     if let Some((ray, length)) = lr.ray {
                         shadow[i] = ray;
@@ -539,7 +551,7 @@ impl Tracer {
                         cast |= 1 << i;
                     }
                     if let Some(slot) = g.lights.get_mut(li) {
-                        *slot = lr;
+                        *slot = Some(lr);
                     }
                 }
             }
@@ -660,6 +672,7 @@ impl Tracer {
         material: &crate::scene::Material,
         v: Vec3,
         light: &crate::scene::Light,
+        base: &mut ShadowBase,
         terms: &mut Option<LightTerms>,
     ) -> LightRay {
         let (p, n) = (surface.point, surface.normal);
@@ -689,12 +702,23 @@ impl Tracer {
         {
             return out;
         }
-        match self.shadow_start(surface, prim, error, l) {
+        match self.shadow_start(surface, prim, error, l, base) {
             Some((q, q_error, side)) => {
                 // Only objects count as blockers, never lights.
                 let offset = self.methods().offset;
                 let ng = surface.geometric_normal;
-                out.ray = Some(shadow_ray(offset, q, q_error, ng, side, light.position));
+                // The origin depends on the side only through `side·ng < 0` (see
+                // `offset_ray_origin`): the `+ng` one is shared by the hit's lights.
+                let origin = match base.origin_up {
+                    _ if side.dot(ng) < 0.0 => offset_ray_origin(offset, q, q_error, ng, side),
+                    Some(origin) => origin,
+                    None => {
+                        let origin = offset_ray_origin(offset, q, q_error, ng, ng);
+                        base.origin_up = Some(origin);
+                        origin
+                    }
+                };
+                out.ray = Some(shadow_ray(origin, light.position));
             }
             None => out.behind_surface = true,
         }
@@ -713,6 +737,7 @@ impl Tracer {
         prim: u32,
         error: Vec3,
         l: Vec3,
+        base: &mut ShadowBase,
     ) -> Option<(Vec3, Vec3, Vec3)> {
         let (p, ng) = (surface.point, surface.geometric_normal);
         let robust = self.methods().shading_normals == ShadingNormals::Robust;
@@ -721,13 +746,21 @@ impl Tracer {
         else {
             return Some((p, error, l));
         };
-        let index = prim as usize - self.scene.spheres.len();
-        let v = &self.scene.triangles[index].vertices;
         // N1 (Hanika 2021): from the smooth surface, when it lies outside the flat one, offset
         // to the visible side: a light behind the surface is then reached only past its edge
-        // (N3), never through it.
+        // (N3), never through it. The same point for every light of the hit.
         let in_front = ng.dot(l) > 0.0;
-        match terminator_origin(v, ns, b, p, error, ng) {
+        let terminator = match base.terminator {
+            Some(known) => known,
+            None => {
+                let index = prim as usize - self.scene.spheres.len();
+                let v = &self.scene.triangles[index].vertices;
+                let found = terminator_origin(v, ns, b, p, error, ng);
+                base.terminator = Some(found);
+                found
+            }
+        };
+        match terminator {
             Some((q, q_error, clear)) if in_front || clear => Some((q, q_error, ng)),
             _ => in_front.then_some((p, error, l)),
         }
@@ -774,6 +807,7 @@ impl Tracer {
         };
 
         let ambient = ka * scene.render.ambient_light;
+        let mut base = ShadowBase::default();
         let mut diffuse = Vec3::ZERO;
         let mut specular = Vec3::ZERO;
         for (i, light) in scene.lights.iter().enumerate() {
@@ -786,11 +820,11 @@ impl Tracer {
                 distance,
                 ray: cast,
                 behind_surface,
-            } = match known.and_then(|g| g.lights.get(i)) {
-                Some(&lr) => lr,
-                None => {
-                    self.light_ray::<R>(surface, hit.prim, error, material, v, light, &mut terms)
-                }
+            } = match known.and_then(|g| g.lights.get(i).copied().flatten()) {
+                Some(lr) => lr,
+                None => self.light_ray::<R>(
+                    surface, hit.prim, error, material, v, light, &mut base, &mut terms,
+                ),
             };
             let mut blocked_by = None;
             let mut blocked_at = None;
@@ -913,7 +947,16 @@ impl Tracer {
         let material = self.scene.material(surface.material);
         let v = -ray.dir;
         match self
-            .light_ray::<NoRecord>(&surface, hit.prim, error, material, v, light, &mut None)
+            .light_ray::<NoRecord>(
+                &surface,
+                hit.prim,
+                error,
+                material,
+                v,
+                light,
+                &mut ShadowBase::default(),
+                &mut None,
+            )
             .ray
         {
             Some((shadow, length)) => self.accel.occluded_visits(m, &shadow, 0.0, length),
@@ -980,30 +1023,23 @@ struct LightRay {
     behind_surface: bool,
 }
 
-impl LightRay {
-    /// A placeholder for lights not yet set up.
-    const NONE: LightRay = LightRay {
-        l: Vec3::ZERO,
-        distance: 0.0,
-        ray: None,
-        behind_surface: false,
-    };
+/// What every shadow ray of one hit shares, found for the first light that needs it: where
+/// the rays start (STABILITY N1) and that start offset to the side the geometric normal points
+/// to. A hit's lights differ only in their directions, so the second light reuses both.
+#[derive(Clone, Copy, Default)]
+struct ShadowBase {
+    /// [`terminator_origin`]'s answer, once asked (robust shading normals on a smooth triangle).
+    terminator: Option<Option<(Vec3, Vec3, bool)>>,
+    /// The offset origin towards the `+ng` side, once formed.
+    origin_up: Option<Vec3>,
 }
 
-/// The shadow ray from hit point `p` (error bound `error`, geometric normal `n`) towards the
-/// light at `light`: from the origin offset to the side of the surface `side` points to (the
-/// direction `l` to the light; the visible side for robust shading normals, so the ray never
-/// starts behind the surface, STABILITY N3) to the light's centre, and its length.
+/// The shadow ray from `origin` (the hit point offset to the side of the surface the ray
+/// leaves to: the light's side, or the visible side for robust shading normals, so the ray
+/// never starts behind the surface, STABILITY N3) to the light's centre at `light`, and its
+/// length.
 #[inline(always)]
-fn shadow_ray(
-    offset: OffsetMethod,
-    p: Vec3,
-    error: Vec3,
-    n: Vec3,
-    side: Vec3,
-    light: Vec3,
-) -> (Ray, f32) {
-    let origin = offset_ray_origin(offset, p, error, n, side);
+fn shadow_ray(origin: Vec3, light: Vec3) -> (Ray, f32) {
     let segment = light - origin;
     let length = segment.length();
     (Ray::new(origin, div3(segment, length)), length)
