@@ -25,6 +25,7 @@ use super::paint3d::{self, Drawn, Look, ScreenView};
 use super::viewport::{DisplayCallback, DisplayId, DisplayState, SharedDisplay};
 use super::{ViewerApp, tree_view};
 use crate::render::session::{Session, SessionEvent, View};
+use crate::scene::camera::FRAME_MARGIN;
 use crate::scene::{Camera, CameraFrame, Scene};
 use crate::scene_view::{self, Filter, Segment};
 use crate::trace::{EndReason, Tracer};
@@ -104,15 +105,16 @@ impl SceneView {
             ..scene.camera.clone()
         };
         let mut camera = base.framing(lo, hi, direction);
-        // `framing` fits the vertical field; a pane narrower than tall has the narrower field
-        // across, so the camera moves back until the bounding sphere fits that one too.
+        // `framing` fits the bounding sphere in the vertical field, which leaves a flat scene
+        // (a floor and a few objects) small in the pane: the camera comes as close as the
+        // box's eight corners allow, in both fields of the pane (the narrower one across
+        // when the pane is narrower than tall), with the same margin.
         let (w, h) = self.size;
         let aspect = w as f32 / h.max(1) as f32;
-        if aspect < 1.0 {
-            let half_y = (0.5 * camera.fov_y_deg).to_radians();
-            let half_x = (aspect * half_y.tan()).atan();
-            let farther = half_y.sin() / half_x.sin().max(1e-3);
-            camera.position = camera.look_at + (camera.position - camera.look_at) * farther;
+        let tan_y = (0.5 * camera.fov_y_deg).to_radians().min(1.5).tan();
+        let tan_x = aspect * tan_y;
+        if let Some(distance) = corner_fit(lo, hi, direction, up, tan_x, tan_y) {
+            camera.position = camera.look_at + direction * distance;
         }
         self.camera = camera;
         self.framed = true;
@@ -491,14 +493,55 @@ pub fn scene_view_ui(app: &mut ViewerApp, ui: &mut Ui) {
     pick_and_hover(app, &response, &drawn);
     app.scene_view.drawn = drawn;
     if app.tree.is_none() {
-        painter.text(
-            rect.left_top() + egui::vec2(8.0, 8.0),
-            egui::Align2::LEFT_TOP,
-            "click a pixel in the render view to see its rays here",
+        // Wrapped to the pane: a narrow pane must not cut the hint off.
+        let hint = painter.layout(
+            "click a pixel in the render view to see its rays here".to_owned(),
             egui::FontId::proportional(14.0),
             Color32::from_gray(220),
+            (rect.width() - 16.0).max(40.0),
+        );
+        painter.galley(
+            rect.left_top() + egui::vec2(8.0, 8.0),
+            hint,
+            Color32::PLACEHOLDER,
         );
     }
+}
+
+/// The distance from the centre of `lo..hi` along the unit `direction` (from the centre towards
+/// the eye) at which every corner of the box lies inside a view whose half fields have
+/// tangents `tan_x` across and `tan_y` up, with [`FRAME_MARGIN`]; `None` for a degenerate view.
+fn corner_fit(
+    lo: Vec3,
+    hi: Vec3,
+    direction: Vec3,
+    up: Vec3,
+    tan_x: f32,
+    tan_y: f32,
+) -> Option<f32> {
+    let right = up.cross(direction).normalize_or_zero();
+    let upward = direction.cross(right);
+    if right == Vec3::ZERO || !(tan_x > 0.0 && tan_y > 0.0) {
+        return None;
+    }
+    let center = 0.5 * (lo + hi);
+    let mut distance = 0.0f32;
+    for k in 0..8 {
+        let corner = Vec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        );
+        let q = corner - center;
+        // The corner's depth in front of an eye at `distance` is `distance − q·direction`.
+        let across = q.dot(direction) + FRAME_MARGIN * q.dot(right).abs() / tan_x;
+        let upwards = q.dot(direction) + FRAME_MARGIN * q.dot(upward).abs() / tan_y;
+        distance = distance.max(across).max(upwards);
+    }
+    // Never inside the box's bounding sphere, where the near corners would pass the eye.
+    let radius = 0.5 * (hi - lo).length();
+    let distance = distance.max(1.05 * radius);
+    (distance.is_finite() && distance > 0.0).then_some(distance)
 }
 
 /// Hover on drawn rays: the current tree's node under the pointer lights up everywhere.
@@ -535,5 +578,53 @@ impl SceneView {
     /// Whether the view's render reached its samples (or stopped).
     pub fn is_finished(&self) -> bool {
         self.finished
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Where a point lands in a view from `eye` towards `target`: tangents across and up.
+    fn tangents(eye: Vec3, target: Vec3, up: Vec3, p: Vec3) -> (f32, f32) {
+        let forward = (target - eye).normalize();
+        let right = forward.cross(up).normalize();
+        let upward = right.cross(forward);
+        let d = p - eye;
+        let depth = d.dot(forward);
+        assert!(depth > 0.0, "{p} is behind the eye");
+        (d.dot(right) / depth, d.dot(upward) / depth)
+    }
+
+    /// A flat floor with a few objects, seen from above at an angle: every corner lies inside
+    /// the view with the margin, one of them on its edge (the fit is tight), and the camera is
+    /// closer than the bounding sphere's framing (which the pane used before) puts it.
+    #[test]
+    fn corner_fit_frames_a_flat_box_tightly() {
+        let (lo, hi) = (Vec3::new(-12.0, 0.0, -12.0), Vec3::new(12.0, 2.0, 12.0));
+        let direction = Vec3::new(1.0, 0.45, 0.25).normalize();
+        let center = 0.5 * (lo + hi);
+        for (tan_x, tan_y) in [(0.41, 0.41), (0.25, 0.41), (0.7, 0.41)] {
+            let d = corner_fit(lo, hi, direction, Vec3::Y, tan_x, tan_y).expect("a distance");
+            let eye = center + direction * d;
+            let mut widest = 0.0f32;
+            for k in 0..8 {
+                let c = Vec3::new(
+                    if k & 1 == 0 { lo.x } else { hi.x },
+                    if k & 2 == 0 { lo.y } else { hi.y },
+                    if k & 4 == 0 { lo.z } else { hi.z },
+                );
+                let (x, y) = tangents(eye, center, Vec3::Y, c);
+                let (fx, fy) = (x.abs() * FRAME_MARGIN / tan_x, y.abs() * FRAME_MARGIN / tan_y);
+                assert!(fx <= 1.0 + 1e-4 && fy <= 1.0 + 1e-4, "corner {c}: {fx} {fy}");
+                widest = widest.max(fx).max(fy);
+            }
+            assert!(widest > 0.999, "not tight: the widest corner fills {widest} of the view");
+            // The sphere's framing, in the narrower of the two fields.
+            let half = tan_x.min(tan_y).atan();
+            let sphere = FRAME_MARGIN * 0.5 * (hi - lo).length() / half.sin();
+            assert!(d < sphere, "{d} against the sphere's {sphere}");
+        }
+        assert_eq!(corner_fit(lo, hi, Vec3::Y, Vec3::Y, 0.4, 0.4), None);
     }
 }
