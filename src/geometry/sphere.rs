@@ -117,7 +117,7 @@ fn pick_root(t0: f32, t1: f32, t_min: f32, t_max: f32) -> Option<f32> {
 ///   `C + r·(P − C)/|P − C|` (pbrt-v4; evaluated in `f64`, rounded once), with pbrt's error
 ///   bound `γ(5)·|P − C| + γ(1)·|P|` per axis (the re-projection plus the rounding of adding
 ///   `C`), which is conservative for the `f64` evaluation.
-#[inline]
+#[inline(always)]
 pub fn sphere_hit_point(
     method: SphereMethod,
     center: Vec3,
