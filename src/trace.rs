@@ -563,14 +563,15 @@ impl Tracer {
             }
         }
         for i in bits() {
-            let mut info = SampleInfo::default();
+            // In place: the facts are written where the caller reads them.
+            let (color, info) = &mut out[i];
+            *info = SampleInfo::default();
             let s = &mut Sample {
                 counts: &mut *counts,
-                info: &mut info,
+                info,
                 rec: &mut NoRecord,
             };
-            let c = self.trace_ray_given(&rays[i], primary, s, Some(&given[i]));
-            out[i] = (c, info);
+            *color = self.trace_ray_given(&rays[i], primary, s, Some(&given[i]));
         }
     }
 
