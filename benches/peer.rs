@@ -119,6 +119,9 @@ struct Options {
     chart: Option<PathBuf>,
     /// Image size instead of the scene's 640×480 (more rays: a longer, steadier render phase).
     size: Option<(u32, u32)>,
+    /// The camera- and shadow-dominated frame: every material's reflectivity and transparency
+    /// set to 0, so each ray is a camera ray or a shadow ray.
+    opaque: bool,
 }
 
 fn parse_options() -> Options {
@@ -135,6 +138,7 @@ fn parse_options() -> Options {
             .to_vec(),
         chart: None,
         size: None,
+        opaque: false,
     };
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
@@ -154,6 +158,7 @@ fn parse_options() -> Options {
             "--frames" => o.frames = value("--frames").parse().expect("--frames: a number"),
             "--keep" => o.keep = Some(PathBuf::from(value("--keep"))),
             "--scaling" => o.scaling = true,
+            "--opaque" => o.opaque = true,
             "--no-peer" => o.peer = false,
             "--peer-config" => {
                 o.peer_configs = value("--peer-config")
@@ -177,6 +182,26 @@ fn parse_options() -> Options {
     o.runs = o.runs.max(1);
     o.frames = o.frames.clamp(1, 1000);
     o
+}
+
+/// Rewrites the scene file with every material's reflectivity and transparency 0: the
+/// camera- and shadow-dominated frame (no reflected or refracted rays).
+fn make_opaque(scene_file: &Path) {
+    let text = std::fs::read_to_string(scene_file).expect("read the bench scene");
+    let mut table: toml::Table = text.parse().expect("the bench scene is TOML");
+    let materials = table
+        .get_mut("material")
+        .and_then(|m| m.as_array_mut())
+        .expect("the bench scene has materials");
+    for material in materials.iter_mut().filter_map(|m| m.as_table_mut()) {
+        material.insert("reflectivity".into(), toml::Value::Float(0.0));
+        material.insert("transparency".into(), toml::Value::Float(0.0));
+    }
+    let text = format!(
+        "# The bench scene with every material opaque (no reflection, no refraction).\n{}",
+        toml::to_string(&table).expect("write TOML")
+    );
+    std::fs::write(scene_file, text).expect("write the opaque bench scene");
 }
 
 /// One process's figures, from either renderer.
@@ -505,6 +530,11 @@ fn peer_comparison(o: &Options, root: &Path) {
         o.frames,
         load_average()
     );
+    if o.opaque {
+        println!(
+            "frame: --opaque, every material's reflectivity and transparency 0 (camera and shadow rays only)"
+        );
+    }
     for (i, c) in configs.iter().enumerate() {
         println!(
             "peer {}: Embree 3 ({}), {}; triangles in Embree's own BVH, scene flags none, rtcIntersect1/rtcOccluded1, pthreads over 32x32 tiles",
@@ -517,6 +547,9 @@ fn peer_comparison(o: &Options, root: &Path) {
     for &size in &o.sizes {
         let dir = root.join(format!("tris_{size}"));
         let scene_file = write_bench_scene(&dir, size).expect("write the bench scene");
+        if o.opaque {
+            make_opaque(&scene_file);
+        }
         let mut scene = load_scene_file(&scene_file).expect("load the bench scene");
         if let Some((w, h)) = o.size {
             (scene.render.width, scene.render.height) = (w, h);
