@@ -277,13 +277,6 @@ struct Given {
 const GIVEN_LIGHTS: usize = 4;
 
 impl Given {
-    const NONE: Given = Given {
-        found: Found::Nothing,
-        surface: None,
-        blocked: 0,
-        lights: [None; GIVEN_LIGHTS],
-    };
-
     #[inline(always)]
     fn blocked(&self, light: usize) -> Option<bool> {
         (light < 64).then(|| self.blocked >> light & 1 != 0)
@@ -521,16 +514,20 @@ impl Tracer {
         let scene = &*self.scene;
         let mut hits = [None; K];
         self.accel.closest_hits(m, rays, active, &mut hits);
-        // Filled in place: a `Given` is large, and building the array by value copies it.
-        let mut given = [Given::NONE; K];
-        for (i, g) in given.iter_mut().enumerate() {
-            g.found = self.with_lights(&rays[i], hits[i]);
-            if let Found::Prim(hit) = g.found
-                && active & (1 << i) != 0
-            {
-                g.surface = Some(self.surface(&rays[i], &hit));
+        // Each built in its slot, not copied from a placeholder: a `Given` is large.
+        let mut given: [Given; K] = std::array::from_fn(|i| {
+            let found = self.with_lights(&rays[i], hits[i]);
+            let surface = match found {
+                Found::Prim(hit) if active & (1 << i) != 0 => Some(self.surface(&rays[i], &hit)),
+                _ => None,
+            };
+            Given {
+                found,
+                surface,
+                blocked: 0,
+                lights: [None; GIVEN_LIGHTS],
             }
-        }
+        });
         let mut bases = [ShadowBase::default(); K];
         for (li, light) in scene.lights.iter().enumerate().take(64) {
             let mut shadow = [Ray::new(Vec3::ZERO, Vec3::Z); K];

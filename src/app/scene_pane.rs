@@ -615,11 +615,20 @@ mod tests {
                     if k & 4 == 0 { lo.z } else { hi.z },
                 );
                 let (x, y) = tangents(eye, center, Vec3::Y, c);
-                let (fx, fy) = (x.abs() * FRAME_MARGIN / tan_x, y.abs() * FRAME_MARGIN / tan_y);
-                assert!(fx <= 1.0 + 1e-4 && fy <= 1.0 + 1e-4, "corner {c}: {fx} {fy}");
+                let (fx, fy) = (
+                    x.abs() * FRAME_MARGIN / tan_x,
+                    y.abs() * FRAME_MARGIN / tan_y,
+                );
+                assert!(
+                    fx <= 1.0 + 1e-4 && fy <= 1.0 + 1e-4,
+                    "corner {c}: {fx} {fy}"
+                );
                 widest = widest.max(fx).max(fy);
             }
-            assert!(widest > 0.999, "not tight: the widest corner fills {widest} of the view");
+            assert!(
+                widest > 0.999,
+                "not tight: the widest corner fills {widest} of the view"
+            );
             // The sphere's framing, in the narrower of the two fields.
             let half = tan_x.min(tan_y).atan();
             let sphere = FRAME_MARGIN * 0.5 * (hi - lo).length() / half.sin();
