@@ -527,12 +527,7 @@ fn corner_fit(
     let center = 0.5 * (lo + hi);
     let mut distance = 0.0f32;
     for k in 0..8 {
-        let corner = Vec3::new(
-            if k & 1 == 0 { lo.x } else { hi.x },
-            if k & 2 == 0 { lo.y } else { hi.y },
-            if k & 4 == 0 { lo.z } else { hi.z },
-        );
-        let q = corner - center;
+        let q = box_corner(lo, hi, k) - center;
         // The corner's depth in front of an eye at `distance` is `distance − q·direction`.
         let across = q.dot(direction) + FRAME_MARGIN * q.dot(right).abs() / tan_x;
         let upwards = q.dot(direction) + FRAME_MARGIN * q.dot(upward).abs() / tan_y;
@@ -542,6 +537,16 @@ fn corner_fit(
     let radius = 0.5 * (hi - lo).length();
     let distance = distance.max(1.05 * radius);
     (distance.is_finite() && distance > 0.0).then_some(distance)
+}
+
+/// Corner `k` (0..8) of the box `lo..hi`: bit 0 picks x, bit 1 y, bit 2 z.
+fn box_corner(lo: Vec3, hi: Vec3, k: usize) -> Vec3 {
+    let pick = |bit: usize, l: f32, h: f32| if k & bit == 0 { l } else { h };
+    Vec3::new(
+        pick(1, lo.x, hi.x),
+        pick(2, lo.y, hi.y),
+        pick(4, lo.z, hi.z),
+    )
 }
 
 /// Hover on drawn rays: the current tree's node under the pointer lights up everywhere.
@@ -609,11 +614,7 @@ mod tests {
             let eye = center + direction * d;
             let mut widest = 0.0f32;
             for k in 0..8 {
-                let c = Vec3::new(
-                    if k & 1 == 0 { lo.x } else { hi.x },
-                    if k & 2 == 0 { lo.y } else { hi.y },
-                    if k & 4 == 0 { lo.z } else { hi.z },
-                );
+                let c = box_corner(lo, hi, k);
                 let (x, y) = tangents(eye, center, Vec3::Y, c);
                 let (fx, fy) = (
                     x.abs() * FRAME_MARGIN / tan_x,
