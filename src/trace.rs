@@ -553,9 +553,11 @@ impl Tracer {
                 }
             }
             if cast != 0 {
-                let blocked = self.accel.occluded_packet(m, &shadow, &lengths, cast);
-                for (i, g) in given.iter_mut().enumerate() {
-                    g.blocked |= u64::from(blocked >> i & 1) << li;
+                // Only the blocked lanes change: one step per set bit.
+                let mut blocked = self.accel.occluded_packet(m, &shadow, &lengths, cast);
+                while blocked != 0 {
+                    given[blocked.trailing_zeros() as usize].blocked |= 1 << li;
+                    blocked &= blocked - 1;
                 }
             }
         }
