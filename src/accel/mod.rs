@@ -27,7 +27,7 @@ mod visits;
 pub use bvh::{PacketSimd, packet_simd, packet_uses_avx2, set_packet_simd};
 pub use visits::{AccelBox, VisitedBox, Visits};
 
-use glam::{Vec3, Vec3A};
+use glam::Vec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -641,9 +641,7 @@ fn active_bit(mask: u32, i: usize) -> bool {
 
 #[inline]
 fn ray_is_usable(ray: &Ray, t_min: f32, t_max: f32) -> bool {
-    // Each test one SSE compare of the three lanes (the same answers as `Vec3`'s).
-    let (o, d) = (Vec3A::from(ray.origin), Vec3A::from(ray.dir));
-    o.is_finite() && d.is_finite() && d != Vec3A::ZERO && t_min < t_max
+    ray.origin.is_finite() && ray.dir.is_finite() && ray.dir != Vec3::ZERO && t_min < t_max
 }
 
 /// `1/d` per axis with zero (or subnormal) components mapped to `±f32::MAX` (sign of the zero):
