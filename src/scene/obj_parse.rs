@@ -603,33 +603,28 @@ impl Assembly<'_> {
             ..Default::default()
         };
         let [pos_map, tex_map, norm_map] = &mut self.maps;
-        let mut positions = List {
-            all: self.positions,
-            width: 3,
-            count: counts[0],
-            map: pos_map,
-            values: &mut mesh.positions,
-            indices: &mut mesh.indices,
-            used: Vec::new(),
-        };
+        let mut positions = List::new(
+            (self.positions, 3, counts[0]),
+            pos_map,
+            &mut mesh.positions,
+            &mut mesh.indices,
+        );
         // The indices into a list the file does not have (yet) are ignored, as tobj ignores them.
-        let mut texcoords = (counts[1] > 0).then(|| List {
-            all: self.texcoords,
-            width: 2,
-            count: counts[1],
-            map: tex_map,
-            values: &mut mesh.texcoords,
-            indices: &mut mesh.texcoord_indices,
-            used: Vec::new(),
+        let mut texcoords = (counts[1] > 0).then(|| {
+            List::new(
+                (self.texcoords, 2, counts[1]),
+                tex_map,
+                &mut mesh.texcoords,
+                &mut mesh.texcoord_indices,
+            )
         });
-        let mut normals = (counts[2] > 0).then(|| List {
-            all: self.normals,
-            width: 3,
-            count: counts[2],
-            map: norm_map,
-            values: &mut mesh.normals,
-            indices: &mut mesh.normal_indices,
-            used: Vec::new(),
+        let mut normals = (counts[2] > 0).then(|| {
+            List::new(
+                (self.normals, 3, counts[2]),
+                norm_map,
+                &mut mesh.normals,
+                &mut mesh.normal_indices,
+            )
         });
         for list in [&mut texcoords, &mut normals].into_iter().flatten() {
             list.indices.reserve(n);
@@ -672,7 +667,26 @@ struct List<'a> {
     used: Vec<u32>,
 }
 
-impl List<'_> {
+impl<'a> List<'a> {
+    /// The list of the file's values `all` (`width` floats each, the first `count` usable),
+    /// filling `values` and `indices` through `map`.
+    fn new(
+        (all, width, count): (&'a [f32], usize, usize),
+        map: &'a mut [u32],
+        values: &'a mut Vec<f32>,
+        indices: &'a mut Vec<u32>,
+    ) -> Self {
+        Self {
+            all,
+            width,
+            count,
+            map,
+            values,
+            indices,
+            used: Vec::new(),
+        }
+    }
+
     /// Adds a corner's file index `i`; `None` when it is out of range.
     fn push(&mut self, i: u32) -> Option<()> {
         let slot = self
