@@ -273,6 +273,34 @@ struct Given {
     lights: [Option<LightRay>; GIVEN_LIGHTS],
 }
 
+/// The working state of [`Tracer::trace_packet`] for packets of `K` rays, kept by its caller
+/// from one packet to the next so that its large records are written in place rather than
+/// built on the stack and copied; its contents between calls mean nothing.
+pub struct PacketScratch<const K: usize> {
+    hits: [Option<PrimHit>; K],
+    given: [Given; K],
+    bases: [ShadowBase; K],
+    shadow: [Ray; K],
+    lengths: [f32; K],
+}
+
+impl<const K: usize> Default for PacketScratch<K> {
+    fn default() -> Self {
+        PacketScratch {
+            hits: [None; K],
+            given: [Given {
+                found: Found::Nothing,
+                surface: None,
+                blocked: 0,
+                lights: [None; GIVEN_LIGHTS],
+            }; K],
+            bases: [ShadowBase::default(); K],
+            shadow: [Ray::new(Vec3::ZERO, Vec3::Z); K],
+            lengths: [0.0; K],
+        }
+    }
+}
+
 /// Lights whose shadow-ray setup a packet keeps for shading (the rest are set up again).
 const GIVEN_LIGHTS: usize = 4;
 
@@ -485,6 +513,7 @@ impl Tracer {
         active: u32,
         counts: &mut RayCounts,
         out: &mut [(Vec3, SampleInfo); K],
+        scratch: &mut PacketScratch<K>,
     ) {
         const { assert!(K <= MAX_PACKET) };
         let primary = Branch {
@@ -512,28 +541,29 @@ impl Tracer {
         }
         let m = self.methods();
         let scene = &*self.scene;
-        let mut hits = [None; K];
-        self.accel.closest_hits(m, rays, active, &mut hits);
-        // Each built in its slot, not copied from a placeholder: a `Given` is large.
-        let mut given: [Given; K] = std::array::from_fn(|i| {
-            let found = self.with_lights(&rays[i], hits[i]);
-            let surface = match found {
+        let PacketScratch {
+            hits,
+            given,
+            bases,
+            shadow,
+            lengths,
+        } = scratch;
+        self.accel.closest_hits(m, rays, active, hits);
+        // Field by field into the caller's slots: a `Given` is large, and a fresh array of
+        // them would be built on the stack and copied.
+        for (i, g) in given.iter_mut().enumerate() {
+            g.found = self.with_lights(&rays[i], hits[i]);
+            g.surface = match g.found {
                 Found::Prim(hit) if active & (1 << i) != 0 => Some(self.surface(&rays[i], &hit)),
                 _ => None,
             };
-            Given {
-                found,
-                surface,
-                blocked: 0,
-                lights: [None; GIVEN_LIGHTS],
-            }
-        });
-        let mut bases = [ShadowBase::default(); K];
+            g.blocked = 0;
+            g.lights = [None; GIVEN_LIGHTS];
+            bases[i] = ShadowBase::default();
+        }
         for (li, light) in scene.lights.iter().enumerate().take(64) {
-            let mut shadow = [Ray::new(Vec3::ZERO, Vec3::Z); K];
-            let mut lengths = [0.0; K];
             let mut cast = 0u32;
-            for ((i, g), base) in given.iter_mut().enumerate().zip(&mut bases) {
+            for ((i, g), base) in given.iter_mut().enumerate().zip(bases.iter_mut()) {
                 if let Some((surface, error)) = &g.surface {
                     let material = scene.material(surface.material);
                     let v = -rays[i].dir;
@@ -554,7 +584,7 @@ impl Tracer {
             }
             if cast != 0 {
                 // Only the blocked lanes change: one step per set bit.
-                let mut blocked = self.accel.occluded_packet(m, &shadow, &lengths, cast);
+                let mut blocked = self.accel.occluded_packet(m, shadow, lengths, cast);
                 while blocked != 0 {
                     given[blocked.trailing_zeros() as usize].blocked |= 1 << li;
                     blocked &= blocked - 1;

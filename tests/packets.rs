@@ -298,10 +298,18 @@ impl Rng {
 
 /// Packet queries against single ones on a triangle soup with spheres: neighbouring rays,
 /// scattered rays, unusable rays (NaN, zero direction, empty interval) and inactive lanes,
-/// which are left alone.
+/// which are left alone. Packets of 8 rays (what the render casts), and of 5, 13 and 32 (the
+/// traversal keeps 8, 16 and 32 lanes by packet size).
 #[test]
 fn packet_queries_answer_as_single_queries() {
-    let mut rng = Rng(12345);
+    packet_queries_of_size::<8>(12345);
+    packet_queries_of_size::<5>(777);
+    packet_queries_of_size::<13>(4242);
+    packet_queries_of_size::<32>(31337);
+}
+
+fn packet_queries_of_size<const K: usize>(seed: u32) {
+    let mut rng = Rng(seed);
     let mut prims = PrimSet::default();
     for _ in 0..40 {
         prims
@@ -322,45 +330,51 @@ fn packet_queries_answer_as_single_queries() {
             let origin = rng.vec() * 6.0;
             let aim = rng.vec() * 2.0;
             let spread = if round % 3 == 0 { 2.0 } else { 0.02 };
-            let mut rays: [Ray; 8] = std::array::from_fn(|_| {
+            let mut rays: [Ray; K] = std::array::from_fn(|_| {
                 Ray::new(origin, (aim + rng.vec() * spread - origin).normalize())
             });
-            let lengths: [f32; 8] = std::array::from_fn(|_| 1.0 + rng.next().abs() * 8.0);
+            let lengths: [f32; K] = std::array::from_fn(|_| 1.0 + rng.next().abs() * 8.0);
             if round % 7 == 0 {
                 rays[3].dir = Vec3::ZERO;
-                rays[5].origin.x = f32::NAN;
+                rays[K - 1].origin.x = f32::NAN;
             }
-            let active = if round % 5 == 0 { 0b1011_0111 } else { 0xff };
+            let all = u32::MAX >> (32 - K);
+            let active = if round % 5 == 0 {
+                all & 0xb6b7_b6b7
+            } else {
+                all
+            };
             let sentinel = Some(raytree::accel::PrimHit {
                 t: -1.0,
                 prim: 7,
                 b1: 0.0,
                 b2: 0.0,
             });
-            let mut out = [sentinel; 8];
+            let mut out = [sentinel; K];
             accel.closest_hits(&m, &rays, active, &mut out);
             let blocked = accel.occluded_packet(&m, &rays, &lengths, active);
-            for i in 0..8 {
+            for i in 0..K {
                 if active & (1 << i) == 0 {
-                    assert_eq!(out[i], sentinel, "{kind:?} lane {i} touched");
+                    assert_eq!(out[i], sentinel, "{kind:?} K={K} lane {i} touched");
                     assert_eq!(blocked & (1 << i), 0);
                     continue;
                 }
                 let single = accel.closest_hit(&m, &rays[i], 0.0, f32::INFINITY);
-                assert_eq!(out[i], single, "{kind:?} round {round} lane {i}");
+                assert_eq!(out[i], single, "{kind:?} K={K} round {round} lane {i}");
                 let occluded = accel.occluded(&m, &rays[i], 0.0, lengths[i]);
                 assert_eq!(
                     blocked & (1 << i) != 0,
                     occluded,
-                    "{kind:?} round {round} lane {i}"
+                    "{kind:?} K={K} round {round} lane {i}"
                 );
                 hits += usize::from(single.is_some());
                 blocked_count += usize::from(occluded);
             }
         }
+        // 300 rounds of K rays: at least an eighth hit and a twentieth are blocked.
         assert!(
-            hits > 300 && blocked_count > 100,
-            "{kind:?}: {hits} hits, {blocked_count} blocked"
+            hits > 300 * K / 8 && blocked_count > 300 * K / 20,
+            "{kind:?} K={K}: {hits} hits, {blocked_count} blocked"
         );
     }
 }

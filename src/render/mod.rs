@@ -17,7 +17,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::scene::budget::{MemoryError, batch_memory_estimate, memory_limit};
 use crate::scene::{CameraFrame, primary_ray};
-use crate::trace::{NoRecord, RayCounts, RayKind, SampleInfo, TraceSettings, Tracer};
+use crate::trace::{
+    NoRecord, PacketScratch, RayCounts, RayKind, SampleInfo, TraceSettings, Tracer,
+};
 pub use stats::{MemoryStats, RenderStats, RunReport, peak_memory_bytes};
 
 /// Side of a square tile in pixels.
@@ -153,6 +155,7 @@ pub fn accumulate_tile(
     }
     let mut rays = [crate::geometry::Ray::new(Vec3::ZERO, Vec3::Z); PACKET_RAYS];
     let mut out = [(Vec3::ZERO, SampleInfo::default()); PACKET_RAYS];
+    let mut scratch = PacketScratch::default();
     for by in (0..rect.height).step_by(bh as usize) {
         for bx in (0..rect.width).step_by(bw as usize) {
             // The block's pixels inside the rect, row-major: (index in `sums`, x, y).
@@ -169,7 +172,7 @@ pub fn accumulate_tile(
                 for (k, &(_, x, y)) in pixels[..n].iter().enumerate() {
                     rays[k] = primary_ray(frame, x, y, s);
                 }
-                tracer.trace_packet(&rays, active, counts, &mut out);
+                tracer.trace_packet(&rays, active, counts, &mut out, &mut scratch);
                 for (&(at, _, _), &(c, info)) in pixels[..n].iter().zip(&out[..n]) {
                     sums[at] += c;
                     if s == 0
@@ -227,12 +230,13 @@ pub fn preview_tile(
     preview_with(frame, rect, block, |centres, out| {
         let mut rays = [crate::geometry::Ray::new(Vec3::ZERO, Vec3::Z); PACKET_RAYS];
         let mut traced = [(Vec3::ZERO, SampleInfo::default()); PACKET_RAYS];
+        let mut scratch = PacketScratch::default();
         for (chunk, outs) in centres.chunks(PACKET_RAYS).zip(out.chunks_mut(PACKET_RAYS)) {
             for (ray, &(x, y)) in rays.iter_mut().zip(chunk) {
                 *ray = primary_ray(frame, x, y, 0);
             }
             let active = (1u32 << chunk.len()) - 1;
-            tracer.trace_packet(&rays, active, counts, &mut traced);
+            tracer.trace_packet(&rays, active, counts, &mut traced, &mut scratch);
             outs.copy_from_slice(&traced[..chunk.len()]);
         }
     })

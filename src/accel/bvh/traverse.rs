@@ -120,6 +120,11 @@ impl Bvh {
                         let seed = &deeper[..sp + k - 1];
                         return self.walk_from::<V, STACK_SIZE>(r, v, seed, word);
                     }
+                    // The pushed children's lines load while the nearest is walked (the
+                    // unused entries name the root, which is in cache).
+                    for h in &hits[..3] {
+                        self.prefetch_child(h.0);
+                    }
                     stack[sp] = hits[0];
                     stack[sp + 1] = hits[1];
                     stack[sp + 2] = hits[2];
@@ -165,12 +170,32 @@ impl Bvh {
         if self.nodes.is_empty() || active == 0 {
             return;
         }
+        // The rays' lanes in arrays of the next multiple of 8 (the AVX2 test loads eight), so
+        // that a small packet does not fill 32 lanes.
+        if K <= 8 {
+            self.walk_packet_lanes::<V, K, 8>(rays, t_min, vs, active);
+        } else if K <= 16 {
+            self.walk_packet_lanes::<V, K, 16>(rays, t_min, vs, active);
+        } else {
+            self.walk_packet_lanes::<V, K, 32>(rays, t_min, vs, active);
+        }
+    }
+
+    /// [`Bvh::walk_packet`] with the rays' lanes in arrays of `L ≥ K`.
+    #[inline(always)]
+    fn walk_packet_lanes<V: Visitor, const K: usize, const L: usize>(
+        &self,
+        rays: &[Ray; K],
+        t_min: f32,
+        vs: &mut [V; K],
+        active: u32,
+    ) {
         #[cfg(target_arch = "x86_64")]
         if let Some(v3) = super::avx2() {
             // The whole walk compiled for AVX2 (the node test eight rays wide; the rest the
             // same SSE arithmetic, VEX-encoded: no fused multiply-add is formed, so every
             // number is the SSE path's).
-            return v3.vectorize(Avx8Walk {
+            return v3.vectorize(Avx8Walk::<V, K, L> {
                 bvh: self,
                 rays,
                 t_min,
@@ -179,12 +204,12 @@ impl Bvh {
                 v3,
             });
         }
-        self.walk_packet_with(rays, t_min, vs, active, Sse4);
+        self.walk_packet_with::<V, K, L, _>(rays, t_min, vs, active, Sse4);
     }
 
     /// [`Bvh::walk_packet`] with the node test `T`.
     #[inline(always)]
-    fn walk_packet_with<V: Visitor, const K: usize, T: NodeTest>(
+    fn walk_packet_with<V: Visitor, const K: usize, const L: usize, T: NodeTest>(
         &self,
         rays: &[Ray; K],
         t_min: f32,
@@ -192,7 +217,7 @@ impl Bvh {
         mut active: u32,
         test: T,
     ) {
-        let mut rays4 = Rays4::new(rays, t_min);
+        let mut rays4 = Rays4::<L>::new(rays, t_min);
         for (i, v) in vs.iter().enumerate() {
             rays4.set_limit(i, v.limit());
         }
@@ -225,7 +250,7 @@ impl Bvh {
                 let node = &self.nodes[word as usize];
                 // Per child slot, the rays that enter it, and a `t` no later than any of their
                 // entry ts.
-                let (entered, key) = test.enter::<K>(&rays4, node, mask);
+                let (entered, key) = test.enter::<K, L>(&rays4, node, mask);
                 // The children entered, nearest first when ordered.
                 let mut hits = [(0u32, 0u32, 0f32); 4];
                 let mut k = 0;
@@ -246,6 +271,7 @@ impl Bvh {
                 if k > 0 {
                     (word, mask) = (hits[k - 1].0, hits[k - 1].1);
                     for h in &hits[..k - 1] {
+                        self.prefetch_child(h.0);
                         stack[sp] = *h;
                         sp += 1;
                     }
@@ -280,6 +306,35 @@ impl Bvh {
             }
         }
     }
+}
+
+impl Bvh {
+    /// Prefetches the node or triangle packet of child word `word` (a pushed child, visited
+    /// later: its lines load while the nearer children are walked).
+    #[inline(always)]
+    fn prefetch_child(&self, word: u32) {
+        if word & LEAF == 0 {
+            prefetch(&self.nodes[word as usize]);
+        } else if word & SPHERE == 0 {
+            prefetch(&self.packets[((word & !LEAF) >> 2) as usize]);
+        }
+    }
+}
+
+/// Asks for the cache lines of `at` ahead of their use: a hint, with no effect on any answer.
+/// (`pulp`'s SSE token makes the prefetch instruction a safe call; SSE is part of x86-64.)
+#[inline(always)]
+fn prefetch<T>(at: &T) {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(sse) = pulp::core_arch::x86::Sse::try_new() {
+        use std::arch::x86_64::_MM_HINT_T0;
+        let p = (at as *const T).cast::<i8>();
+        for line in (0..size_of::<T>()).step_by(64) {
+            sse._mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(line));
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = at;
 }
 
 /// A ray prepared for the node test.
@@ -321,19 +376,22 @@ impl TravRay {
 /// larger of the two planes' `t` (for `1/d` of either sign, the plane [`TravRay::near`] picks
 /// gives the smaller: `(plane − o)·(1/d)` rounds monotonically in the plane, so the values are
 /// the same, bar the sign of a zero, which no comparison sees).
-struct Rays4 {
-    o: [[f32; 32]; 3],
-    inv: [[f32; 32]; 3],
+struct Rays4<const L: usize> {
+    o: [[f32; L]; 3],
+    inv: [[f32; L]; 3],
     t_min: f32,
     /// Each ray's [`Visitor::limit`], as of its last leaf.
-    limit: [f32; 32],
+    limit: [f32; L],
 }
 
-impl Rays4 {
+impl<const L: usize> Rays4<L> {
     #[inline(always)]
     fn new<const K: usize>(rays: &[Ray; K], t_min: f32) -> Self {
-        let mut o = [[0.0f32; 32]; 3];
-        let mut inv = [[1.0f32; 32]; 3];
+        // `walk_packet` picks `L ≥ K`; its other branches, where `L < K`, are never taken.
+        const { assert!(L.is_multiple_of(8)) };
+        assert!(K <= L);
+        let mut o = [[0.0f32; L]; 3];
+        let mut inv = [[1.0f32; L]; 3];
         for (i, ray) in rays.iter().enumerate() {
             let d = trav_inv(ray.dir);
             for axis in 0..3 {
@@ -345,7 +403,7 @@ impl Rays4 {
             o,
             inv,
             t_min,
-            limit: [f32::NEG_INFINITY; 32],
+            limit: [f32::NEG_INFINITY; L],
         }
     }
 
@@ -360,9 +418,9 @@ impl Rays4 {
 /// tests each), and the smallest entry `t` of the rays of their lane groups that meet it (no
 /// later than any of theirs, so a child popped behind it is behind every one of them).
 trait NodeTest: Copy {
-    fn enter<const K: usize>(
+    fn enter<const K: usize, const L: usize>(
         &self,
-        r: &Rays4,
+        r: &Rays4<L>,
         node: &super::Node,
         mask: u32,
     ) -> ([u32; 4], [f32; 4]);
@@ -374,9 +432,9 @@ struct Sse4;
 
 impl NodeTest for Sse4 {
     #[inline(always)]
-    fn enter<const K: usize>(
+    fn enter<const K: usize, const L: usize>(
         &self,
-        r: &Rays4,
+        r: &Rays4<L>,
         node: &super::Node,
         mask: u32,
     ) -> ([u32; 4], [f32; 4]) {
@@ -391,7 +449,7 @@ impl NodeTest for Sse4 {
                 continue;
             }
             let lanes = 4 * g..4 * g + 4;
-            let load = |a: &[f32; 32]| Vec4::from_slice(&a[lanes.clone()]);
+            let load = |a: &[f32; L]| Vec4::from_slice(&a[lanes.clone()]);
             let (ox, oy, oz) = (load(&r.o[0]), load(&r.o[1]), load(&r.o[2]));
             let (ix, iy, iz) = (load(&r.inv[0]), load(&r.inv[1]), load(&r.inv[2]));
             let limit = load(&r.limit);
@@ -425,7 +483,7 @@ impl NodeTest for Sse4 {
 /// [`Bvh::walk_packet_with`] the [`Avx8`] test, as the function `pulp` compiles with AVX2:
 /// its `call` must be inlined there, hence a type rather than a closure.
 #[cfg(target_arch = "x86_64")]
-struct Avx8Walk<'a, V, const K: usize> {
+struct Avx8Walk<'a, V, const K: usize, const L: usize> {
     bvh: &'a Bvh,
     rays: &'a [Ray; K],
     t_min: f32,
@@ -435,14 +493,14 @@ struct Avx8Walk<'a, V, const K: usize> {
 }
 
 #[cfg(target_arch = "x86_64")]
-impl<V: Visitor, const K: usize> pulp::NullaryFnOnce for Avx8Walk<'_, V, K> {
+impl<V: Visitor, const K: usize, const L: usize> pulp::NullaryFnOnce for Avx8Walk<'_, V, K, L> {
     type Output = ();
 
     #[inline(always)]
     fn call(self) {
         let test = Avx8(self.v3);
         self.bvh
-            .walk_packet_with(self.rays, self.t_min, self.vs, self.active, test);
+            .walk_packet_with::<V, K, L, _>(self.rays, self.t_min, self.vs, self.active, test);
     }
 }
 
@@ -456,9 +514,9 @@ struct Avx8(pulp::x86::V3);
 #[cfg(target_arch = "x86_64")]
 impl NodeTest for Avx8 {
     #[inline(always)]
-    fn enter<const K: usize>(
+    fn enter<const K: usize, const L: usize>(
         &self,
-        r: &Rays4,
+        r: &Rays4<L>,
         node: &super::Node,
         mask: u32,
     ) -> ([u32; 4], [f32; 4]) {
@@ -486,7 +544,7 @@ impl NodeTest for Avx8 {
             if group == 0 {
                 continue;
             }
-            let load = |a: &[f32; 32]| -> __m256 {
+            let load = |a: &[f32; L]| -> __m256 {
                 let mut lanes = [0.0f32; 8];
                 lanes.copy_from_slice(&a[8 * g..8 * g + 8]);
                 pulp::cast(lanes)
