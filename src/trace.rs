@@ -548,7 +548,19 @@ impl Tracer {
             shadow,
             lengths,
         } = scratch;
+        // Inactive lanes are left alone by the query: none of the last packet's hits stay.
+        *hits = [None; K];
         self.accel.closest_hits(m, rays, active, hits);
+        // The hit triangles' records load together, not one miss per lane in turn.
+        let n_spheres = scene.spheres.len();
+        for hit in hits.iter().flatten() {
+            if let Some(tri) = (hit.prim as usize)
+                .checked_sub(n_spheres)
+                .and_then(|i| scene.triangles.get(i))
+            {
+                crate::accel::prefetch(tri);
+            }
+        }
         // Field by field into the caller's slots: a `Given` is large, and a fresh array of
         // them would be built on the stack and copied.
         for (i, g) in given.iter_mut().enumerate() {

@@ -688,3 +688,21 @@ fn slab(o: Vec3, inv: Vec3, lo: Vec3, hi: Vec3) -> (f32, f32) {
 fn box_t_slack() -> f32 {
     2.0 * crate::geometry::gamma(3)
 }
+
+/// Asks for the cache lines of `at` ahead of their use: a hint, with no effect on any answer.
+/// (`pulp`'s SSE token makes the prefetch instruction a safe call; SSE is part of x86-64.)
+#[inline(always)]
+pub fn prefetch<T>(at: &T) {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(sse) = pulp::core_arch::x86::Sse::try_new() {
+        use std::arch::x86_64::_MM_HINT_T0;
+        let p = (at as *const T).cast::<i8>();
+        // Every line from the first byte to the last.
+        for line in (0..size_of::<T>()).step_by(64) {
+            sse._mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(line));
+        }
+        sse._mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(size_of::<T>().saturating_sub(1)));
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = at;
+}

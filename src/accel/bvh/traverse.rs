@@ -21,7 +21,7 @@
 use glam::{Vec3, Vec3A, Vec4};
 
 use super::{Bvh, LEAF, SPHERE, STACK_SIZE};
-use crate::accel::{Visitor, box_t_slack};
+use crate::accel::{Visitor, box_t_slack, prefetch};
 use crate::geometry::Ray;
 
 /// Entries of the stack a query starts with; deeper queries continue on a [`STACK_SIZE`] one.
@@ -321,21 +321,6 @@ impl Bvh {
     }
 }
 
-/// Asks for the cache lines of `at` ahead of their use: a hint, with no effect on any answer.
-/// (`pulp`'s SSE token makes the prefetch instruction a safe call; SSE is part of x86-64.)
-#[inline(always)]
-fn prefetch<T>(at: &T) {
-    #[cfg(target_arch = "x86_64")]
-    if let Some(sse) = pulp::core_arch::x86::Sse::try_new() {
-        use std::arch::x86_64::_MM_HINT_T0;
-        let p = (at as *const T).cast::<i8>();
-        for line in (0..size_of::<T>()).step_by(64) {
-            sse._mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(line));
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = at;
-}
 
 /// A ray prepared for the node test.
 struct TravRay {
