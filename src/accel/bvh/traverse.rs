@@ -321,7 +321,6 @@ impl Bvh {
     }
 }
 
-
 /// A ray prepared for the node test.
 struct TravRay {
     ox: Vec4,
