@@ -32,7 +32,9 @@
 //! Run: `cargo bench --bench peer` (80k, 320k and 1.28M triangles, 2 threads, 5 rounds), or
 //! e.g. `cargo bench --bench peer -- --sizes 1000,1000000 --threads 1 --runs 3 --keep /tmp/b`.
 //! `--size 1280x960` renders more rays than the scene's 640×480 (a longer, steadier render
-//! phase on a noisy machine). `--scaling` instead prints raytree's build and render time
+//! phase on a noisy machine). `--scene A,B` races on other scenes instead of the generated
+//! ones: built-in names, scene files or bare OBJ files, within the peer's reach (point lights,
+//! no textures; meshes are shaded flat on both sides, as the peer has no vertex normals). `--scaling` instead prints raytree's build and render time
 //! against triangle count (1k to 4M) on 1 and 2 threads, and with `--chart FILE.png` draws it.
 
 use std::io::Write as _;
@@ -122,6 +124,9 @@ struct Options {
     /// The camera- and shadow-dominated frame: every material's reflectivity and transparency
     /// set to 0, so each ray is a camera ray or a shadow ray.
     opaque: bool,
+    /// Scenes to race on instead of the generated ones (`--scene`): built-in names, scene
+    /// files or bare OBJ files.
+    scenes: Vec<String>,
 }
 
 fn parse_options() -> Options {
@@ -139,6 +144,7 @@ fn parse_options() -> Options {
         chart: None,
         size: None,
         opaque: false,
+        scenes: Vec::new(),
     };
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
@@ -159,6 +165,9 @@ fn parse_options() -> Options {
             "--keep" => o.keep = Some(PathBuf::from(value("--keep"))),
             "--scaling" => o.scaling = true,
             "--opaque" => o.opaque = true,
+            "--scene" => o
+                .scenes
+                .extend(value("--scene").split(',').map(str::to_string)),
             "--no-peer" => o.peer = false,
             "--peer-config" => {
                 o.peer_configs = value("--peer-config")
@@ -182,6 +191,86 @@ fn parse_options() -> Options {
     o.runs = o.runs.max(1);
     o.frames = o.frames.clamp(1, 1000);
     o
+}
+
+/// What one row of the race renders.
+enum Entry {
+    /// The generated bench scene with this many triangles.
+    Generated(usize),
+    /// A scene named on the command line (`--scene`).
+    Given(String),
+}
+
+impl Entry {
+    fn label(&self, triangles: usize) -> String {
+        match self {
+            Entry::Generated(_) => triangles.to_string(),
+            Entry::Given(arg) => format!("`{arg}`, {triangles}"),
+        }
+    }
+}
+
+/// Writes the scene `arg` (a built-in name, a scene file or a bare OBJ) as a scene file in
+/// `dir`, its meshes by absolute path and shaded flat (the peer has no vertex normals).
+fn write_given_scene(arg: &str, dir: &Path) -> PathBuf {
+    use raytree::scene::{NormalsMode, ObjectSource};
+    let mut scene =
+        raytree::scene::open_scene_arg(arg).unwrap_or_else(|e| panic!("--scene {arg}: {e}"));
+    // Where the scene's mesh paths start: the file's folder, or a built-in's in `assets`.
+    let folder = if Path::new(arg).exists() {
+        let parent = Path::new(arg)
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty());
+        std::fs::canonicalize(parent.unwrap_or(Path::new(".")))
+            .unwrap_or_else(|e| panic!("--scene {arg}: {e}"))
+    } else {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes")
+    };
+    for object in &mut scene.objects {
+        if let ObjectSource::Mesh { file, normals, .. } = &mut object.source {
+            *file = folder.join(&*file).to_string_lossy().into_owned();
+            *normals = NormalsMode::Flat;
+        }
+    }
+    std::fs::create_dir_all(dir).expect("make the scene's folder");
+    let path = dir.join("bench.toml");
+    std::fs::write(&path, raytree::scene::save::scene_to_toml(&scene))
+        .expect("write the scene file");
+    path
+}
+
+/// Why scene `arg`, as raytree loads it for the race, is beyond what the peer renders alike,
+/// if it is: lights with a radius, textures, or (with `--opaque`) a reflective or transparent
+/// material the rewrite could not reach (one an OBJ's MTL file brings).
+fn beyond_reach(arg: &str, scene: &Scene, opaque: bool) -> Option<String> {
+    if let Some(l) = scene.lights.iter().find(|l| l.radius != 0.0) {
+        return Some(format!(
+            "--scene {arg}: light `{}` has a radius; the peer takes point lights only",
+            l.name
+        ));
+    }
+    if let Some(m) = scene
+        .materials
+        .iter()
+        .find(|m| m.diffuse_map.is_some() || m.ambient_map.is_some())
+    {
+        return Some(format!(
+            "--scene {arg}: material `{}` is textured; the peer has no textures",
+            m.name
+        ));
+    }
+    if opaque
+        && let Some(m) = scene
+            .materials
+            .iter()
+            .find(|m| m.reflectivity != glam::Vec3::ZERO || m.transparency != glam::Vec3::ZERO)
+    {
+        return Some(format!(
+            "--scene {arg} --opaque: material `{}` still reflects or refracts (it comes from the mesh's MTL file, which the rewrite does not reach)",
+            m.name
+        ));
+    }
+    None
 }
 
 /// Rewrites the scene file with every material's reflectivity and transparency 0: the
@@ -494,7 +583,8 @@ fn mb(bytes: u64) -> f64 {
 /// One scene size's results: raytree's runs and each peer configuration's runs, round by
 /// round (the same index is the same round), and the pixels each peer's image differs in.
 struct SizeResult {
-    triangles: usize,
+    /// The row's name: the triangle count of a generated scene, or the scene's name and count.
+    label: String,
     ours: Vec<Run>,
     theirs: Vec<Vec<Run>>,
     differing: Vec<[usize; 2]>,
@@ -544,13 +634,34 @@ fn peer_comparison(o: &Options, root: &Path) {
         );
     }
     let mut results = Vec::new();
-    for &size in &o.sizes {
-        let dir = root.join(format!("tris_{size}"));
-        let scene_file = write_bench_scene(&dir, size).expect("write the bench scene");
+    let entries: Vec<Entry> = if o.scenes.is_empty() {
+        o.sizes.iter().map(|&n| Entry::Generated(n)).collect()
+    } else {
+        o.scenes.iter().cloned().map(Entry::Given).collect()
+    };
+    for (k, entry) in entries.iter().enumerate() {
+        let (dir, scene_file) = match entry {
+            Entry::Generated(size) => {
+                let dir = root.join(format!("tris_{size}"));
+                let file = write_bench_scene(&dir, *size).expect("write the bench scene");
+                (dir, file)
+            }
+            Entry::Given(arg) => {
+                let dir = root.join(format!("scene_{k}"));
+                let file = write_given_scene(arg, &dir);
+                (dir, file)
+            }
+        };
         if o.opaque {
             make_opaque(&scene_file);
         }
         let mut scene = load_scene_file(&scene_file).expect("load the bench scene");
+        if let Entry::Given(arg) = entry
+            && let Some(why) = beyond_reach(arg, &scene, o.opaque)
+        {
+            println!("skipped: {why}");
+            continue;
+        }
         if let Some((w, h)) = o.size {
             (scene.render.width, scene.render.height) = (w, h);
         }
@@ -598,13 +709,13 @@ fn peer_comparison(o: &Options, root: &Path) {
             .map(|image| differing_pixels(&ours_png, image, w, h))
             .collect();
         println!(
-            "{} triangles done; load average {}",
-            scene.triangles.len(),
+            "{} done; load average {}",
+            entry.label(scene.triangles.len()),
             load_average()
         );
         let _ = std::io::stdout().flush();
         results.push(SizeResult {
-            triangles: scene.triangles.len(),
+            label: entry.label(scene.triangles.len()),
             ours,
             theirs,
             differing,
@@ -621,8 +732,8 @@ fn peer_comparison(o: &Options, root: &Path) {
                 let d = ray_difference(mine, peer);
                 if d > MAX_RAY_DIFFERENCE {
                     flagged.push(format!(
-                        "{} triangles, peer {}: rays differ by {:.2} % in one kind",
-                        r.triangles,
+                        "{}, peer {}: rays differ by {:.2} % in one kind",
+                        r.label,
                         c + 1,
                         100.0 * d
                     ));
@@ -705,7 +816,7 @@ fn print_tables(results: &[SizeResult], configs: &[PeerConfig]) {
             let e = c.map(|c| r.theirs[c].as_slice());
             println!(
                 "| {} | {label} | {} | {} | {} | {} | {} |",
-                r.triangles,
+                r.label,
                 pair(
                     medians(&r.ours, Run::first_secs),
                     e.map(|e| medians(e, Run::first_secs)),
@@ -737,7 +848,7 @@ fn print_tables(results: &[SizeResult], configs: &[PeerConfig]) {
             let m = |runs: &[Run], key: fn(&Run) -> f64| medians(runs, key);
             println!(
                 "| {} | {label} | {} | {} | {} | {} |",
-                r.triangles,
+                r.label,
                 pair(
                     m(&r.ours, |x| x.load_secs),
                     e.map(|e| m(e, |x| x.load_secs)),
@@ -794,7 +905,7 @@ fn print_tables(results: &[SizeResult], configs: &[PeerConfig]) {
             };
             println!(
                 "| {} | {label} | {} | {theirs} | {delta} | {diff} |",
-                r.triangles,
+                r.label,
                 kinds(mine)
             );
         }

@@ -274,6 +274,18 @@ static vec3 offset_origin(vec3 p, vec3 err, vec3 n, vec3 dir) {
 
 static vec3 reflect(vec3 u, vec3 n) { return sub(u, scale(2.0f * dot(u, n), n)); }
 
+/* max(cos, 0)^shininess, cos of the halfway vector (Blinn-Phong) or of the mirrored light
+ * (Phong), as raytree's shade::light_terms_with. */
+static inline float highlight(vec3 n, vec3 l, vec3 view, float shininess) {
+    float cos_spec;
+    if (S.blinn) {
+        cos_spec = dot(n, normalize_or_zero(add(l, view)));
+    } else {
+        cos_spec = dot(reflect(neg(l), n), view);
+    }
+    return powf(fmaxf(cos_spec, 0.0f), shininess);
+}
+
 static int refract(vec3 u, vec3 n, float eta, vec3 *out) {
     float cos_i = fminf(fmaxf(-dot(u, n), 0.0f), 1.0f);
     float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
@@ -345,11 +357,20 @@ static vec3 trace(vec3 o, vec3 d, Kind kind, uint32_t depth, Counts *counts,
         vec3 l = scale(1.0f / dist, to_light);
         float n_dot_l = dot(n, l);
         /* raytree's rule: no shadow ray where the light's unshadowed contribution is exactly
-         * zero: the light behind the surface, or no diffuse and no specular in the light's
-         * channels. */
+         * zero: the light behind the surface; or no diffuse in the light's channels and a
+         * specular term of exactly zero (none in its channels, or a highlight that is 0: the
+         * halfway vector beyond 90 degrees, or a power that underflows). A NaN term casts. */
         if (!(n_dot_l > 0.0f)) continue;
-        if (is_zero(mul(light->color, m->diffuse)) && is_zero(mul(light->color, m->specular)))
-            continue;
+        vec3 ks = mul(light->color, m->specular);
+        /* The highlight, formed before the shadow ray only where the rule needs it. */
+        int have_spec = 0;
+        float spec = 0.0f;
+        if (is_zero(mul(light->color, m->diffuse))) {
+            if (is_zero(ks)) continue;
+            spec = highlight(n, l, view, m->shininess);
+            have_spec = 1;
+            if (is_zero(scale(spec, ks))) continue;
+        }
         vec3 origin = offset_origin(p, err, n, l);
         vec3 seg = sub(light->position, origin);
         float seg_len = length(seg);
@@ -366,13 +387,7 @@ static vec3 trace(vec3 o, vec3 d, Kind kind, uint32_t depth, Counts *counts,
         sr.flags = 0;
         rtcOccluded1(scene, ctx, &sr);
         if (sr.tfar < 0.0f) continue; /* blocked */
-        float cos_spec;
-        if (S.blinn) {
-            cos_spec = dot(n, normalize_or_zero(add(l, view)));
-        } else {
-            cos_spec = dot(reflect(neg(l), n), view);
-        }
-        float spec = powf(fmaxf(cos_spec, 0.0f), m->shininess);
+        if (!have_spec) spec = highlight(n, l, view, m->shininess);
         diffuse = add(diffuse, scale(n_dot_l, mul(light->color, m->diffuse)));
         specular = add(specular, scale(spec, mul(light->color, m->specular)));
     }
