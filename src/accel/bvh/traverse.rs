@@ -35,6 +35,17 @@ impl Bvh {
         if self.nodes.is_empty() {
             return;
         }
+        #[cfg(target_arch = "x86_64")]
+        if let Some(v3) = super::avx2() {
+            // The same walk compiled for x86-64-v3 (VEX-encoded SSE, no fused multiply-add is
+            // formed): the same numbers, in fewer instructions.
+            return v3.vectorize(Avx2Walk {
+                bvh: self,
+                ray,
+                t_min,
+                v,
+            });
+        }
         let r = TravRay::new(ray, t_min);
         self.walk_from::<V, SHORT_STACK>(&r, v, &[], 0);
     }
@@ -461,6 +472,26 @@ impl NodeTest for Sse4 {
             }
         }
         (entered, key)
+    }
+}
+
+/// [`Bvh::walk`] as the function `pulp` compiles with AVX2.
+#[cfg(target_arch = "x86_64")]
+struct Avx2Walk<'a, V> {
+    bvh: &'a Bvh,
+    ray: &'a Ray,
+    t_min: f32,
+    v: &'a mut V,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<V: Visitor> pulp::NullaryFnOnce for Avx2Walk<'_, V> {
+    type Output = ();
+
+    #[inline(always)]
+    fn call(self) {
+        let r = TravRay::new(self.ray, self.t_min);
+        self.bvh.walk_from::<V, SHORT_STACK>(&r, self.v, &[], 0);
     }
 }
 
