@@ -563,8 +563,18 @@ impl Tracer {
         }
         // Field by field into the caller's slots: a `Given` is large, and a fresh array of
         // them would be built on the stack and copied.
+        let no_visible_lights = self.visible_lights.is_empty();
         for (i, g) in given.iter_mut().enumerate() {
-            g.found = self.with_lights(&rays[i], hits[i]);
+            // Written in each branch: a `Found` formed in one temporary for both and copied
+            // into the slot is loaded across the end of the store that formed it, and stalls.
+            if no_visible_lights {
+                g.found = match hits[i] {
+                    Some(hit) => Found::Prim(hit),
+                    None => Found::Nothing,
+                };
+            } else {
+                g.found = self.with_visible_lights(&rays[i], hits[i]);
+            }
             g.surface = match g.found {
                 Found::Prim(hit) if active & (1 << i) != 0 => Some(self.surface(&rays[i], &hit)),
                 _ => None,
