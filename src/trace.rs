@@ -256,6 +256,14 @@ enum Found {
     Prim(PrimHit),
 }
 
+impl Found {
+    /// The closest hit of a scene without visible lights: the primitive hit, or nothing.
+    #[inline(always)]
+    fn of(hit: Option<PrimHit>) -> Found {
+        hit.map_or(Found::Nothing, Found::Prim)
+    }
+}
+
 /// A primary ray's closest hit, its surface and its shadow rays' answers, found by packet
 /// queries ([`Tracer::trace_packet`]).
 #[derive(Clone, Copy)]
@@ -401,7 +409,7 @@ impl Tracer {
     #[inline(always)]
     fn with_lights(&self, ray: &Ray, hit: Option<PrimHit>) -> Found {
         if self.visible_lights.is_empty() {
-            return hit.map_or(Found::Nothing, Found::Prim);
+            return Found::of(hit);
         }
         self.with_visible_lights(ray, hit)
     }
@@ -568,10 +576,7 @@ impl Tracer {
             // Written in each branch: a `Found` formed in one temporary for both and copied
             // into the slot is loaded across the end of the store that formed it, and stalls.
             if no_visible_lights {
-                g.found = match hits[i] {
-                    Some(hit) => Found::Prim(hit),
-                    None => Found::Nothing,
-                };
+                g.found = Found::of(hits[i]);
             } else {
                 g.found = self.with_visible_lights(&rays[i], hits[i]);
             }

@@ -27,7 +27,7 @@ use super::{ViewerApp, tree_view};
 use crate::render::session::{Session, SessionEvent, View};
 use crate::scene::camera::FRAME_MARGIN;
 use crate::scene::{Camera, CameraFrame, Scene};
-use crate::scene_view::{self, Filter, Segment};
+use crate::scene_view::{self, Filter, Segment, box_corner};
 use crate::trace::{EndReason, Tracer};
 
 /// The longest side of the scene view's image, in pixels.
@@ -537,16 +537,6 @@ fn corner_fit(
     let radius = 0.5 * (hi - lo).length();
     let distance = distance.max(1.05 * radius);
     (distance.is_finite() && distance > 0.0).then_some(distance)
-}
-
-/// Corner `k` (0..8) of the box `lo..hi`: bit 0 picks x, bit 1 y, bit 2 z.
-fn box_corner(lo: Vec3, hi: Vec3, k: usize) -> Vec3 {
-    let pick = |bit: usize, l: f32, h: f32| if k & bit == 0 { l } else { h };
-    Vec3::new(
-        pick(1, lo.x, hi.x),
-        pick(2, lo.y, hi.y),
-        pick(4, lo.z, hi.z),
-    )
 }
 
 /// Hover on drawn rays: the current tree's node under the pointer lights up everywhere.

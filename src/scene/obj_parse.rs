@@ -611,20 +611,12 @@ impl Assembly<'_> {
         );
         // The indices into a list the file does not have (yet) are ignored, as tobj ignores them.
         let mut texcoords = (counts[1] > 0).then(|| {
-            List::new(
-                (self.texcoords, 2, counts[1]),
-                tex_map,
-                &mut mesh.texcoords,
-                &mut mesh.texcoord_indices,
-            )
+            let (values, indices) = (&mut mesh.texcoords, &mut mesh.texcoord_indices);
+            List::new((self.texcoords, 2, counts[1]), tex_map, values, indices)
         });
         let mut normals = (counts[2] > 0).then(|| {
-            List::new(
-                (self.normals, 3, counts[2]),
-                norm_map,
-                &mut mesh.normals,
-                &mut mesh.normal_indices,
-            )
+            let (values, indices) = (&mut mesh.normals, &mut mesh.normal_indices);
+            List::new((self.normals, 3, counts[2]), norm_map, values, indices)
         });
         for list in [&mut texcoords, &mut normals].into_iter().flatten() {
             list.indices.reserve(n);

@@ -325,15 +325,18 @@ pub fn light_markers(scene: &Scene) -> Vec<LightMarker> {
         .collect()
 }
 
+/// Corner `k` (0..8) of the box `lo..hi`: bit 0 picks x, bit 1 y, bit 2 z.
+pub fn box_corner(lo: Vec3, hi: Vec3, k: usize) -> Vec3 {
+    Vec3::new(
+        if k & 1 == 0 { lo.x } else { hi.x },
+        if k & 2 == 0 { lo.y } else { hi.y },
+        if k & 4 == 0 { lo.z } else { hi.z },
+    )
+}
+
 /// The twelve edges of the box `lo..hi` in `style`.
 pub fn box_segments(lo: Vec3, hi: Vec3, style: Style) -> Vec<Segment> {
-    let corner = |i: usize| {
-        Vec3::new(
-            if i & 1 == 0 { lo.x } else { hi.x },
-            if i & 2 == 0 { lo.y } else { hi.y },
-            if i & 4 == 0 { lo.z } else { hi.z },
-        )
-    };
+    let corner = |i: usize| box_corner(lo, hi, i);
     // Corner pairs that differ in one bit are the edges.
     (0..8)
         .flat_map(|i| [1, 2, 4].map(move |bit| (i, i | bit)))
