@@ -51,7 +51,7 @@ crate::choice::choice!(AccelKind {
     Auto => ("auto", "picks from the scene's size (measured crossovers)"),
     None => ("none", "tests every primitive"),
     Grid => ("grid", "uniform grid, 3D-DDA traversal (spatial subdivision)"),
-    Bvh => ("bvh", "bounding volume hierarchy (obvhs build, 4-wide nodes)"),
+    Bvh => ("bvh", "bounding volume hierarchy (obvhs build, 8-wide nodes)"),
 });
 
 /// Geometry the accelerators see. Primitive ids: spheres are `0..spheres.len()`, triangles

@@ -1361,7 +1361,7 @@ fn row_b2(o: &StabilityOptions, rng: &mut Pcg) -> Row {
         ),
         naive: "panics or overflows in other BVH libraries (svenstaro #44, tinybvh #164)".into(),
         robust: format!(
-            "always terminates; max depth of the 4-wide BVH {max_depth} (cap {BVH_DEPTH_CAP}); slowest build \
+            "always terminates; max depth of the 8-wide BVH {max_depth} (cap {BVH_DEPTH_CAP}); slowest build \
              {slowest:.2} s; {disagreements} probe rays differ from brute force"
         ),
         target: "terminates; depth ≤ cap; no overflow",
@@ -1369,7 +1369,7 @@ fn row_b2(o: &StabilityOptions, rng: &mut Pcg) -> Row {
         chart: Some(chart(
             "B2: BVH depth on pathological input",
             "triangles",
-            "4-wide BVH depth",
+            "8-wide BVH depth",
             false,
             series,
         )),

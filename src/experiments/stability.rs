@@ -984,8 +984,9 @@ pub fn refract_identity_err(n: usize, rng: &mut Pcg) -> f64 {
 // =============================================================================================
 // B2: pathological BVH builds
 
-/// The traversal stack of the BVH holds 64 entries; the build guarantees the 4-wide BVH is
-/// shallower (`accel::bvh`), so a depth at or above this would be a bug.
+/// The build keeps the 8-wide BVH shallow (`accel::bvh`: a balanced tree of 2²⁸ primitives
+/// is about 10 levels deep, and the median-split fallback replaces any tree whose traversal
+/// could overflow its stack), so a depth at or above this would be a bug.
 pub const BVH_DEPTH_CAP: usize = 64;
 
 /// Pathological inputs for the BVH build.

@@ -1,12 +1,12 @@
-//! Construction of the 4-wide [`Bvh`]: a binary BVH from `obvhs`, collapsed to four children
-//! per node, and the build presets.
+//! Construction of the 8-wide [`Bvh`]: a binary BVH from `obvhs`, collapsed to [`WIDTH`]
+//! children per node, and the build presets.
 //!
 //! Build: `obvhs`' PLOC with the parameters of [`build_params`] (its `medium_build` preset,
 //! `fast_build` from [`FAST_BUILD_MIN_PRIMS`] primitives on), then its
 //! reinsertion optimiser (Meister et al. 2021, Meister & Bittner 2018), then our own collapse
-//! to four children per node: a surface-area cost decides, bottom up, which subtrees of at
+//! to eight children per node: a surface-area cost decides, bottom up, which subtrees of at
 //! most [`MAX_LEAF`] primitives become leaves, and each node of the wide tree takes the two
-//! children of its binary node and keeps opening the largest inner child until it has four
+//! children of its binary node and keeps opening the largest inner child until it has eight
 //! (the way Embree and Wald et al. 2008 collapse). The primitives are then copied in leaf
 //! order, each keeping its original id, so a leaf reads a contiguous run.
 //!
@@ -20,7 +20,7 @@
 //!   [`MAX_STACKED`] primitives share one box centre, or when PLOC's tree is deeper than
 //!   [`MAX_BVH2_DEPTH`], or when its wide tree could need more than [`STACK_SIZE`] traversal
 //!   stack entries.
-use glam::{Vec3, Vec3A, Vec4};
+use glam::{Vec3, Vec3A};
 use obvhs::{
     BvhBuildParams,
     aabb::Aabb,
@@ -29,7 +29,9 @@ use obvhs::{
 };
 use rayon::prelude::*;
 
-use super::{Bvh, LEAF, MAX_LEAF, MAX_PRIMS, NODE_PAD_REL, Node, Packet, SPHERE, STACK_SIZE};
+use super::{
+    Bvh, LEAF, MAX_LEAF, MAX_PRIMS, NODE_PAD_REL, Node, Packet, SPHERE, STACK_SIZE, WIDTH,
+};
 use crate::accel::{Prim, Prims, Shape};
 use crate::geometry::Triangles4;
 
@@ -53,7 +55,7 @@ pub const MAX_BVH2_DEPTH: usize = 96;
 /// | 1M | 0.604 / 0.382 (0.335) s | 0.524 / 0.347 (0.336) s | 0.421 / 0.345 (0.336) s |
 /// | 2M | 1.058 / 0.343 (0.315) s | 0.917 / 0.317 (0.311) s | 0.844 / 0.332 (0.322) s |
 ///
-/// The renders are within noise of each other (our own surface-area collapse to the 4-wide
+/// The renders are within noise of each other (our own surface-area collapse to the wide
 /// tree evens out the binary trees' differences), the build is 13–15% faster with `fast`.
 /// Below this size the build takes well under a third of a second anyway, and a scene less
 /// even than the torus can profit from `medium`'s wider PLOC search; `very_fast` is not used
@@ -70,8 +72,8 @@ pub fn build_params(prims: usize) -> BvhBuildParams {
     }
 }
 
-/// Costs of a visit relative to each other, for the surface-area leaf decision: a node (four
-/// box tests), a leaf of up to four triangles (one four-lane test), a sphere.
+/// Costs of a visit relative to each other, for the surface-area leaf decision: a node (one
+/// box test of the binary tree's), a leaf of up to four triangles (one four-lane test), a sphere.
 const NODE_COST: f32 = 1.0;
 const PACKET_COST: f32 = 1.5;
 const SPHERE_COST: f32 = 1.0;
@@ -121,7 +123,7 @@ impl Bvh {
             };
             built = flat
                 .and_then(|flat| collapse_flat(flat, prims))
-                .filter(|b| stack_need(&b.nodes) + 3 <= STACK_SIZE);
+                .filter(|b| stack_need(&b.nodes) + WIDTH - 1 <= STACK_SIZE);
         }
         built.unwrap_or_else(|| {
             let boxes: Vec<Aabb> = (0..n).into_par_iter().map(bounds).collect();
@@ -131,9 +133,9 @@ impl Bvh {
                 spheres: Vec::new(),
                 depth: 0,
             });
-            // A balanced binary tree of 2²⁸ leaves has depth 29; its 4-wide collapse needs
-            // fewer than 3·15 stack entries.
-            debug_assert!(stack_need(&b.nodes) + 3 <= STACK_SIZE);
+            // A balanced binary tree of 2²⁸ leaves has depth 29; its 8-wide collapse needs
+            // fewer than 7·10 + 7 stack entries.
+            debug_assert!(stack_need(&b.nodes) + WIDTH - 1 <= STACK_SIZE);
             b
         })
     }
@@ -331,7 +333,7 @@ fn preorder_into(bvh2: &Bvh2, ids: &[u32], flat: &mut Vec<FlatNode>, depth: usiz
     Some(())
 }
 
-/// The 4-wide tree of a binary BVH whose leaves hold one primitive each (PLOC's and
+/// The wide tree of a binary BVH whose leaves hold one primitive each (PLOC's and
 /// [`median_bvh2`]'s do); `None` for an empty tree or one deeper than [`MAX_BVH2_DEPTH`].
 fn collapse<P: Prims + ?Sized>(bvh2: Bvh2, prims: &P) -> Option<Bvh> {
     let flat = preorder(&bvh2)?;
@@ -340,7 +342,7 @@ fn collapse<P: Prims + ?Sized>(bvh2: Bvh2, prims: &P) -> Option<Bvh> {
     collapse_flat(flat, prims)
 }
 
-/// The 4-wide tree of a binary tree in pre-order ([`preorder`]).
+/// The wide tree of a binary tree in pre-order ([`preorder`]).
 fn collapse_flat<P: Prims + ?Sized>(flat: Vec<FlatNode>, prims: &P) -> Option<Bvh> {
     let n = flat.len();
     let right = |i: usize| flat[i].link as usize;
@@ -392,7 +394,7 @@ fn collapse_flat<P: Prims + ?Sized>(flat: Vec<FlatNode>, prims: &P) -> Option<Bv
         depth = depth.max(d);
         // (binary node, how many times opened); a tie in area opens the shallower child, so
         // equal boxes (a median-split tree of duplicates) collapse evenly.
-        let mut slots = [(0usize, 0u32); 4];
+        let mut slots = [(0usize, 0u32); WIDTH];
         let mut len = if leaf[b] {
             slots[0] = (b, 0);
             1
@@ -402,7 +404,7 @@ fn collapse_flat<P: Prims + ?Sized>(flat: Vec<FlatNode>, prims: &P) -> Option<Bv
             2
         };
         // Open the largest inner child until there are four.
-        while len < 4 {
+        while len < WIDTH {
             let mut best: Option<(usize, f32, u32)> = None;
             for (k, &(s, opened)) in slots[..len].iter().enumerate() {
                 if leaf[s] {
@@ -498,8 +500,8 @@ fn collapse_flat<P: Prims + ?Sized>(flat: Vec<FlatNode>, prims: &P) -> Option<Bv
 
 fn empty_node() -> Node {
     Node {
-        planes: [Vec4::ZERO; 6],
-        child: [0; 4],
+        planes: [[0.0; WIDTH]; 6],
+        child: [0; WIDTH],
         valid: 0,
     }
 }
@@ -516,7 +518,7 @@ pub(super) fn stack_need(nodes: &[Node]) -> usize {
         let node = &nodes[i as usize];
         let here = above + (node.valid.count_ones() as usize).saturating_sub(1);
         worst = worst.max(here);
-        for slot in 0..4 {
+        for slot in 0..WIDTH {
             if node.valid & (1 << slot) != 0 && node.child[slot] & LEAF == 0 {
                 todo.push((node.child[slot], here));
             }
@@ -641,7 +643,7 @@ mod tests {
         };
         let (mut total, mut lo, mut hi) = (0.0, Vec3::INFINITY, Vec3::NEG_INFINITY);
         for node in &bvh.nodes {
-            for slot in 0..4 {
+            for slot in 0..WIDTH {
                 if node.valid & (1 << slot) == 0 {
                     continue;
                 }
@@ -791,7 +793,7 @@ mod tests {
             &prims[..],
         )
         .expect("a tree");
-        assert!(stack_need(&split.nodes) + 3 <= STACK_SIZE);
+        assert!(stack_need(&split.nodes) + WIDTH - 1 <= STACK_SIZE);
         // `build_split` takes this path too.
         let built = Bvh::build_split(&prims[..], 0);
         assert_eq!(built.nodes.len(), split.nodes.len());

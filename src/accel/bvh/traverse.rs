@@ -1,5 +1,5 @@
-//! Traversal of the 4-wide [`Bvh`]: the closest-hit and any-hit walks over one stack and the
-//! SIMD test of a node's four child boxes.
+//! Traversal of the 8-wide [`Bvh`]: the closest-hit and any-hit walks over one stack and the
+//! SIMD test of a node's eight child boxes (one AVX2 test, or two SSE ones).
 //!
 //! Traversal, and what it must guarantee (the accelerators agree bit for bit with brute force):
 //! child boxes are padded by a few ulp of their magnitude in every axis
@@ -20,12 +20,12 @@
 //! (`StackStack<_, 32>`) silently overwrites its top entry when full.
 use glam::{Vec3, Vec3A, Vec4};
 
-use super::{Bvh, LEAF, SPHERE, STACK_SIZE};
+use super::{Bvh, LEAF, SPHERE, STACK_SIZE, WIDTH};
 use crate::accel::{Visitor, box_t_slack, prefetch};
 use crate::geometry::Ray;
 
 /// Entries of the stack a query starts with; deeper queries continue on a [`STACK_SIZE`] one.
-const SHORT_STACK: usize = 16;
+const SHORT_STACK: usize = 32;
 
 impl Bvh {
     /// Visits every primitive whose padded box the ray's `(t_min, v.limit()]` interval meets;
@@ -44,22 +44,24 @@ impl Bvh {
                 ray,
                 t_min,
                 v,
+                v3,
             });
         }
         let r = TravRay::new(ray, t_min);
-        self.walk_from::<V, SHORT_STACK>(&r, v, &[], 0);
+        self.walk_from::<V, SHORT_STACK, _>(&r, v, &[], 0, Sse4);
     }
 
     /// The traversal loop from child word `word` with `seed` on a stack of `N` entries. A
     /// query starts on a short stack (clearing it is part of every query's cost) and, in the
     /// rare case it would overflow, continues on a [`STACK_SIZE`] one.
     #[inline(always)]
-    fn walk_from<V: Visitor, const N: usize>(
+    fn walk_from<V: Visitor, const N: usize, T: NodeTest>(
         &self,
         r: &TravRay,
         v: &mut V,
         seed: &[(u32, f32)],
         mut word: u32,
+        test: T,
     ) {
         let mut stack = [(0u32, 0f32); N];
         // Element by element: these copies are short, and `copy_from_slice` of a variable
@@ -68,8 +70,6 @@ impl Bvh {
             *to = *from;
         }
         let mut sp = seed.len();
-        let (nx, ny, nz) = (r.near[0], r.near[1], r.near[2]);
-        let (fx, fy, fz) = (nx ^ 1, ny ^ 1, nz ^ 1);
         loop {
             v.enter(word);
             if word & LEAF != 0 {
@@ -84,29 +84,15 @@ impl Bvh {
                 }
             } else {
                 let node = &self.nodes[word as usize];
-                let p = &node.planes;
-                let t_near = ((p[nx] - r.ox) * r.ix)
-                    .max((p[ny] - r.oy) * r.iy)
-                    .max((p[nz] - r.oz) * r.iz);
-                let t_far = ((p[fx] - r.ox) * r.ix)
-                    .min((p[fy] - r.oy) * r.iy)
-                    .min((p[fz] - r.oz) * r.iz);
-                // Widen both ends by the rounding of the slab arithmetic *and* of the
-                // primitives' own t: a tie (equal t, lower id) in a flat box must not be
-                // culled by an ulp.
-                let slack = Vec4::splat(box_t_slack());
-                let t_near = (t_near - t_near.abs() * slack).max(r.t_min);
-                let t_far = (t_far + t_far.abs() * slack).min(Vec4::splat(v.limit()));
-                let mut mask = t_near.cmple(t_far).bitmask() & node.valid;
+                let (mut mask, t) = test.enter_one(r, node, v.limit());
                 if mask != 0 {
                     if mask & (mask - 1) == 0 {
                         word = node.child[mask.trailing_zeros() as usize];
                         continue;
                     }
-                    let t = t_near.to_array();
-                    // Up to four hits; all but the one taken next are pushed with their
+                    // Up to `WIDTH` hits; all but the one taken next are pushed with their
                     // entry t (sorted farthest first when ordered, so the nearest is next).
-                    let mut hits = [(0u32, 0f32); 4];
+                    let mut hits = [(0u32, 0f32); WIDTH];
                     let mut k = 0;
                     while mask != 0 {
                         let i = mask.trailing_zeros() as usize;
@@ -122,23 +108,23 @@ impl Bvh {
                         k += 1;
                     }
                     word = hits[k - 1].0;
-                    // Three entries are always written (only `k − 1` are kept): a fixed-length
-                    // copy, where a loop of 1 to 3 would mispredict.
-                    if N < STACK_SIZE && sp + 3 > N {
+                    // `WIDTH − 1` entries are always written (only `k − 1` are kept): a
+                    // fixed-length copy, where a loop of 1 to 7 would mispredict.
+                    if N < STACK_SIZE && sp + WIDTH - 1 > N {
                         let mut deeper = [(0u32, 0f32); STACK_SIZE];
                         deeper[..sp].copy_from_slice(&stack[..sp]);
                         deeper[sp..sp + k - 1].copy_from_slice(&hits[..k - 1]);
                         let seed = &deeper[..sp + k - 1];
-                        return self.walk_from::<V, STACK_SIZE>(r, v, seed, word);
+                        return self.walk_from::<V, STACK_SIZE, T>(r, v, seed, word, test);
                     }
-                    // The pushed children's lines load while the nearest is walked (the
-                    // unused entries name the root, which is in cache).
-                    for h in &hits[..3] {
+                    // The pushed children's lines load while the nearest is walked.
+                    for h in &hits[..k - 1] {
                         self.prefetch_child(h.0);
                     }
-                    stack[sp] = hits[0];
-                    stack[sp + 1] = hits[1];
-                    stack[sp + 2] = hits[2];
+                    let top: &mut [(u32, f32); WIDTH - 1] = (&mut stack[sp..sp + WIDTH - 1])
+                        .try_into()
+                        .expect("checked above");
+                    *top = hits[..WIDTH - 1].try_into().expect("WIDTH − 1 entries");
                     sp += k - 1;
                     continue;
                 }
@@ -263,9 +249,9 @@ impl Bvh {
                 // entry ts.
                 let (entered, key) = test.enter::<K, L>(&rays4, node, mask);
                 // The children entered, nearest first when ordered.
-                let mut hits = [(0u32, 0u32, 0f32); 4];
+                let mut hits = [(0u32, 0u32, 0f32); WIDTH];
                 let mut k = 0;
-                for slot in 0..4 {
+                for slot in 0..WIDTH {
                     if entered[slot] == 0 {
                         continue;
                     }
@@ -374,6 +360,8 @@ impl TravRay {
 struct Rays4<const L: usize> {
     o: [[f32; L]; 3],
     inv: [[f32; L]; 3],
+    /// Each ray's [`TravRay::near`].
+    near: [[u32; 3]; L],
     t_min: f32,
     /// Each ray's [`Visitor::limit`], as of its last leaf.
     limit: [f32; L],
@@ -387,16 +375,19 @@ impl<const L: usize> Rays4<L> {
         assert!(K <= L);
         let mut o = [[0.0f32; L]; 3];
         let mut inv = [[1.0f32; L]; 3];
+        let mut near = [[0u32; 3]; L];
         for (i, ray) in rays.iter().enumerate() {
             let d = trav_inv(ray.dir);
             for axis in 0..3 {
                 o[axis][i] = ray.origin[axis];
                 inv[axis][i] = d[axis];
+                near[i][axis] = 2 * axis as u32 + u32::from(d[axis] < 0.0);
             }
         }
         Rays4 {
             o,
             inv,
+            near,
             t_min,
             limit: [f32::NEG_INFINITY; L],
         }
@@ -413,12 +404,16 @@ impl<const L: usize> Rays4<L> {
 /// tests each), and the smallest entry `t` of the rays of their lane groups that meet it (no
 /// later than any of theirs, so a child popped behind it is behind every one of them).
 trait NodeTest: Copy {
+    /// The single-ray test: the slots of `node` whose widened `(t_min, limit]` interval the
+    /// ray `r` meets (bit `i` for slot `i`), and each slot's widened entry `t`.
+    fn enter_one(&self, r: &TravRay, node: &super::Node, limit: f32) -> (u32, [f32; WIDTH]);
+
     fn enter<const K: usize, const L: usize>(
         &self,
         r: &Rays4<L>,
         node: &super::Node,
         mask: u32,
-    ) -> ([u32; 4], [f32; 4]);
+    ) -> ([u32; WIDTH], [f32; WIDTH]);
 }
 
 /// The node test four rays wide (SSE, glam).
@@ -427,15 +422,42 @@ struct Sse4;
 
 impl NodeTest for Sse4 {
     #[inline(always)]
+    fn enter_one(&self, r: &TravRay, node: &super::Node, limit: f32) -> (u32, [f32; WIDTH]) {
+        let (nx, ny, nz) = (r.near[0], r.near[1], r.near[2]);
+        let (fx, fy, fz) = (nx ^ 1, ny ^ 1, nz ^ 1);
+        let slack = Vec4::splat(box_t_slack());
+        let limit = Vec4::splat(limit);
+        let mut mask = 0;
+        let mut t = [0.0; WIDTH];
+        for half in 0..WIDTH / 4 {
+            let lanes = 4 * half..4 * half + 4;
+            let p = |k: usize| Vec4::from_slice(&node.planes[k][lanes.clone()]);
+            let t_near = ((p(nx) - r.ox) * r.ix)
+                .max((p(ny) - r.oy) * r.iy)
+                .max((p(nz) - r.oz) * r.iz);
+            let t_far = ((p(fx) - r.ox) * r.ix)
+                .min((p(fy) - r.oy) * r.iy)
+                .min((p(fz) - r.oz) * r.iz);
+            // Widen both ends by the rounding of the slab arithmetic *and* of the primitives'
+            // own t: a tie (equal t, lower id) in a flat box must not be culled by an ulp.
+            let t_near = (t_near - t_near.abs() * slack).max(r.t_min);
+            let t_far = (t_far + t_far.abs() * slack).min(limit);
+            mask |= t_near.cmple(t_far).bitmask() << (4 * half);
+            t[lanes].copy_from_slice(&t_near.to_array());
+        }
+        (mask & node.valid, t)
+    }
+
+    #[inline(always)]
     fn enter<const K: usize, const L: usize>(
         &self,
         r: &Rays4<L>,
         node: &super::Node,
         mask: u32,
-    ) -> ([u32; 4], [f32; 4]) {
-        let mut entered = [0u32; 4];
-        let mut key = [f32::INFINITY; 4];
-        let planes = node.planes.map(|p| p.to_array());
+    ) -> ([u32; WIDTH], [f32; WIDTH]) {
+        let mut entered = [0u32; WIDTH];
+        let mut key = [f32::INFINITY; WIDTH];
+        let planes = &node.planes;
         let slack = Vec4::splat(box_t_slack());
         let t_min = Vec4::splat(r.t_min);
         for g in 0..K.div_ceil(4) {
@@ -482,6 +504,7 @@ struct Avx2Walk<'a, V> {
     ray: &'a Ray,
     t_min: f32,
     v: &'a mut V,
+    v3: pulp::x86::V3,
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -491,7 +514,9 @@ impl<V: Visitor> pulp::NullaryFnOnce for Avx2Walk<'_, V> {
     #[inline(always)]
     fn call(self) {
         let r = TravRay::new(self.ray, self.t_min);
-        self.bvh.walk_from::<V, SHORT_STACK>(&r, self.v, &[], 0);
+        let test = Avx8(self.v3);
+        self.bvh
+            .walk_from::<V, SHORT_STACK, _>(&r, self.v, &[], 0, test);
     }
 }
 
@@ -528,23 +553,82 @@ struct Avx8(pulp::x86::V3);
 
 #[cfg(target_arch = "x86_64")]
 impl NodeTest for Avx8 {
+    /// [`Sse4::enter_one`] on all eight slots at once: the same operations lane by lane.
+    #[inline(always)]
+    fn enter_one(&self, r: &TravRay, node: &super::Node, limit: f32) -> (u32, [f32; WIDTH]) {
+        let o = [r.ox.x, r.oy.x, r.oz.x];
+        let inv = [r.ix.x, r.iy.x, r.iz.x];
+        let (hit, t_near) = self.slab(node, o, inv, r.near, r.t_min.x, limit);
+        let mask = self.0.avx._mm256_movemask_ps(hit) as u32;
+        (mask & node.valid, pulp::cast(t_near))
+    }
+
     #[inline(always)]
     fn enter<const K: usize, const L: usize>(
         &self,
         r: &Rays4<L>,
         node: &super::Node,
         mask: u32,
-    ) -> ([u32; 4], [f32; 4]) {
-        use std::arch::x86_64::{__m256, _CMP_LE_OQ};
+    ) -> ([u32; WIDTH], [f32; WIDTH]) {
+        // Ray by ray, each ray against the eight boxes at once (as the single walk tests
+        // them): deep in the tree a packet's rays have parted, and slot by slot (a box
+        // against eight rays) tests rays no longer in the packet. The rays' slot masks form
+        // an 8×8 bit matrix, transposed into each slot's rays.
         let avx = self.0.avx;
-        let mut entered = [0u32; 4];
-        let mut key = [f32::INFINITY; 4];
-        let planes = node.planes.map(|p| p.to_array());
+        let mut entered = [0u32; WIDTH];
+        let mut keys = avx._mm256_set1_ps(f32::INFINITY);
+        for g in 0..K.div_ceil(8) {
+            let group = (mask >> (8 * g)) & 0xff;
+            if group == 0 {
+                continue;
+            }
+            let mut rows = 0u64;
+            let mut m = group;
+            while m != 0 {
+                let i = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let ray = 8 * g + i;
+                let o = [r.o[0][ray], r.o[1][ray], r.o[2][ray]];
+                let inv = [r.inv[0][ray], r.inv[1][ray], r.inv[2][ray]];
+                let near = r.near[ray].map(|n| n as usize);
+                let (hit, t_near) = self.slab(node, o, inv, near, r.t_min, r.limit[ray]);
+                let bits = avx._mm256_movemask_ps(hit) as u32 & node.valid;
+                rows |= u64::from(bits) << (8 * i);
+                // The nearest entry of the rays that enter each slot (an empty slot's key,
+                // from its zero box, is never read: no ray enters it).
+                let inf = avx._mm256_set1_ps(f32::INFINITY);
+                keys = avx._mm256_min_ps(keys, avx._mm256_blendv_ps(inf, t_near, hit));
+            }
+            let columns = transpose8(rows);
+            for (c, e) in entered.iter_mut().enumerate() {
+                *e |= (((columns >> (8 * c)) & 0xff) as u32) << (8 * g);
+            }
+        }
+        (entered, pulp::cast(keys))
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Avx8 {
+    /// The widened slab test of one ray (origin `o`, clamped `1/d` `inv`, near planes `near`)
+    /// against a node's eight child boxes: the slots met (all bits of lane `c`, not yet
+    /// masked by `valid`) and each slot's widened entry `t`.
+    #[inline(always)]
+    fn slab(
+        &self,
+        node: &super::Node,
+        o: [f32; 3],
+        inv: [f32; 3],
+        near: [usize; 3],
+        t_min: f32,
+        limit: f32,
+    ) -> (std::arch::x86_64::__m256, std::arch::x86_64::__m256) {
+        use std::arch::x86_64::{__m256, _CMP_LE_OQ};
+        const { assert!(WIDTH == 8) };
+        let avx = self.0.avx;
+        let [nx, ny, nz] = near;
+        let (fx, fy, fz) = (nx ^ 1, ny ^ 1, nz ^ 1);
         let splat = |x: f32| avx._mm256_set1_ps(x);
-        let slack = splat(box_t_slack());
-        let t_min = splat(r.t_min);
-        let sign = splat(-0.0);
-        let inf = splat(f32::INFINITY);
         let (min, max) = (
             |a, b| avx._mm256_min_ps(a, b),
             |a, b| avx._mm256_max_ps(a, b),
@@ -553,45 +637,39 @@ impl NodeTest for Avx8 {
             |a, b| avx._mm256_sub_ps(a, b),
             |a, b| avx._mm256_mul_ps(a, b),
         );
-        let abs = |a| avx._mm256_andnot_ps(sign, a);
-        for g in 0..K.div_ceil(8) {
-            let group = (mask >> (8 * g)) & 0xff;
-            if group == 0 {
-                continue;
-            }
-            let load = |a: &[f32; L]| -> __m256 {
-                let mut lanes = [0.0f32; 8];
-                lanes.copy_from_slice(&a[8 * g..8 * g + 8]);
-                pulp::cast(lanes)
-            };
-            let (ox, oy, oz) = (load(&r.o[0]), load(&r.o[1]), load(&r.o[2]));
-            let (ix, iy, iz) = (load(&r.inv[0]), load(&r.inv[1]), load(&r.inv[2]));
-            let limit = load(&r.limit);
-            let mut valid = node.valid;
-            while valid != 0 {
-                let c = valid.trailing_zeros() as usize;
-                valid &= valid - 1;
-                let ax = mul(sub(splat(planes[0][c]), ox), ix);
-                let bx = mul(sub(splat(planes[1][c]), ox), ix);
-                let ay = mul(sub(splat(planes[2][c]), oy), iy);
-                let by = mul(sub(splat(planes[3][c]), oy), iy);
-                let az = mul(sub(splat(planes[4][c]), oz), iz);
-                let bz = mul(sub(splat(planes[5][c]), oz), iz);
-                let t_near = max(max(min(ax, bx), min(ay, by)), min(az, bz));
-                let t_far = min(min(max(ax, bx), max(ay, by)), max(az, bz));
-                let t_near = max(sub(t_near, mul(abs(t_near), slack)), t_min);
-                let t_far = min(avx._mm256_add_ps(t_far, mul(abs(t_far), slack)), limit);
-                let hit = avx._mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far);
-                let bits = avx._mm256_movemask_ps(hit) as u32 & group;
-                if bits != 0 {
-                    entered[c] |= bits << (8 * g);
-                    let t: [f32; 8] = pulp::cast(avx._mm256_blendv_ps(inf, t_near, hit));
-                    key[c] = t.iter().fold(key[c], |k, &x| k.min(x));
-                }
-            }
-        }
-        (entered, key)
+        let abs = |a| avx._mm256_andnot_ps(splat(-0.0), a);
+        let p = |k: usize| -> __m256 { pulp::cast(node.planes[k]) };
+        let (ox, oy, oz) = (splat(o[0]), splat(o[1]), splat(o[2]));
+        let (ix, iy, iz) = (splat(inv[0]), splat(inv[1]), splat(inv[2]));
+        let t_near = max(
+            max(mul(sub(p(nx), ox), ix), mul(sub(p(ny), oy), iy)),
+            mul(sub(p(nz), oz), iz),
+        );
+        let t_far = min(
+            min(mul(sub(p(fx), ox), ix), mul(sub(p(fy), oy), iy)),
+            mul(sub(p(fz), oz), iz),
+        );
+        let slack = splat(box_t_slack());
+        let t_near = max(sub(t_near, mul(abs(t_near), slack)), splat(t_min));
+        let t_far = min(
+            avx._mm256_add_ps(t_far, mul(abs(t_far), slack)),
+            splat(limit),
+        );
+        (avx._mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far), t_near)
     }
+}
+
+#[cfg(target_arch = "x86_64")]
+/// The transpose of an 8×8 bit matrix whose row `i` is byte `i` (bit `j` of the byte for
+/// column `j`): row `j` of the result holds column `j`.
+#[inline(always)]
+fn transpose8(x: u64) -> u64 {
+    let t = (x ^ (x >> 7)) & 0x00AA_00AA_00AA_00AA;
+    let x = x ^ t ^ (t << 7);
+    let t = (x ^ (x >> 14)) & 0x0000_CCCC_0000_CCCC;
+    let x = x ^ t ^ (t << 14);
+    let t = (x ^ (x >> 28)) & 0x0000_0000_F0F0_F0F0;
+    x ^ t ^ (t << 28)
 }
 
 /// `1/d`, clamped to `±2⁶⁰` (zero components keep their sign): the node test multiplies it by
@@ -615,6 +693,22 @@ mod tests {
     use crate::accel::bvh::build::stack_need;
     use crate::accel::{Closest, Prim, Shape};
     use crate::geometry::Methods;
+
+    /// `transpose8` moves bit `(i, j)` to `(j, i)`.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn bit_matrix_transpose() {
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        for _ in 0..200 {
+            x = x.rotate_left(13) ^ (x >> 7) ^ 0x2545_F491_4F6C_DD1D;
+            let t = transpose8(x);
+            for i in 0..8 {
+                for j in 0..8 {
+                    assert_eq!(t >> (8 * j + i) & 1, x >> (8 * i + j) & 1);
+                }
+            }
+        }
+    }
 
     /// A query that overflows the short stack continues on the long one and finds what brute
     /// force finds: a one-entry short stack overflows on nearly every query.
@@ -648,7 +742,7 @@ mod tests {
                 brute.visit(p);
             }
             let mut tiny = Closest::new(&m, &ray, 0.0, f32::INFINITY);
-            bvh.walk_from::<_, 1>(&TravRay::new(&ray, 0.0), &mut tiny, &[], 0);
+            bvh.walk_from::<_, 8, _>(&TravRay::new(&ray, 0.0), &mut tiny, &[], 0, Sse4);
             let mut short = Closest::new(&m, &ray, 0.0, f32::INFINITY);
             bvh.walk(&ray, 0.0, &mut short);
             assert_eq!(tiny.hit(), brute.hit());
