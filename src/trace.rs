@@ -237,6 +237,10 @@ pub struct Tracer {
     visible_lights: Vec<usize>,
     /// Seconds spent building the accelerator.
     pub build_secs: f64,
+    /// The batch render's per-pixel sums, kept from one render to the next so that a repeated
+    /// render (`--frames`, a turntable) writes into memory the process has already touched
+    /// instead of faulting in fresh pages (see [`Tracer::take_sums`]).
+    sums: std::sync::Mutex<Vec<Vec3>>,
 }
 
 /// Which of a ray's accelerator queries [`Tracer::visits_of`] replays.
@@ -378,6 +382,30 @@ impl Tracer {
             settings,
             visible_lights,
             build_secs: 0.0,
+            sums: std::sync::Mutex::new(Vec::new()),
+        }
+    }
+
+    /// `n` zeroed sums for a batch render: the buffer of the last render when it is large
+    /// enough (zeroed in place), else a fresh one. Give it back with [`Tracer::keep_sums`].
+    pub(crate) fn take_sums(&self, n: usize) -> Vec<Vec3> {
+        let mut kept = self
+            .sums
+            .lock()
+            .map(|mut kept| std::mem::take(&mut *kept))
+            .unwrap_or_default();
+        if kept.capacity() < n {
+            return vec![Vec3::ZERO; n];
+        }
+        kept.clear();
+        kept.resize(n, Vec3::ZERO);
+        kept
+    }
+
+    /// Keeps `sums` for the next batch render ([`Tracer::take_sums`]).
+    pub(crate) fn keep_sums(&self, sums: Vec<Vec3>) {
+        if let Ok(mut kept) = self.sums.lock() {
+            *kept = sums;
         }
     }
 

@@ -67,6 +67,43 @@ fn thread_count_never_changes_a_bit() {
     }
 }
 
+/// A tracer keeps its sums buffer from one batch render to the next: each render must start
+/// from zero sums, whether the kept buffer is larger (a region after the full image) or the
+/// same size, so the same tracer gives the same pixels every time.
+#[test]
+fn repeated_renders_on_one_tracer_give_the_same_pixels() {
+    let s = scene("default", 96, 64);
+    let tracer = Tracer::new(Arc::new(s), TraceSettings::default());
+    let first = render(&tracer, 2, 2, &|_, _| {}).expect("render").0;
+    assert!(
+        first.pixels.iter().any(|p| p.max_element() > 0.05),
+        "a dark image"
+    );
+    let region = raytree::render::Rect {
+        x: 10,
+        y: 7,
+        width: 40,
+        height: 30,
+    };
+    let part = raytree::render::region::render_region(&tracer, region, 2, 2, &|_, _| {})
+        .expect("region")
+        .0;
+    for y in 0..region.height {
+        for x in 0..region.width {
+            let whole = first.pixels[((region.y + y) * 96 + region.x + x) as usize];
+            assert_eq!(
+                part.pixels[(y * region.width + x) as usize],
+                whole,
+                "({x}, {y})"
+            );
+        }
+    }
+    for _ in 0..2 {
+        let again = render(&tracer, 2, 2, &|_, _| {}).expect("render").0;
+        assert!(again == first, "a repeated render differs from the first");
+    }
+}
+
 #[test]
 fn clicked_tree_colour_equals_the_render() {
     for name in NAMES {

@@ -429,8 +429,11 @@ pub(crate) fn render_part_with(
         })
         .collect();
     let total = region.width as u64 * region.height as u64;
-    // One buffer for every tile's sums, tile after tile: no allocation per tile.
-    let mut sums = vec![Vec3::ZERO; total as usize];
+    let start = Instant::now();
+    // One buffer for every tile's sums, tile after tile: no allocation per tile; the last
+    // render's, zeroed, when there was one (taken inside the timed part: a fresh buffer's pages
+    // are faulted in as the tiles first write them, a kept one is cleared here).
+    let mut sums = tracer.take_sums(total as usize);
     let mut parts: Vec<&mut [Vec3]> = Vec::with_capacity(tiles.len());
     let mut rest = sums.as_mut_slice();
     for rect in &tiles {
@@ -439,7 +442,6 @@ pub(crate) fn render_part_with(
         rest = tail;
     }
     let done = AtomicU64::new(0);
-    let start = Instant::now();
     let work = || -> Vec<Result<RayCounts, RenderError>> {
         tiles
             .par_iter()
@@ -478,6 +480,7 @@ pub(crate) fn render_part_with(
             }
         }
     }
+    tracer.keep_sums(sums);
     let stats = RenderStats {
         width: region.width,
         height: region.height,
