@@ -386,8 +386,9 @@ impl Tracer {
         }
     }
 
-    /// `n` zeroed sums for a batch render: the buffer of the last render when it is large
-    /// enough (zeroed in place), else a fresh one. Give it back with [`Tracer::keep_sums`].
+    /// `n` sums for a batch render: the buffer of the last render when it is large enough
+    /// (holding that render's sums: the caller zeroes each tile's part where its worker starts
+    /// it), else a fresh zeroed one. Give it back with [`Tracer::keep_sums`].
     pub(crate) fn take_sums(&self, n: usize) -> Vec<Vec3> {
         let mut kept = self
             .sums
@@ -397,7 +398,6 @@ impl Tracer {
         if kept.capacity() < n {
             return vec![Vec3::ZERO; n];
         }
-        kept.clear();
         kept.resize(n, Vec3::ZERO);
         kept
     }

@@ -431,8 +431,8 @@ pub(crate) fn render_part_with(
     let total = region.width as u64 * region.height as u64;
     let start = Instant::now();
     // One buffer for every tile's sums, tile after tile: no allocation per tile; the last
-    // render's, zeroed, when there was one (taken inside the timed part: a fresh buffer's pages
-    // are faulted in as the tiles first write them, a kept one is cleared here).
+    // render's when there was one (taken inside the timed part, so a fresh buffer's zeroing
+    // and page faults count; a kept one is zeroed tile by tile by the workers, in parallel).
     let mut sums = tracer.take_sums(total as usize);
     let mut parts: Vec<&mut [Vec3]> = Vec::with_capacity(tiles.len());
     let mut rest = sums.as_mut_slice();
@@ -447,6 +447,7 @@ pub(crate) fn render_part_with(
             .par_iter()
             .zip(parts.into_par_iter())
             .map(|(&rect, sums)| {
+                sums.fill(Vec3::ZERO);
                 let outcome = catch_unwind(AssertUnwindSafe(|| {
                     tile(tracer, &frame, rect, 0..samples, sums)
                 }));
