@@ -273,8 +273,10 @@ impl Found {
 #[derive(Clone, Copy)]
 struct Given {
     found: Found,
-    /// The surface and error bound of `found`'s hit, as [`Tracer::surface`] gives them.
-    surface: Option<(SurfaceHit, Vec3)>,
+    /// The surface and error bound of `found`'s hit, as [`Tracer::surface`] gives them, when
+    /// `has_surface` (written in place: see [`Tracer::surface_into`]).
+    surface: (SurfaceHit, Vec3),
+    has_surface: bool,
     /// Bit `i`: the shadow ray towards light `i` is blocked (lights from 64 on are asked one
     /// ray at a time).
     blocked: u64,
@@ -302,7 +304,8 @@ impl<const K: usize> Default for PacketScratch<K> {
             hits: [None; K],
             given: [Given {
                 found: Found::Nothing,
-                surface: None,
+                surface: (PLACEHOLDER_SURFACE, Vec3::ZERO),
+                has_surface: false,
                 blocked: 0,
                 lights: [None; GIVEN_LIGHTS],
             }; K],
@@ -315,6 +318,22 @@ impl<const K: usize> Default for PacketScratch<K> {
 
 /// Lights whose shadow-ray setup a packet keeps for shading (the rest are set up again).
 const GIVEN_LIGHTS: usize = 4;
+
+/// What a surface slot holds before [`Tracer::surface_into`] first fills it.
+const PLACEHOLDER_SURFACE: SurfaceHit = SurfaceHit {
+    t: 0.0,
+    point: Vec3::ZERO,
+    normal: Vec3::Z,
+    geometric_normal: Vec3::Z,
+    object: ObjectId(0),
+    material: MaterialId(0),
+    front_face: true,
+    barycentric: None,
+    vertex_normals: None,
+    uv: None,
+    texel_kd: None,
+    texel_ka: None,
+};
 
 impl Given {
     #[inline(always)]
@@ -608,9 +627,12 @@ impl Tracer {
             } else {
                 g.found = self.with_visible_lights(&rays[i], hits[i]);
             }
-            g.surface = match g.found {
-                Found::Prim(hit) if active & (1 << i) != 0 => Some(self.surface(&rays[i], &hit)),
-                _ => None,
+            g.has_surface = match g.found {
+                Found::Prim(hit) if active & (1 << i) != 0 => {
+                    self.surface_into(&rays[i], &hit, &mut g.surface);
+                    true
+                }
+                _ => false,
             };
             g.blocked = 0;
             g.lights = [None; GIVEN_LIGHTS];
@@ -619,7 +641,8 @@ impl Tracer {
         for (li, light) in scene.lights.iter().enumerate().take(64) {
             let mut cast = 0u32;
             for ((i, g), base) in given.iter_mut().enumerate().zip(bases.iter_mut()) {
-                if let Some((surface, error)) = &g.surface {
+                if g.has_surface {
+                    let (surface, error) = &g.surface;
                     let material = scene.material(surface.material);
                     let v = -rays[i].dir;
                     let mut terms = None;
@@ -676,9 +699,19 @@ impl Tracer {
     }
 
     /// Hit point, its error bound, normals, object, material, barycentrics and texture.
-    /// Inlined into its two callers: returned by value, its result is otherwise copied.
+    /// Inlined into its callers: returned by value, its result is otherwise copied.
     #[inline(always)]
     fn surface(&self, ray: &Ray, hit: &PrimHit) -> (SurfaceHit, Vec3) {
+        let mut out = (PLACEHOLDER_SURFACE, Vec3::ZERO);
+        self.surface_into(ray, hit, &mut out);
+        out
+    }
+
+    /// [`Tracer::surface`] written field by field into `out` (a packet's slot): a surface
+    /// formed in a temporary and copied into the slot reads its optional fields across the
+    /// ends of the stores that wrote only their tags, and stalls.
+    #[inline(always)]
+    fn surface_into(&self, ray: &Ray, hit: &PrimHit, out: &mut (SurfaceHit, Vec3)) {
         let scene = &self.scene;
         let n_spheres = scene.spheres.len();
         let prim = hit.prim as usize;
@@ -723,21 +756,20 @@ impl Tracer {
             texel_kd = texel(m.diffuse_map);
             texel_ka = texel(m.ambient_map);
         }
-        let surface = SurfaceHit {
-            t: hit.t,
-            point,
-            normal: shading_normal,
-            geometric_normal,
-            object,
-            material,
-            front_face,
-            barycentric,
-            vertex_normals,
-            uv,
-            texel_kd,
-            texel_ka,
-        };
-        (surface, error)
+        let (surface, out_error) = out;
+        surface.t = hit.t;
+        surface.point = point;
+        surface.normal = shading_normal;
+        surface.geometric_normal = geometric_normal;
+        surface.object = object;
+        surface.material = material;
+        surface.front_face = front_face;
+        surface.barycentric = barycentric;
+        surface.vertex_normals = vertex_normals;
+        surface.uv = uv;
+        surface.texel_kd = texel_kd;
+        surface.texel_ka = texel_ka;
+        *out_error = error;
     }
 
     /// Light `light` at a hit (`surface` of primitive `prim`, its point's error bound `error`,
@@ -869,8 +901,8 @@ impl Tracer {
         // The surface, and the shadow rays' setups and answers, the packet found, if any (by
         // reference: they are large).
         let found_here;
-        let (surface, error, known) = match given.and_then(|g| g.surface.as_ref().map(|s| (s, g))) {
-            Some(((surface, error), g)) => (surface, *error, Some(g)),
+        let (surface, error, known) = match given.filter(|g| g.has_surface) {
+            Some(g) => (&g.surface.0, g.surface.1, Some(g)),
             None => {
                 found_here = self.surface(ray, hit);
                 (&found_here.0, found_here.1, None)

@@ -27,6 +27,10 @@ use crate::geometry::Ray;
 /// Entries of the stack a query starts with; deeper queries continue on a [`STACK_SIZE`] one.
 const SHORT_STACK: usize = 32;
 
+/// Entries of the stack a packet walk starts with (each entry carries a ray mask and a `t`);
+/// deeper walks continue on a [`STACK_SIZE`] one.
+const SHORT_PACKET_STACK: usize = 24;
+
 impl Bvh {
     /// Visits every primitive whose padded box the ray's `(t_min, v.limit()]` interval meets;
     /// nearest child first when [`Visitor::ORDERED`].
@@ -211,16 +215,41 @@ impl Bvh {
         rays: &[Ray; K],
         t_min: f32,
         vs: &mut [V; K],
-        mut active: u32,
+        active: u32,
         test: T,
     ) {
         let mut rays4 = Rays4::<L>::new(rays, t_min);
         for (i, v) in vs.iter().enumerate() {
             rays4.set_limit(i, v.limit());
         }
-        let mut stack = [(0u32, 0u32, 0f32); STACK_SIZE];
-        let mut sp = 0;
-        let (mut word, mut mask) = (0u32, active);
+        self.packet_from::<V, K, L, T, SHORT_PACKET_STACK>(&mut rays4, vs, active, &[], 0, test);
+    }
+
+    /// The packet walk's loop from child word `word` (its rays `mask`), with `seed` on a
+    /// stack of `N` entries: a walk starts on a short stack (clearing it is part of every
+    /// walk's cost) and, in the rare case it would overflow, continues on a [`STACK_SIZE`] one.
+    #[inline(always)]
+    fn packet_from<V: Visitor, const K: usize, const L: usize, T: NodeTest, const N: usize>(
+        &self,
+        rays4: &mut Rays4<L>,
+        vs: &mut [V; K],
+        mut active: u32,
+        seed: &[(u32, u32, f32)],
+        word: u32,
+        test: T,
+    ) {
+        let mut stack = [(0u32, 0u32, 0f32); N];
+        for (to, from) in stack.iter_mut().zip(seed) {
+            *to = *from;
+        }
+        let mut sp = seed.len();
+        let (mut word, mut mask) = (word, if seed.is_empty() { active } else { 0 });
+        if !seed.is_empty() {
+            // Continued from a short stack: `word` is the child about to be entered, its
+            // rays the last entry of `seed`'s caller (passed as the top of the seed).
+            sp -= 1;
+            (word, mask) = (stack[sp].0, stack[sp].1);
+        }
         loop {
             if word & LEAF != 0 {
                 let mut m = mask;
@@ -247,7 +276,7 @@ impl Bvh {
                 let node = &self.nodes[word as usize];
                 // Per child slot, the rays that enter it, and a `t` no later than any of their
                 // entry ts.
-                let (entered, key) = test.enter::<K, L>(&rays4, node, mask);
+                let (entered, key) = test.enter::<K, L>(rays4, node, mask);
                 // The children entered, nearest first when ordered.
                 let mut hits = [(0u32, 0u32, 0f32); WIDTH];
                 let mut k = 0;
@@ -266,6 +295,16 @@ impl Bvh {
                     k += 1;
                 }
                 if k > 0 {
+                    if N < STACK_SIZE && sp + k > N {
+                        // The pushed children and the one taken next, on the long stack.
+                        let mut deeper = [(0u32, 0u32, 0f32); STACK_SIZE];
+                        deeper[..sp].copy_from_slice(&stack[..sp]);
+                        deeper[sp..sp + k].copy_from_slice(&hits[..k]);
+                        let seed = &deeper[..sp + k];
+                        return self.packet_from::<V, K, L, T, STACK_SIZE>(
+                            rays4, vs, active, seed, 0, test,
+                        );
+                    }
                     (word, mask) = (hits[k - 1].0, hits[k - 1].1);
                     for h in &hits[..k - 1] {
                         self.prefetch_child(h.0);
@@ -691,7 +730,7 @@ const INV_DIR_CLAMP: f32 = (1u64 << 60) as f32;
 mod tests {
     use super::*;
     use crate::accel::bvh::build::stack_need;
-    use crate::accel::{Closest, Prim, Shape};
+    use crate::accel::{AnyHit, Closest, Prim, Shape};
     use crate::geometry::Methods;
 
     /// `transpose8` moves bit `(i, j)` to `(j, i)`.
@@ -710,26 +749,33 @@ mod tests {
         }
     }
 
-    /// A query that overflows the short stack continues on the long one and finds what brute
-    /// force finds: a one-entry short stack overflows on nearly every query.
-    #[test]
-    fn overflow_to_the_long_stack_finds_the_same_hits() {
-        let mut seed = 7u32;
-        let mut rnd = || {
+    /// 3000 small triangles scattered in a box of side 4, and the pseudo-random numbers in
+    /// `[−1, 1]` (seeded by `seed`) that placed them, to go on with.
+    fn scattered_triangles(mut seed: u32) -> (Vec<Prim>, impl FnMut() -> f32) {
+        let mut rnd = move || {
             seed ^= seed << 13;
             seed ^= seed >> 17;
             seed ^= seed << 5;
             seed as f32 / u32::MAX as f32 * 2.0 - 1.0
         };
-        let mut prims = Vec::new();
-        for id in 0..3000u32 {
-            let c = Vec3::new(rnd(), rnd(), rnd()) * 2.0;
-            let v = [0, 1, 2].map(|_| c + Vec3::new(rnd(), rnd(), rnd()) * 0.3);
-            prims.push(Prim {
-                shape: Shape::Triangle(v),
-                id,
-            });
-        }
+        let prims = (0..3000u32)
+            .map(|id| {
+                let c = Vec3::new(rnd(), rnd(), rnd()) * 2.0;
+                let v = [0, 1, 2].map(|_| c + Vec3::new(rnd(), rnd(), rnd()) * 0.3);
+                Prim {
+                    shape: Shape::Triangle(v),
+                    id,
+                }
+            })
+            .collect();
+        (prims, rnd)
+    }
+
+    /// A query that overflows the short stack continues on the long one and finds what brute
+    /// force finds: a one-entry short stack overflows on nearly every query.
+    #[test]
+    fn overflow_to_the_long_stack_finds_the_same_hits() {
+        let (prims, mut rnd) = scattered_triangles(7);
         let bvh = Bvh::build(prims.clone());
         assert!(stack_need(&bvh.nodes) > 1);
         let m = Methods::default();
@@ -750,5 +796,58 @@ mod tests {
             hits += usize::from(brute.hit().is_some());
         }
         assert!(hits > 1000, "{hits}");
+    }
+
+    /// A packet walk that overflows its short stack continues on the long one and finds, ray
+    /// by ray, what brute force finds: an eight-entry short stack overflows on most packets.
+    #[test]
+    fn packet_overflow_to_the_long_stack_finds_the_same_hits() {
+        let (prims, mut rnd) = scattered_triangles(11);
+        let bvh = Bvh::build(prims.clone());
+        let m = Methods::default();
+        let (mut hits, mut blocked) = (0, 0);
+        for _ in 0..300 {
+            // Eight rays from one point in nearby directions, as a camera packet.
+            let o = Vec3::new(rnd(), rnd(), rnd()) * 4.0;
+            let aim = Vec3::new(rnd(), rnd(), rnd()) - o;
+            let rays: [Ray; 8] = std::array::from_fn(|_| {
+                let d = aim + Vec3::new(rnd(), rnd(), rnd()) * 0.2;
+                Ray::new(o, d.normalize())
+            });
+            let mut closest = rays
+                .each_ref()
+                .map(|r| Closest::new(&m, r, 0.0, f32::INFINITY));
+            let mut rays4 = Rays4::<8>::new(&rays, 0.0);
+            for (i, v) in closest.iter().enumerate() {
+                rays4.set_limit(i, v.limit());
+            }
+            bvh.packet_from::<_, 8, 8, Sse4, 8>(&mut rays4, &mut closest, 0xff, &[], 0, Sse4);
+            let length = 3.0;
+            let mut any = rays.each_ref().map(|r| AnyHit {
+                q: crate::accel::Query::new(&m, r, 0.0),
+                t_max: length,
+                hit: false,
+            });
+            let mut rays4 = Rays4::<8>::new(&rays, 0.0);
+            for (i, v) in any.iter().enumerate() {
+                rays4.set_limit(i, v.limit());
+            }
+            bvh.packet_from::<_, 8, 8, Sse4, 8>(&mut rays4, &mut any, 0xff, &[], 0, Sse4);
+            for (i, ray) in rays.iter().enumerate() {
+                let mut brute = Closest::new(&m, ray, 0.0, f32::INFINITY);
+                for p in &prims {
+                    brute.visit(p);
+                }
+                assert_eq!(closest[i].hit(), brute.hit());
+                let occluded = brute.hit().is_some_and(|h| h.t < length);
+                assert_eq!(any[i].hit, occluded);
+                hits += usize::from(brute.hit().is_some());
+                blocked += usize::from(occluded);
+            }
+        }
+        assert!(
+            hits > 1000 && blocked > 500,
+            "{hits} hits, {blocked} blocked"
+        );
     }
 }
