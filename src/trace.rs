@@ -1117,7 +1117,16 @@ fn casts_shadow_ray(
     if color * kd != Vec3::ZERO {
         return true;
     }
-    let t = *terms.get_or_insert_with(|| light_terms_with(shading, material, kd, color, n, l, v));
+    // Not `get_or_insert_with`: left to the heuristics, that generic call was sometimes
+    // not inlined, and the terms' arithmetic with it.
+    let t = match *terms {
+        Some(t) => t,
+        None => {
+            let t = light_terms_with(shading, material, kd, color, n, l, v);
+            *terms = Some(t);
+            t
+        }
+    };
     t.specular != Vec3::ZERO || t.diffuse != Vec3::ZERO
 }
 
