@@ -405,18 +405,15 @@ impl Tracer {
         }
     }
 
-    /// `n` sums for a batch render: the buffer of the last render when it is large enough
-    /// (holding that render's sums: the caller zeroes each tile's part where its worker starts
-    /// it), else a fresh zeroed one. Give it back with [`Tracer::keep_sums`].
+    /// `n` sums for a batch render, in the buffer of the last render (still holding its
+    /// values: the caller zeroes each tile's part where its worker starts it), grown when it
+    /// is smaller. Give it back with [`Tracer::keep_sums`].
     pub(crate) fn take_sums(&self, n: usize) -> Vec<Vec3> {
         let mut kept = self
             .sums
             .lock()
             .map(|mut kept| std::mem::take(&mut *kept))
             .unwrap_or_default();
-        if kept.capacity() < n {
-            return vec![Vec3::ZERO; n];
-        }
         kept.resize(n, Vec3::ZERO);
         kept
     }
@@ -756,6 +753,8 @@ impl Tracer {
             texel_kd = texel(m.diffuse_map);
             texel_ka = texel(m.ambient_map);
         }
+        // Field by field: a whole `SurfaceHit` assigned at once is formed on the stack and
+        // copied (+0.2 % instructions on the 80k bench frame).
         let (surface, out_error) = out;
         surface.t = hit.t;
         surface.point = point;

@@ -222,11 +222,12 @@ impl Bvh {
         for (i, v) in vs.iter().enumerate() {
             rays4.set_limit(i, v.limit());
         }
-        self.packet_from::<V, K, L, T, SHORT_PACKET_STACK>(&mut rays4, vs, active, &[], 0, test);
+        let root = (0, active);
+        self.packet_from::<V, K, L, T, SHORT_PACKET_STACK>(&mut rays4, vs, active, &[], root, test);
     }
 
-    /// The packet walk's loop from child word `word` (its rays `mask`), with `seed` on a
-    /// stack of `N` entries: a walk starts on a short stack (clearing it is part of every
+    /// The packet walk's loop from child word `next.0` with its rays `next.1`, with `seed` on
+    /// a stack of `N` entries: a walk starts on a short stack (clearing it is part of every
     /// walk's cost) and, in the rare case it would overflow, continues on a [`STACK_SIZE`] one.
     #[inline(always)]
     fn packet_from<V: Visitor, const K: usize, const L: usize, T: NodeTest, const N: usize>(
@@ -235,7 +236,7 @@ impl Bvh {
         vs: &mut [V; K],
         mut active: u32,
         seed: &[(u32, u32, f32)],
-        word: u32,
+        next: (u32, u32),
         test: T,
     ) {
         let mut stack = [(0u32, 0u32, 0f32); N];
@@ -243,13 +244,7 @@ impl Bvh {
             *to = *from;
         }
         let mut sp = seed.len();
-        let (mut word, mut mask) = (word, if seed.is_empty() { active } else { 0 });
-        if !seed.is_empty() {
-            // Continued from a short stack: `word` is the child about to be entered, its
-            // rays the last entry of `seed`'s caller (passed as the top of the seed).
-            sp -= 1;
-            (word, mask) = (stack[sp].0, stack[sp].1);
-        }
+        let (mut word, mut mask) = next;
         loop {
             if word & LEAF != 0 {
                 let mut m = mask;
@@ -295,17 +290,18 @@ impl Bvh {
                     k += 1;
                 }
                 if k > 0 {
-                    if N < STACK_SIZE && sp + k > N {
-                        // The pushed children and the one taken next, on the long stack.
+                    let next = (hits[k - 1].0, hits[k - 1].1);
+                    if N < STACK_SIZE && sp + k - 1 > N {
+                        // The pushed children on the long stack, the nearest walked next.
                         let mut deeper = [(0u32, 0u32, 0f32); STACK_SIZE];
                         deeper[..sp].copy_from_slice(&stack[..sp]);
-                        deeper[sp..sp + k].copy_from_slice(&hits[..k]);
-                        let seed = &deeper[..sp + k];
+                        deeper[sp..sp + k - 1].copy_from_slice(&hits[..k - 1]);
+                        let seed = &deeper[..sp + k - 1];
                         return self.packet_from::<V, K, L, T, STACK_SIZE>(
-                            rays4, vs, active, seed, 0, test,
+                            rays4, vs, active, seed, next, test,
                         );
                     }
-                    (word, mask) = (hits[k - 1].0, hits[k - 1].1);
+                    (word, mask) = next;
                     for h in &hits[..k - 1] {
                         self.prefetch_child(h.0);
                         stack[sp] = *h;
@@ -821,7 +817,14 @@ mod tests {
             for (i, v) in closest.iter().enumerate() {
                 rays4.set_limit(i, v.limit());
             }
-            bvh.packet_from::<_, 8, 8, Sse4, 8>(&mut rays4, &mut closest, 0xff, &[], 0, Sse4);
+            bvh.packet_from::<_, 8, 8, Sse4, 8>(
+                &mut rays4,
+                &mut closest,
+                0xff,
+                &[],
+                (0, 0xff),
+                Sse4,
+            );
             let length = 3.0;
             let mut any = rays.each_ref().map(|r| AnyHit {
                 q: crate::accel::Query::new(&m, r, 0.0),
@@ -832,7 +835,7 @@ mod tests {
             for (i, v) in any.iter().enumerate() {
                 rays4.set_limit(i, v.limit());
             }
-            bvh.packet_from::<_, 8, 8, Sse4, 8>(&mut rays4, &mut any, 0xff, &[], 0, Sse4);
+            bvh.packet_from::<_, 8, 8, Sse4, 8>(&mut rays4, &mut any, 0xff, &[], (0, 0xff), Sse4);
             for (i, ray) in rays.iter().enumerate() {
                 let mut brute = Closest::new(&m, ray, 0.0, f32::INFINITY);
                 for p in &prims {
