@@ -240,7 +240,7 @@ pub struct Tracer {
     /// The batch render's per-pixel sums, kept from one render to the next so that a repeated
     /// render (`--frames`, a turntable) writes into memory the process has already touched
     /// instead of faulting in fresh pages (see [`Tracer::take_sums`]).
-    sums: std::sync::Mutex<Vec<Vec3>>,
+    sums: std::sync::Mutex<Vec<[f32; 3]>>,
 }
 
 /// Which of a ray's accelerator queries [`Tracer::visits_of`] replays.
@@ -405,21 +405,29 @@ impl Tracer {
         }
     }
 
-    /// `n` sums for a batch render, in the buffer of the last render (still holding its
-    /// values: the caller zeroes each tile's part where its worker starts it), grown when it
-    /// is smaller. Give it back with [`Tracer::keep_sums`].
-    pub(crate) fn take_sums(&self, n: usize) -> Vec<Vec3> {
-        let mut kept = self
+    /// `n` sums for a batch render, as `[x, y, z]` triples ([`bytemuck::cast_slice_mut`] sees
+    /// them as `Vec3`s): the buffer of the last render (still holding its values: the caller
+    /// zeroes each tile's part where its worker starts it) when it is large enough, otherwise a
+    /// fresh one from the allocator's zeroed pages (`calloc`), which the workers fault in
+    /// tile by tile, in parallel, instead of one thread writing it all before the first tile.
+    /// Give it back with [`Tracer::keep_sums`].
+    pub(crate) fn take_sums(&self, n: usize) -> Vec<[f32; 3]> {
+        let kept = self
             .sums
             .lock()
             .map(|mut kept| std::mem::take(&mut *kept))
             .unwrap_or_default();
-        kept.resize(n, Vec3::ZERO);
-        kept
+        if kept.len() >= n {
+            let mut kept = kept;
+            kept.truncate(n);
+            kept
+        } else {
+            vec![[0.0; 3]; n]
+        }
     }
 
     /// Keeps `sums` for the next batch render ([`Tracer::take_sums`]).
-    pub(crate) fn keep_sums(&self, sums: Vec<Vec3>) {
+    pub(crate) fn keep_sums(&self, sums: Vec<[f32; 3]>) {
         if let Ok(mut kept) = self.sums.lock() {
             *kept = sums;
         }

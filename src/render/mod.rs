@@ -431,11 +431,12 @@ pub(crate) fn render_part_with(
     let total = region.width as u64 * region.height as u64;
     let start = Instant::now();
     // One buffer for every tile's sums, tile after tile: no allocation per tile; the last
-    // render's when there was one (taken inside the timed part, so a fresh buffer's zeroing
-    // and page faults count; a kept one is zeroed tile by tile by the workers, in parallel).
+    // render's when there was one. Taken inside the timed part, so a fresh buffer's page
+    // faults count; either kind is zeroed tile by tile by the workers, in parallel (a fresh
+    // one's pages are faulted in there, not by this thread before the first tile starts).
     let mut sums = tracer.take_sums(total as usize);
     let mut parts: Vec<&mut [Vec3]> = Vec::with_capacity(tiles.len());
-    let mut rest = sums.as_mut_slice();
+    let mut rest: &mut [Vec3] = bytemuck::cast_slice_mut(sums.as_mut_slice());
     for rect in &tiles {
         let (part, tail) = rest.split_at_mut((rect.width * rect.height) as usize);
         parts.push(part);
@@ -471,7 +472,8 @@ pub(crate) fn render_part_with(
     let mut offset = 0;
     for (rect, result) in tiles.iter().zip(results) {
         rays.add(&result?);
-        let tile_sums = &sums[offset..offset + (rect.width * rect.height) as usize];
+        let tile_sums: &[Vec3] =
+            bytemuck::cast_slice(&sums[offset..offset + (rect.width * rect.height) as usize]);
         offset += tile_sums.len();
         for j in 0..rect.height {
             for i in 0..rect.width {
