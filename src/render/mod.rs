@@ -444,9 +444,12 @@ pub(crate) fn render_part_with(
     }
     let done = AtomicU64::new(0);
     let work = || -> Vec<Result<RayCounts, RenderError>> {
+        // One task per tile, so neither worker is left waiting while the other runs a long
+        // unsplit piece (see the viewer's `Job::pass`).
         tiles
             .par_iter()
             .zip(parts.into_par_iter())
+            .with_max_len(1)
             .map(|(&rect, sums)| {
                 sums.fill(Vec3::ZERO);
                 let outcome = catch_unwind(AssertUnwindSafe(|| {
