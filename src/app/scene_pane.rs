@@ -231,60 +231,104 @@ pub fn advance_playback(app: &mut ViewerApp, ctx: &egui::Context) {
     ctx.request_repaint();
 }
 
-/// The toolbar: the step-through (depth slider, play, speed) and the filters.
+/// Width (points) from which the scene view's filters sit in the toolbar as checkboxes; a
+/// narrower pane keeps them in its "Show" menu, so the toolbar stays two or three rows and the
+/// view below keeps its height (at 1024×640 the checkboxes wrapped into five rows and left the
+/// 3D view a strip about 50 points tall once a pixel was clicked).
+pub const FILTERS_INLINE_WIDTH: f32 = 560.0;
+
+/// The smallest 3D view (points) that shows the key of ray colours.
+const KEY_MIN_VIEW: (f32, f32) = (360.0, 320.0);
+
+/// The toolbar: the step-through (play, depth slider, speed), "Frame", and the filters, inline
+/// in a wide pane and in the "Show" menu otherwise (two rows in all, however narrow).
 fn toolbar(app: &mut ViewerApp, ui: &mut Ui) {
+    let inline = ui.available_width() >= FILTERS_INLINE_WIDTH;
+    if inline {
+        ui.horizontal_wrapped(|ui| {
+            step_through(app, ui);
+            speed_and_frame(app, ui, true);
+        });
+        ui.horizontal_wrapped(|ui| filters(app, ui));
+    } else {
+        ui.horizontal(|ui| step_through(app, ui));
+        ui.horizontal_wrapped(|ui| {
+            speed_and_frame(app, ui, false);
+            ui.menu_button("Show", |ui| filters(app, ui))
+                .response
+                .on_hover_text("ray kinds, normals, visits, BVH level and end reasons shown");
+        });
+    }
+}
+
+/// Play (or Pause) and the depth slider, which takes the row's remaining width.
+fn step_through(app: &mut ViewerApp, ui: &mut Ui) {
     let deepest = deepest(app.trees());
-    ui.horizontal_wrapped(|ui| {
-        let mut depth = app.tree_state.reveal.unwrap_or(deepest).min(deepest);
-        let l = ui.label("depth");
-        let r = ui
-            .add(egui::Slider::new(&mut depth, 0..=deepest.max(1)))
-            .labelled_by(l.id)
-            .on_hover_text("show the tree down to this generation");
-        if r.changed() {
-            app.tree_state.reveal = (depth < deepest).then_some(depth);
+    let playing = app.scene_view.playing.is_some();
+    if ui
+        .button(if playing { "Pause" } else { "Play" })
+        .on_hover_text("reveal the tree generation by generation")
+        .clicked()
+    {
+        if playing {
             app.scene_view.playing = None;
+        } else {
+            app.tree_state.reveal = Some(0);
+            app.scene_view.playing = Some(Instant::now());
         }
-        let playing = app.scene_view.playing.is_some();
-        if ui
-            .button(if playing { "Pause" } else { "Play" })
-            .on_hover_text("reveal the tree generation by generation")
-            .clicked()
-        {
-            if playing {
-                app.scene_view.playing = None;
-            } else {
-                app.tree_state.reveal = Some(0);
-                app.scene_view.playing = Some(Instant::now());
-            }
-        }
+    }
+    let mut depth = app.tree_state.reveal.unwrap_or(deepest).min(deepest);
+    let l = ui.label("depth");
+    // What the slider's value box and the spacing before it take.
+    const VALUE_BOX: f32 = 48.0;
+    ui.spacing_mut().slider_width = (ui.available_width() - VALUE_BOX).clamp(30.0, 160.0);
+    let r = ui
+        .add(egui::Slider::new(&mut depth, 0..=deepest.max(1)))
+        .labelled_by(l.id)
+        .on_hover_text("show the tree down to this generation");
+    if r.changed() {
+        app.tree_state.reveal = (depth < deepest).then_some(depth);
+        app.scene_view.playing = None;
+    }
+}
+
+/// The playback speed (labelled where there is room) and "Frame".
+fn speed_and_frame(app: &mut ViewerApp, ui: &mut Ui, labelled: bool) {
+    let speed = egui::DragValue::new(&mut app.scene_view.speed)
+        .range(0.25..=8.0)
+        .speed(0.05)
+        .suffix(" gen/s");
+    if labelled {
         let l = ui.label("speed");
-        ui.add(
-            egui::DragValue::new(&mut app.scene_view.speed)
-                .range(0.25..=8.0)
-                .speed(0.05)
-                .suffix(" gen/s"),
-        )
-        .labelled_by(l.id);
-        if ui.button("Frame").clicked() {
-            let scene = app.scene.clone();
-            app.scene_view.frame(&scene);
-            app.scene_view.restart(&app.tracer);
-        }
-    });
-    ui.horizontal_wrapped(|ui| {
-        let f = &mut app.scene_view.filter;
-        ui.checkbox(&mut f.primary, "primary");
-        ui.checkbox(&mut f.reflected, "reflected");
-        ui.checkbox(&mut f.refracted, "refracted");
-        ui.checkbox(&mut f.shadow, "shadow");
-        ui.checkbox(&mut f.normals, "normals");
-        ui.checkbox(&mut app.scene_view.show_visits, "visits")
-            .on_hover_text(
-                "the boxes the selected ray's traversal entered (BVH nodes or grid cells)",
-            );
-        let levels = app.tracer.accel.levels();
-        let mut on = app.scene_view.bvh_level.is_some();
+        ui.add(speed).labelled_by(l.id);
+    } else {
+        ui.add(speed).on_hover_text("playback speed");
+    }
+    if ui
+        .button("Frame")
+        .on_hover_text("frame the scene and the render camera")
+        .clicked()
+    {
+        let scene = app.scene.clone();
+        app.scene_view.frame(&scene);
+        app.scene_view.restart(&app.tracer);
+    }
+}
+
+/// The scene view's filters: ray kinds, normals, the selected ray's visits, one BVH level, and
+/// the end reasons (a menu of its own).
+fn filters(app: &mut ViewerApp, ui: &mut Ui) {
+    let f = &mut app.scene_view.filter;
+    ui.checkbox(&mut f.primary, "primary");
+    ui.checkbox(&mut f.reflected, "reflected");
+    ui.checkbox(&mut f.refracted, "refracted");
+    ui.checkbox(&mut f.shadow, "shadow");
+    ui.checkbox(&mut f.normals, "normals");
+    ui.checkbox(&mut app.scene_view.show_visits, "visits")
+        .on_hover_text("the boxes the selected ray's traversal entered (BVH nodes or grid cells)");
+    let levels = app.tracer.accel.levels();
+    let mut on = app.scene_view.bvh_level.is_some();
+    ui.horizontal(|ui| {
         if ui
             .checkbox(&mut on, "BVH level")
             .on_hover_text("every box of one level of the accelerator")
@@ -295,24 +339,24 @@ fn toolbar(app: &mut ViewerApp, ui: &mut Ui) {
         if let Some(level) = &mut app.scene_view.bvh_level {
             ui.add(egui::DragValue::new(level).range(0..=levels.saturating_sub(1)));
         }
-        let f = &mut app.scene_view.filter;
-        ui.menu_button("ends", |ui| {
-            for end in [
-                EndReason::NoHit,
-                EndReason::HitLight,
-                EndReason::MaxDepth,
-                EndReason::Cutoff,
-                EndReason::Budget,
-            ] {
-                let mut shown = !f.hidden_ends.contains(&end);
-                if ui.checkbox(&mut shown, tree_view::end_label(end)).changed() {
-                    f.hidden_ends.retain(|e| *e != end);
-                    if !shown {
-                        f.hidden_ends.push(end);
-                    }
+    });
+    let f = &mut app.scene_view.filter;
+    ui.menu_button("ends", |ui| {
+        for end in [
+            EndReason::NoHit,
+            EndReason::HitLight,
+            EndReason::MaxDepth,
+            EndReason::Cutoff,
+            EndReason::Budget,
+        ] {
+            let mut shown = !f.hidden_ends.contains(&end);
+            if ui.checkbox(&mut shown, tree_view::end_label(end)).changed() {
+                f.hidden_ends.retain(|e| *e != end);
+                if !shown {
+                    f.hidden_ends.push(end);
                 }
             }
-        });
+        }
     });
 }
 
@@ -487,7 +531,9 @@ pub fn scene_view_ui(app: &mut ViewerApp, ui: &mut Ui) {
         ..app.scene_view.filter.clone()
     };
     let drawn = draw_trees(app, &painter, &view, &depth, &filter);
-    if app.tree.is_some() {
+    // The key of ray colours, where it leaves most of the view free (the render pane shows
+    // the same key over the image).
+    if app.tree.is_some() && rect.width() >= KEY_MIN_VIEW.0 && rect.height() >= KEY_MIN_VIEW.1 {
         super::legend::ray_key(&painter, rect);
     }
     pick_and_hover(app, &response, &drawn);

@@ -37,10 +37,14 @@ impl Pane {
 pub type Layout = egui_tiles::Tree<Pane>;
 
 /// The version of [`default_layout`]: a saved layout of another version is replaced.
-pub const LAYOUT_VERSION: u32 = 2;
+pub const LAYOUT_VERSION: u32 = 3;
 
 /// The render pane's share of the workspace's width in the default layout.
 pub const RENDER_SHARE: f32 = 0.74;
+
+/// The scene view's share of the right column's height once the tree's pane is open: the
+/// larger part, as the 3D view is where a tree is read in space.
+pub const SCENE_SHARE: f32 = 0.55;
 
 fn tabs(tiles: &mut egui_tiles::Tiles<Pane>, pane: Pane) -> TileId {
     let id = tiles.insert_pane(pane);
@@ -57,7 +61,7 @@ pub fn default_layout() -> Layout {
     let list = tiles.insert_pane(Pane::TreeList);
     let tree = tiles.insert_tab_tile(vec![diagram, list]);
     let right =
-        tiles.insert_container(Linear::new_binary(LinearDir::Vertical, [scene, tree], 0.45));
+        tiles.insert_container(Linear::new_binary(LinearDir::Vertical, [scene, tree], SCENE_SHARE));
     let root = tiles.insert_container(Linear::new_binary(
         LinearDir::Horizontal,
         [render, right],
