@@ -395,7 +395,8 @@ impl TravRay {
 struct Rays4<const L: usize> {
     o: [[f32; L]; 3],
     inv: [[f32; L]; 3],
-    /// Each ray's [`TravRay::near`].
+    /// Each ray's [`TravRay::near`] (read by the AVX2 test only, so unread off x86-64).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     near: [[u32; 3]; L],
     t_min: f32,
     /// Each ray's [`Visitor::limit`], as of its last leaf.
