@@ -634,16 +634,23 @@ fn image_share(h: &Harness<'static, ViewerApp>) -> f32 {
 /// Once a pixel is clicked, the scene view shares its column with the tree's pane: its toolbar
 /// stays at most three rows and the 3D view below keeps a third of the window's height, at
 /// both window sizes (at 1024×640 the filters wrapped into five rows and left it a strip). In
-/// a narrow pane the filters are in the "Show" menu, and work from there.
+/// a narrow pane the filters are in the "Show" menu, which stays open while they are clicked.
 #[test]
 fn the_scene_view_keeps_a_third_of_the_height_beside_a_tree() {
     for size in [[1024.0, 640.0], [1600.0, 1000.0]] {
         let mut h = window(small("default"), size);
         follow_pane(&mut h);
         let image = h.get_by_label("render viewport").rect();
-        click(&mut h, image.lerp_inside(egui::vec2(0.35, 0.6)), egui::Modifiers::NONE);
+        click(
+            &mut h,
+            image.lerp_inside(egui::vec2(0.35, 0.6)),
+            egui::Modifiers::NONE,
+        );
         h.run_steps(3);
-        assert!(h.state().tree.is_some(), "{size:?}: no tree after the click");
+        assert!(
+            h.state().tree.is_some(),
+            "{size:?}: no tree after the click"
+        );
         let view = h.get_by_label("scene view").rect();
         let play = h.get_by_role_and_label(Role::Button, "Play").rect();
         assert!(
@@ -666,6 +673,13 @@ fn the_scene_view_keeps_a_third_of_the_height_beside_a_tree() {
             assert!(
                 !h.state().scene_view.filter.shadow,
                 "{size:?}: the Show menu's shadow box did not hide the shadow rays"
+            );
+            // The menu stays open: a second box in the same visit.
+            h.get_by_label("reflected").click();
+            h.run_steps(2);
+            assert!(
+                !h.state().scene_view.filter.reflected,
+                "{size:?}: the Show menu closed after one click"
             );
         }
     }

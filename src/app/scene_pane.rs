@@ -16,6 +16,7 @@
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+use eframe::egui::containers::menu::{self, MenuButton, MenuConfig};
 use eframe::egui::{self, Color32, Sense, Ui};
 use glam::Vec3;
 
@@ -254,8 +255,10 @@ fn toolbar(app: &mut ViewerApp, ui: &mut Ui) {
         ui.horizontal(|ui| step_through(app, ui));
         ui.horizontal_wrapped(|ui| {
             speed_and_frame(app, ui, false);
-            ui.menu_button("Show", |ui| filters(app, ui))
-                .response
+            MenuButton::new("Show")
+                .config(stays_open())
+                .ui(ui, |ui| filters(app, ui))
+                .0
                 .on_hover_text("ray kinds, normals, visits, BVH level and end reasons shown");
         });
     }
@@ -315,6 +318,12 @@ fn speed_and_frame(app: &mut ViewerApp, ui: &mut Ui, labelled: bool) {
     }
 }
 
+/// A menu of checkboxes that stays open while they are clicked (egui closes a menu on any click
+/// by default), so several filters change in one visit and the BVH level's box can be dragged.
+fn stays_open() -> MenuConfig {
+    MenuConfig::new().close_behavior(egui::PopupCloseBehavior::CloseOnClickOutside)
+}
+
 /// The scene view's filters: ray kinds, normals, the selected ray's visits, one BVH level, and
 /// the end reasons (a menu of its own).
 fn filters(app: &mut ViewerApp, ui: &mut Ui) {
@@ -341,7 +350,7 @@ fn filters(app: &mut ViewerApp, ui: &mut Ui) {
         }
     });
     let f = &mut app.scene_view.filter;
-    ui.menu_button("ends", |ui| {
+    let ends = |ui: &mut Ui| {
         for end in [
             EndReason::NoHit,
             EndReason::HitLight,
@@ -357,7 +366,14 @@ fn filters(app: &mut ViewerApp, ui: &mut Ui) {
                 }
             }
         }
-    });
+    };
+    // Inside the Show menu a submenu (which keeps that menu's behaviour), a menu of its own in
+    // the toolbar.
+    if menu::is_in_menu(ui) {
+        ui.menu_button("ends", ends);
+    } else {
+        MenuButton::new("ends").config(stays_open()).ui(ui, ends);
+    }
 }
 
 /// Every segment the scene view and the overlay draw for `tree`, shown by `filter`.

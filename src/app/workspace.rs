@@ -60,8 +60,11 @@ pub fn default_layout() -> Layout {
     let diagram = tiles.insert_pane(Pane::Diagram);
     let list = tiles.insert_pane(Pane::TreeList);
     let tree = tiles.insert_tab_tile(vec![diagram, list]);
-    let right =
-        tiles.insert_container(Linear::new_binary(LinearDir::Vertical, [scene, tree], SCENE_SHARE));
+    let right = tiles.insert_container(Linear::new_binary(
+        LinearDir::Vertical,
+        [scene, tree],
+        SCENE_SHARE,
+    ));
     let root = tiles.insert_container(Linear::new_binary(
         LinearDir::Horizontal,
         [render, right],

@@ -508,45 +508,49 @@ impl Job {
         // stolen from runs a quarter of the tiles as one sequential piece, and the other
         // worker, out of pieces to steal, waited for it (70 of the 1-spp pass's 195 ms idle
         // at 1280×720 on 2 threads).
-        order.par_iter().enumerate().with_max_len(1).for_each(|(i, &rect)| {
-            if self.stale() {
-                return;
-            }
-            match catch_unwind(AssertUnwindSafe(|| {
-                if let Some(hook) = &self.tile_hook {
-                    hook(pass, rect);
+        order
+            .par_iter()
+            .enumerate()
+            .with_max_len(1)
+            .for_each(|(i, &rect)| {
+                if self.stale() {
+                    return;
                 }
-                work(rect, i)
-            })) {
-                Ok((pixels, aux)) => {
-                    if self.stale() {
-                        return;
+                match catch_unwind(AssertUnwindSafe(|| {
+                    if let Some(hook) = &self.tile_hook {
+                        hook(pass, rect);
                     }
-                    self.stats
-                        .pixels_done
-                        .fetch_add(pixels.len() as u64, Ordering::Relaxed);
-                    self.send(SessionEvent::Tile(TileUpdate {
-                        generation: self.generation,
-                        pass,
-                        rect,
-                        pixels,
-                        aux,
-                    }));
-                }
-                Err(panic) => {
-                    let message = panic_message(panic.as_ref());
-                    if !self.failed.swap(true, Ordering::Relaxed) {
-                        self.send(SessionEvent::Failed {
+                    work(rect, i)
+                })) {
+                    Ok((pixels, aux)) => {
+                        if self.stale() {
+                            return;
+                        }
+                        self.stats
+                            .pixels_done
+                            .fetch_add(pixels.len() as u64, Ordering::Relaxed);
+                        self.send(SessionEvent::Tile(TileUpdate {
                             generation: self.generation,
-                            message: format!(
-                                "a render worker failed on the tile at ({}, {}): {message}",
-                                rect.x, rect.y
-                            ),
-                        });
+                            pass,
+                            rect,
+                            pixels,
+                            aux,
+                        }));
+                    }
+                    Err(panic) => {
+                        let message = panic_message(panic.as_ref());
+                        if !self.failed.swap(true, Ordering::Relaxed) {
+                            self.send(SessionEvent::Failed {
+                                generation: self.generation,
+                                message: format!(
+                                    "a render worker failed on the tile at ({}, {}): {message}",
+                                    rect.x, rect.y
+                                ),
+                            });
+                        }
                     }
                 }
-            }
-        });
+            });
         if !self.stale() {
             self.send(SessionEvent::PassDone {
                 generation: self.generation,
