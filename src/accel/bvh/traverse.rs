@@ -395,8 +395,7 @@ impl TravRay {
 struct Rays4<const L: usize> {
     o: [[f32; L]; 3],
     inv: [[f32; L]; 3],
-    /// Each ray's [`TravRay::near`] (read by the AVX2 test only, so unread off x86-64).
-    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+    /// Each ray's [`TravRay::near`].
     near: [[u32; 3]; L],
     t_min: f32,
     /// Each ray's [`Visitor::limit`], as of its last leaf.
@@ -444,12 +443,62 @@ trait NodeTest: Copy {
     /// ray `r` meets (bit `i` for slot `i`), and each slot's widened entry `t`.
     fn enter_one(&self, r: &TravRay, node: &super::Node, limit: f32) -> (u32, [f32; WIDTH]);
 
+    /// Each slot's nearest entry so far, as the test keeps it.
+    type Keys: Copy;
+
+    /// No entry yet (every key infinite).
+    fn no_keys(&self) -> Self::Keys;
+
+    /// Ray `ray` of `r` against `node`'s boxes, as [`NodeTest::enter_one`] tests them: the
+    /// slots it meets (not yet masked by `valid`), with its entry `t` of each slot it meets
+    /// folded into `keys` (an empty slot's key, from its zero box, is never read: no ray
+    /// enters it).
+    fn one_of<const L: usize>(
+        &self,
+        r: &Rays4<L>,
+        node: &super::Node,
+        ray: usize,
+        keys: &mut Self::Keys,
+    ) -> u32;
+
+    /// The keys as one `t` per slot.
+    fn key_array(&self, keys: Self::Keys) -> [f32; WIDTH];
+
+    /// The packet's test, ray by ray, each ray against the node's boxes as the single walk
+    /// tests them: deep in the tree a packet's rays have parted, and a box tested against all
+    /// its lanes pays for rays no longer in the packet. The rays' slot masks, eight rays at a
+    /// time, form an 8×8 bit matrix, transposed into each slot's rays (bit `i` of
+    /// `entered[c]`: ray `i` enters slot `c`).
+    #[inline(always)]
     fn enter<const K: usize, const L: usize>(
         &self,
         r: &Rays4<L>,
         node: &super::Node,
         mask: u32,
-    ) -> ([u32; WIDTH], [f32; WIDTH]);
+    ) -> ([u32; WIDTH], [f32; WIDTH]) {
+        const { assert!(WIDTH == 8) };
+        let mut entered = [0u32; WIDTH];
+        let mut keys = self.no_keys();
+        for g in 0..K.div_ceil(8) {
+            let group = (mask >> (8 * g)) & 0xff;
+            if group == 0 {
+                continue;
+            }
+            let mut rows = 0u64;
+            let mut m = group;
+            while m != 0 {
+                let i = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let slots = self.one_of(r, node, 8 * g + i, &mut keys) & node.valid;
+                rows |= u64::from(slots) << (8 * i);
+            }
+            let columns = transpose8(rows);
+            for (c, e) in entered.iter_mut().enumerate() {
+                *e |= (((columns >> (8 * c)) & 0xff) as u32) << (8 * g);
+            }
+        }
+        (entered, self.key_array(keys))
+    }
 }
 
 /// The node test four rays wide (SSE, glam).
@@ -459,77 +508,87 @@ struct Sse4;
 impl NodeTest for Sse4 {
     #[inline(always)]
     fn enter_one(&self, r: &TravRay, node: &super::Node, limit: f32) -> (u32, [f32; WIDTH]) {
-        let (nx, ny, nz) = (r.near[0], r.near[1], r.near[2]);
-        let (fx, fy, fz) = (nx ^ 1, ny ^ 1, nz ^ 1);
-        let slack = Vec4::splat(box_t_slack());
+        let (o, inv) = ([r.ox, r.oy, r.oz], [r.ix, r.iy, r.iz]);
         let limit = Vec4::splat(limit);
         let mut mask = 0;
         let mut t = [0.0; WIDTH];
         for half in 0..WIDTH / 4 {
-            let lanes = 4 * half..4 * half + 4;
-            let p = |k: usize| Vec4::from_slice(&node.planes[k][lanes.clone()]);
-            let t_near = ((p(nx) - r.ox) * r.ix)
-                .max((p(ny) - r.oy) * r.iy)
-                .max((p(nz) - r.oz) * r.iz);
-            let t_far = ((p(fx) - r.ox) * r.ix)
-                .min((p(fy) - r.oy) * r.iy)
-                .min((p(fz) - r.oz) * r.iz);
-            // Widen both ends by the rounding of the slab arithmetic *and* of the primitives'
-            // own t: a tie (equal t, lower id) in a flat box must not be culled by an ulp.
-            let t_near = (t_near - t_near.abs() * slack).max(r.t_min);
-            let t_far = (t_far + t_far.abs() * slack).min(limit);
-            mask |= t_near.cmple(t_far).bitmask() << (4 * half);
-            t[lanes].copy_from_slice(&t_near.to_array());
+            let (hit, t_near) = Self::slab(node, half, o, inv, r.near, r.t_min, limit);
+            mask |= hit.bitmask() << (4 * half);
+            t[4 * half..4 * half + 4].copy_from_slice(&t_near.to_array());
         }
         (mask & node.valid, t)
     }
 
+    type Keys = [Vec4; WIDTH / 4];
+
     #[inline(always)]
-    fn enter<const K: usize, const L: usize>(
+    fn no_keys(&self) -> Self::Keys {
+        [Vec4::INFINITY; WIDTH / 4]
+    }
+
+    /// The eight boxes four at a time.
+    #[inline(always)]
+    fn one_of<const L: usize>(
         &self,
         r: &Rays4<L>,
         node: &super::Node,
-        mask: u32,
-    ) -> ([u32; WIDTH], [f32; WIDTH]) {
-        let mut entered = [0u32; WIDTH];
-        let mut key = [f32::INFINITY; WIDTH];
-        let planes = &node.planes;
-        let slack = Vec4::splat(box_t_slack());
-        let t_min = Vec4::splat(r.t_min);
-        for g in 0..K.div_ceil(4) {
-            let group = (mask >> (4 * g)) & 0xf;
-            if group == 0 {
-                continue;
-            }
-            let lanes = 4 * g..4 * g + 4;
-            let load = |a: &[f32; L]| Vec4::from_slice(&a[lanes.clone()]);
-            let (ox, oy, oz) = (load(&r.o[0]), load(&r.o[1]), load(&r.o[2]));
-            let (ix, iy, iz) = (load(&r.inv[0]), load(&r.inv[1]), load(&r.inv[2]));
-            let limit = load(&r.limit);
-            let mut valid = node.valid;
-            while valid != 0 {
-                let c = valid.trailing_zeros() as usize;
-                valid &= valid - 1;
-                let ax = (Vec4::splat(planes[0][c]) - ox) * ix;
-                let bx = (Vec4::splat(planes[1][c]) - ox) * ix;
-                let ay = (Vec4::splat(planes[2][c]) - oy) * iy;
-                let by = (Vec4::splat(planes[3][c]) - oy) * iy;
-                let az = (Vec4::splat(planes[4][c]) - oz) * iz;
-                let bz = (Vec4::splat(planes[5][c]) - oz) * iz;
-                let t_near = ax.min(bx).max(ay.min(by)).max(az.min(bz));
-                let t_far = ax.max(bx).min(ay.max(by)).min(az.max(bz));
-                let t_near = (t_near - t_near.abs() * slack).max(t_min);
-                let t_far = (t_far + t_far.abs() * slack).min(limit);
-                let hit = t_near.cmple(t_far);
-                let bits = hit.bitmask() & group;
-                if bits != 0 {
-                    entered[c] |= bits << (4 * g);
-                    let t = Vec4::select(hit, t_near, Vec4::INFINITY).min_element();
-                    key[c] = key[c].min(t);
-                }
-            }
+        ray: usize,
+        keys: &mut Self::Keys,
+    ) -> u32 {
+        let o = [0, 1, 2].map(|axis| Vec4::splat(r.o[axis][ray]));
+        let inv = [0, 1, 2].map(|axis| Vec4::splat(r.inv[axis][ray]));
+        let near = r.near[ray].map(|n| n as usize);
+        let (t_min, limit) = (Vec4::splat(r.t_min), Vec4::splat(r.limit[ray]));
+        let mut bits = 0;
+        for (half, key) in keys.iter_mut().enumerate() {
+            let (hit, t_near) = Self::slab(node, half, o, inv, near, t_min, limit);
+            bits |= hit.bitmask() << (4 * half);
+            *key = key.min(Vec4::select(hit, t_near, Vec4::INFINITY));
         }
-        (entered, key)
+        bits
+    }
+
+    #[inline(always)]
+    fn key_array(&self, keys: Self::Keys) -> [f32; WIDTH] {
+        let mut key = [f32::INFINITY; WIDTH];
+        for (half, k) in keys.iter().enumerate() {
+            key[4 * half..4 * half + 4].copy_from_slice(&k.to_array());
+        }
+        key
+    }
+}
+
+impl Sse4 {
+    /// The widened slab test of one ray (origin `o`, clamped `1/d` `inv`, near planes `near`,
+    /// each splat over four lanes) against slots `4·half..4·half + 4` of `node`: the slots met
+    /// (not yet masked by `valid`) and each slot's widened entry `t`.
+    #[inline(always)]
+    fn slab(
+        node: &super::Node,
+        half: usize,
+        o: [Vec4; 3],
+        inv: [Vec4; 3],
+        near: [usize; 3],
+        t_min: Vec4,
+        limit: Vec4,
+    ) -> (glam::BVec4A, Vec4) {
+        let [nx, ny, nz] = near;
+        let (fx, fy, fz) = (nx ^ 1, ny ^ 1, nz ^ 1);
+        let lanes = 4 * half..4 * half + 4;
+        let p = |k: usize| Vec4::from_slice(&node.planes[k][lanes.clone()]);
+        let t_near = ((p(nx) - o[0]) * inv[0])
+            .max((p(ny) - o[1]) * inv[1])
+            .max((p(nz) - o[2]) * inv[2]);
+        let t_far = ((p(fx) - o[0]) * inv[0])
+            .min((p(fy) - o[1]) * inv[1])
+            .min((p(fz) - o[2]) * inv[2]);
+        // Widen both ends by the rounding of the slab arithmetic *and* of the primitives'
+        // own t: a tie (equal t, lower id) in a flat box must not be culled by an ulp.
+        let slack = Vec4::splat(box_t_slack());
+        let t_near = (t_near - t_near.abs() * slack).max(t_min);
+        let t_far = (t_far + t_far.abs() * slack).min(limit);
+        (t_near.cmple(t_far), t_near)
     }
 }
 
@@ -599,48 +658,35 @@ impl NodeTest for Avx8 {
         (mask & node.valid, pulp::cast(t_near))
     }
 
+    type Keys = std::arch::x86_64::__m256;
+
     #[inline(always)]
-    fn enter<const K: usize, const L: usize>(
+    fn no_keys(&self) -> Self::Keys {
+        self.0.avx._mm256_set1_ps(f32::INFINITY)
+    }
+
+    /// The eight boxes at once.
+    #[inline(always)]
+    fn one_of<const L: usize>(
         &self,
         r: &Rays4<L>,
         node: &super::Node,
-        mask: u32,
-    ) -> ([u32; WIDTH], [f32; WIDTH]) {
-        // Ray by ray, each ray against the eight boxes at once (as the single walk tests
-        // them): deep in the tree a packet's rays have parted, and slot by slot (a box
-        // against eight rays) tests rays no longer in the packet. The rays' slot masks form
-        // an 8×8 bit matrix, transposed into each slot's rays.
+        ray: usize,
+        keys: &mut Self::Keys,
+    ) -> u32 {
         let avx = self.0.avx;
-        let mut entered = [0u32; WIDTH];
-        let mut keys = avx._mm256_set1_ps(f32::INFINITY);
-        for g in 0..K.div_ceil(8) {
-            let group = (mask >> (8 * g)) & 0xff;
-            if group == 0 {
-                continue;
-            }
-            let mut rows = 0u64;
-            let mut m = group;
-            while m != 0 {
-                let i = m.trailing_zeros() as usize;
-                m &= m - 1;
-                let ray = 8 * g + i;
-                let o = [r.o[0][ray], r.o[1][ray], r.o[2][ray]];
-                let inv = [r.inv[0][ray], r.inv[1][ray], r.inv[2][ray]];
-                let near = r.near[ray].map(|n| n as usize);
-                let (hit, t_near) = self.slab(node, o, inv, near, r.t_min, r.limit[ray]);
-                let bits = avx._mm256_movemask_ps(hit) as u32 & node.valid;
-                rows |= u64::from(bits) << (8 * i);
-                // The nearest entry of the rays that enter each slot (an empty slot's key,
-                // from its zero box, is never read: no ray enters it).
-                let inf = avx._mm256_set1_ps(f32::INFINITY);
-                keys = avx._mm256_min_ps(keys, avx._mm256_blendv_ps(inf, t_near, hit));
-            }
-            let columns = transpose8(rows);
-            for (c, e) in entered.iter_mut().enumerate() {
-                *e |= (((columns >> (8 * c)) & 0xff) as u32) << (8 * g);
-            }
-        }
-        (entered, pulp::cast(keys))
+        let o = [r.o[0][ray], r.o[1][ray], r.o[2][ray]];
+        let inv = [r.inv[0][ray], r.inv[1][ray], r.inv[2][ray]];
+        let near = r.near[ray].map(|n| n as usize);
+        let (hit, t_near) = self.slab(node, o, inv, near, r.t_min, r.limit[ray]);
+        let inf = avx._mm256_set1_ps(f32::INFINITY);
+        *keys = avx._mm256_min_ps(*keys, avx._mm256_blendv_ps(inf, t_near, hit));
+        avx._mm256_movemask_ps(hit) as u32
+    }
+
+    #[inline(always)]
+    fn key_array(&self, keys: Self::Keys) -> [f32; WIDTH] {
+        pulp::cast(keys)
     }
 }
 
@@ -695,7 +741,6 @@ impl Avx8 {
     }
 }
 
-#[cfg(target_arch = "x86_64")]
 /// The transpose of an 8×8 bit matrix whose row `i` is byte `i` (bit `j` of the byte for
 /// column `j`): row `j` of the result holds column `j`.
 #[inline(always)]
@@ -731,7 +776,6 @@ mod tests {
     use crate::geometry::Methods;
 
     /// `transpose8` moves bit `(i, j)` to `(j, i)`.
-    #[cfg(target_arch = "x86_64")]
     #[test]
     fn bit_matrix_transpose() {
         let mut x = 0x9E37_79B9_7F4A_7C15u64;
