@@ -3,7 +3,8 @@
 # run under qemu-user: the library's unit tests, the packet traversal's bit-identity tests (on
 # ARM the 4-wide node test runs on glam's NEON vectors and there is no AVX2 path), the renders
 # against the golden images, and the trace tests. The headless core only (no window, no
-# lab), so no C++ cross build is needed. Installs the cross toolchain and qemu itself; about 5 minutes on 2 cores.
+# lab), so no C++ cross build is needed. Installs the cross toolchain and qemu itself; about
+# 5 minutes on 2 cores.
 # Not part of scripts/test.sh: it downloads a cross toolchain and rust-std for a second target.
 # Usage: bash scripts/test-aarch64.sh
 set -euo pipefail

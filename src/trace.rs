@@ -412,18 +412,16 @@ impl Tracer {
     /// tile by tile, in parallel, instead of one thread writing it all before the first tile.
     /// Give it back with [`Tracer::keep_sums`].
     pub(crate) fn take_sums(&self, n: usize) -> Vec<[f32; 3]> {
-        let kept = self
+        let mut kept = self
             .sums
             .lock()
             .map(|mut kept| std::mem::take(&mut *kept))
             .unwrap_or_default();
-        if kept.len() >= n {
-            let mut kept = kept;
-            kept.truncate(n);
-            kept
-        } else {
-            vec![[0.0; 3]; n]
+        if kept.len() < n {
+            return vec![[0.0; 3]; n];
         }
+        kept.truncate(n);
+        kept
     }
 
     /// Keeps `sums` for the next batch render ([`Tracer::take_sums`]).

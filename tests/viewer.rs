@@ -631,6 +631,16 @@ fn image_share(h: &Harness<'static, ViewerApp>) -> f32 {
     image.area() / window.area()
 }
 
+/// Clicks the render image a third of the way across and a little below the middle, lets the
+/// tree open, and gives the point clicked.
+fn click_a_third_across(h: &mut Harness<'static, ViewerApp>) -> egui::Pos2 {
+    let image = h.get_by_label("render viewport").rect();
+    let at = image.lerp_inside(egui::vec2(0.35, 0.6));
+    click(h, at, egui::Modifiers::NONE);
+    h.run_steps(3);
+    at
+}
+
 /// Once a pixel is clicked, the scene view shares its column with the tree's pane: its toolbar
 /// stays at most three rows and the 3D view below keeps a third of the window's height, at
 /// both window sizes (at 1024×640 the filters wrapped into five rows and left it a strip). In
@@ -640,13 +650,7 @@ fn the_scene_view_keeps_a_third_of_the_height_beside_a_tree() {
     for size in [[1024.0, 640.0], [1600.0, 1000.0]] {
         let mut h = window(small("default"), size);
         follow_pane(&mut h);
-        let image = h.get_by_label("render viewport").rect();
-        click(
-            &mut h,
-            image.lerp_inside(egui::vec2(0.35, 0.6)),
-            egui::Modifiers::NONE,
-        );
-        h.run_steps(3);
+        click_a_third_across(&mut h);
         assert!(
             h.state().tree.is_some(),
             "{size:?}: no tree after the click"
@@ -697,9 +701,7 @@ fn the_render_holds_half_the_window_and_its_place_when_a_pixel_is_clicked() {
             "{size:?}: the render has {share:.2} of the window"
         );
         // Click a third of the way across: the tree is of the pixel under the pointer.
-        let at = before.lerp_inside(egui::vec2(0.35, 0.6));
-        click(&mut h, at, egui::Modifiers::NONE);
-        h.run_steps(3);
+        let at = click_a_third_across(&mut h);
         let tree = h.state().tree.clone().expect("a tree after the click");
         let after = h.get_by_label("render viewport").rect();
         assert_eq!(before, after, "{size:?}: the render moved or changed size");

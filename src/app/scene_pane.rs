@@ -242,7 +242,7 @@ pub const FILTERS_INLINE_WIDTH: f32 = 560.0;
 const KEY_MIN_VIEW: (f32, f32) = (360.0, 320.0);
 
 /// The toolbar: the step-through (play, depth slider, speed), "Frame", and the filters, inline
-/// in a wide pane and in the "Show" menu otherwise (two rows in all, however narrow).
+/// in a wide pane and in the "Show" menu otherwise (two rows, three in the narrowest pane).
 fn toolbar(app: &mut ViewerApp, ui: &mut Ui) {
     let inline = ui.available_width() >= FILTERS_INLINE_WIDTH;
     if inline {
