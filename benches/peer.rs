@@ -23,8 +23,8 @@
 //! shading rounds as raytree's).
 //!
 //! Each process builds once and renders K frames (`--frames`, default 5): the first frame is
-//! frame 1, the warm frame the median of frames 2..K. Rounds alternate (who goes first turns
-//! each round); each round's Embree time is divided by the same round's raytree time, and the
+//! frame 1, the warm frame the median of frames 2..K. Each size starts with `--warmup` rounds
+//! (default 1) that are run and dropped. Rounds alternate (who goes first turns each round); each round's Embree time is divided by the same round's raytree time, and the
 //! median, smallest and largest of those ratios are reported (above 1: raytree faster). Also
 //! load and build seconds, bytes per triangle, peak memory, rays by kind and how many pixels
 //! of the two images differ.
@@ -112,6 +112,10 @@ struct Options {
     sizes: Vec<usize>,
     threads: usize,
     runs: usize,
+    /// Rounds run before the counted ones at each size and discarded (`--warmup`, default 1):
+    /// the first size otherwise starts on a machine that was compiling or idle, and its first
+    /// frames ran up to 30 % slower than the next round's.
+    warmup: usize,
     /// Renders per process after one build: frame 1 is the first frame, 2..K the warm ones.
     frames: usize,
     keep: Option<PathBuf>,
@@ -134,6 +138,7 @@ fn parse_options() -> Options {
         sizes: vec![80_000, 320_000, 1_280_000],
         threads: 2,
         runs: 5,
+        warmup: 1,
         frames: 5,
         keep: None,
         scaling: false,
@@ -161,6 +166,7 @@ fn parse_options() -> Options {
             }
             "--threads" => o.threads = value("--threads").parse().expect("--threads: a number"),
             "--runs" => o.runs = value("--runs").parse().expect("--runs: a number"),
+            "--warmup" => o.warmup = value("--warmup").parse().expect("--warmup: a number"),
             "--frames" => o.frames = value("--frames").parse().expect("--frames: a number"),
             "--keep" => o.keep = Some(PathBuf::from(value("--keep"))),
             "--scaling" => o.scaling = true,
@@ -613,9 +619,10 @@ fn peer_comparison(o: &Options, root: &Path) {
         &[]
     };
     println!(
-        "peer bench (issue 15): {} threads, {} alternating rounds, {} frames per process (first = frame 1 after the build, warm = median of frames 2..{}), load average before: {}",
+        "peer bench (issue 15): {} threads, {} alternating rounds after {} discarded warm-up round(s) per size, {} frames per process (first = frame 1 after the build, warm = median of frames 2..{}), load average before: {}",
         o.threads,
         o.runs,
+        o.warmup,
         o.frames,
         o.frames,
         load_average()
@@ -675,29 +682,28 @@ fn peer_comparison(o: &Options, root: &Path) {
             .collect();
         let mut ours = Vec::new();
         let mut theirs: Vec<Vec<Run>> = vec![Vec::new(); configs.len()];
-        for round in 0..o.runs {
+        for round in 0..o.warmup + o.runs {
             // Alternating: who goes first turns with the round, so a slow spell of the
-            // machine falls on each renderer in turn.
+            // machine falls on each renderer in turn. The warm-up rounds' runs are dropped.
+            let counted = round >= o.warmup;
             let players = configs.len() + 1;
             for k in 0..players {
                 match (round + k) % players {
-                    0 => ours.push(raytree_run(
-                        &scene_file,
-                        &ours_png,
-                        o.threads,
-                        o.frames,
-                        o.size,
-                    )),
+                    0 => {
+                        let run = raytree_run(&scene_file, &ours_png, o.threads, o.frames, o.size);
+                        ours.extend(counted.then_some(run));
+                    }
                     c => {
                         if let Some(exe) = &harness {
-                            theirs[c - 1].push(harness_run(
+                            let run = harness_run(
                                 exe,
                                 &scene_bin,
                                 &images[c - 1],
                                 o.threads,
                                 o.frames,
                                 &configs[c - 1],
-                            ));
+                            );
+                            theirs[c - 1].extend(counted.then_some(run));
                         }
                     }
                 }
