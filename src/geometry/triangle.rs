@@ -14,7 +14,7 @@
 //! altogether. The watertight test shears the triangle into a ray-aligned space where the three
 //! edge functions of a shared edge are computed from the same numbers in both triangles, so
 //! their signs agree exactly and no ray slips between; it rejects only `det == 0`.
-use glam::{DVec3, Vec3, Vec3A, Vec4};
+use glam::{DVec3, Vec3, Vec3A, Vec3Swizzles, Vec4};
 use serde::{Deserialize, Serialize};
 
 use super::{Ray, gamma};
@@ -178,14 +178,19 @@ impl Shear {
     #[inline]
     pub fn new(d: Vec3) -> Option<Shear> {
         let kz = max_component_index(d.abs());
-        let kx = if kz == 2 { 0 } else { kz + 1 };
-        let ky = if kx == 2 { 0 } else { kx + 1 };
-        let dz = d[kz];
+        // `(d[kx], d[ky], d[kz])` with `kx = kz + 1`, `ky = kx + 1` (mod 3): a rotation of the
+        // components, so constant swizzles rather than three indexed reads.
+        let p = match kz {
+            0 => d.yzx(),
+            1 => d.zxy(),
+            _ => d,
+        };
+        let dz = p.z;
         if dz == 0.0 || dz.is_nan() {
             return None;
         }
         // One vector division for the three quotients (each lane rounds as a scalar `/`).
-        let q = Vec3A::new(-d[kx], -d[ky], 1.0) / Vec3A::splat(dz);
+        let q = Vec3A::new(-p.x, -p.y, 1.0) / Vec3A::splat(dz);
         Some(Shear {
             kz: kz as u8,
             sx: q.x,
