@@ -565,6 +565,7 @@ impl Tracer {
     /// another; reflected and refracted rays are traced one by one. Every colour and fact is
     /// the one [`Tracer::trace`] of the ray alone gives, bit for bit: the same intersection
     /// answers (see [`Accel::closest_hits`]) go through the same shading code.
+    #[inline(always)]
     pub fn trace_packet<const K: usize>(
         &self,
         rays: &[Ray; K],
@@ -893,6 +894,7 @@ impl Tracer {
     ///
     /// `given` holds what a packet query found for a primary ray (its surface, its shadow rays
     /// and their answers); without it everything is found here, one ray at a time.
+    #[inline(always)]
     fn shade<R: Recorder>(
         &self,
         ray: &Ray,

@@ -24,6 +24,8 @@ mod bvh;
 mod grid;
 mod visits;
 
+#[cfg(target_arch = "x86_64")]
+pub(crate) use bvh::avx2;
 pub use bvh::{PacketSimd, packet_simd, packet_uses_avx2, set_packet_simd};
 pub use visits::{AccelBox, VisitedBox, Visits};
 
@@ -545,6 +547,7 @@ impl Accel {
     /// `active` (bit `i` for `rays[i]`), into `out[i]`; the other entries of `out` are left
     /// alone. The BVH walks the rays together (`Bvh::walk_packet`); every answer
     /// is the single query's, bit for bit.
+    #[inline(always)]
     pub fn closest_hits<const K: usize>(
         &self,
         m: &Methods,
@@ -574,6 +577,7 @@ impl Accel {
     /// [`Accel::occluded`] in `(0, lengths[i])` of each ray of a packet whose bit is set in
     /// `active`: the mask of those that are blocked. The BVH walks the rays together; every
     /// answer is the single query's.
+    #[inline(always)]
     pub fn occluded_packet<const K: usize>(
         &self,
         m: &Methods,

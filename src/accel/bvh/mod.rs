@@ -104,9 +104,11 @@ pub fn packet_uses_avx2() -> bool {
     }
 }
 
+/// The AVX2 token when the traversals (and the packet tiles' shading, see
+/// `render::accumulate_tile`) are to use AVX2: present and not turned off.
 #[cfg(target_arch = "x86_64")]
 #[inline]
-fn avx2() -> Option<pulp::x86::V3> {
+pub(crate) fn avx2() -> Option<pulp::x86::V3> {
     match packet_simd() {
         PacketSimd::Sse => None,
         PacketSimd::Auto | PacketSimd::Avx2 => pulp::x86::V3::try_new(),
