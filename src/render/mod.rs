@@ -500,7 +500,7 @@ pub(crate) fn render_part_with(
     // one's pages are faulted in there, not by this thread before the first tile starts).
     let mut sums = tracer.take_sums(total as usize);
     let mut parts: Vec<&mut [Vec3]> = Vec::with_capacity(tiles.len());
-    let mut rest: &mut [Vec3] = bytemuck::cast_slice_mut(sums.as_mut_slice());
+    let mut rest: &mut [Vec3] = sums.vec3s_mut(total as usize);
     for rect in &tiles {
         let (part, tail) = rest.split_at_mut((rect.width * rect.height) as usize);
         parts.push(part);
@@ -537,10 +537,10 @@ pub(crate) fn render_part_with(
     let mut image = Image::new(region.width, region.height);
     let mut rays = RayCounts::default();
     let mut offset = 0;
+    let all: &[Vec3] = sums.vec3s_mut(total as usize);
     for (rect, result) in tiles.iter().zip(results) {
         rays.add(&result?);
-        let tile_sums: &[Vec3] =
-            bytemuck::cast_slice(&sums[offset..offset + (rect.width * rect.height) as usize]);
+        let tile_sums = &all[offset..offset + (rect.width * rect.height) as usize];
         offset += tile_sums.len();
         for j in 0..rect.height {
             for i in 0..rect.width {
