@@ -122,7 +122,7 @@ pub fn trace_tile_single(
 
 /// Width and height in pixels of the block of neighbouring camera rays traced as one packet
 /// ([`Tracer::trace_packet`]).
-pub const PACKET_BLOCK: (u32, u32) = (4, 2);
+pub const PACKET_BLOCK: (u32, u32) = (4, 4);
 const PACKET_RAYS: usize = (PACKET_BLOCK.0 * PACKET_BLOCK.1) as usize;
 
 /// The one tile loop of the batch render ([`trace_tile`]) and the viewer's session: adds
@@ -231,7 +231,8 @@ fn accumulate_tile_with(
                     n += 1;
                 }
             }
-            let active = (1u32 << n) - 1;
+            // The low `n` bits (`n` is 1 to 32: a shift by 32 would not be defined).
+            let active = u32::MAX >> (32 - n);
             for s in samples.clone() {
                 for (k, &(_, x, y)) in pixels[..n].iter().enumerate() {
                     rays[k] = primary_ray(frame, x, y, s);
@@ -299,7 +300,7 @@ pub fn preview_tile(
             for (ray, &(x, y)) in rays.iter_mut().zip(chunk) {
                 *ray = primary_ray(frame, x, y, 0);
             }
-            let active = (1u32 << chunk.len()) - 1;
+            let active = u32::MAX >> (32 - chunk.len());
             tracer.trace_packet(&rays, active, counts, &mut traced, &mut scratch);
             outs.copy_from_slice(&traced[..chunk.len()]);
         }
