@@ -620,12 +620,11 @@ impl Tracer {
             weight: Vec3::ONE,
             corrected: false,
         };
-        let bits = || (0..K).filter(move |&i| active & (1 << i) != 0);
         if self
             .ends_untraced(0, Vec3::ONE, &SampleInfo::default())
             .is_some()
         {
-            for i in bits() {
+            for i in set_bits(active) {
                 let mut info = SampleInfo::default();
                 let s = &mut Sample {
                     counts: &mut *counts,
@@ -662,6 +661,8 @@ impl Tracer {
         // Field by field into the caller's slots: a `Given` is large, and a fresh array of
         // them would be built on the stack and copied.
         let no_visible_lights = self.visible_lights.is_empty();
+        // The lanes with a surface to shade (bit `i` for lane `i`).
+        let mut surfaces = 0u32;
         for (i, g) in given.iter_mut().enumerate() {
             // Written in each branch: a `Found` formed in one temporary for both and copied
             // into the slot is loaded across the end of the store that formed it, and stalls.
@@ -677,30 +678,31 @@ impl Tracer {
                 }
                 _ => false,
             };
+            surfaces |= u32::from(g.has_surface) << i;
             g.blocked = 0;
             g.lights = [None; GIVEN_LIGHTS];
             bases[i] = ShadowBase::default();
         }
         for (li, light) in scene.lights.iter().enumerate().take(64) {
             let mut cast = 0u32;
-            for ((i, g), base) in given.iter_mut().enumerate().zip(bases.iter_mut()) {
-                if g.has_surface {
-                    let (surface, error) = &g.surface;
-                    let material = scene.material(surface.material);
-                    let v = -rays[i].dir;
-                    let mut terms = None;
-                    let Found::Prim(hit) = g.found else { continue };
-                    let lr = self.light_ray::<NoRecord>(
-                        surface, hit.prim, *error, material, v, light, base, &mut terms,
-                    );
-                    if let Some((ray, length)) = lr.ray {
-                        shadow[i] = ray;
-                        lengths[i] = length;
-                        cast |= 1 << i;
-                    }
-                    if let Some(slot) = g.lights.get_mut(li) {
-                        *slot = Some(lr);
-                    }
+            // Only the lanes with a surface: one step per set bit.
+            for i in set_bits(surfaces) {
+                let (g, base) = (&mut given[i], &mut bases[i]);
+                let (surface, error) = &g.surface;
+                let material = scene.material(surface.material);
+                let v = -rays[i].dir;
+                let mut terms = None;
+                let Found::Prim(hit) = g.found else { continue };
+                let lr = self.light_ray::<NoRecord>(
+                    surface, hit.prim, *error, material, v, light, base, &mut terms,
+                );
+                if let Some((ray, length)) = lr.ray {
+                    shadow[i] = ray;
+                    lengths[i] = length;
+                    cast |= 1 << i;
+                }
+                if let Some(slot) = g.lights.get_mut(li) {
+                    *slot = Some(lr);
                 }
             }
             if cast != 0 {
@@ -712,7 +714,7 @@ impl Tracer {
                 }
             }
         }
-        for i in bits() {
+        for i in set_bits(active) {
             // In place: the facts are written where the caller reads them.
             let (color, info) = &mut out[i];
             *info = SampleInfo::default();
@@ -1174,6 +1176,19 @@ fn casts_shadow_ray(
         }
     };
     t.specular != Vec3::ZERO || t.diffuse != Vec3::ZERO
+}
+
+/// The indices of the set bits of `mask`, lowest first: one step per set bit (a packet's
+/// lanes; a filter over all of them pays for the empty ones too).
+#[inline(always)]
+fn set_bits(mut mask: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (mask != 0).then(|| {
+            let i = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            i
+        })
+    })
 }
 
 /// A material's colour times its texel, where the surface is textured.
