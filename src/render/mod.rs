@@ -150,33 +150,29 @@ pub fn accumulate_tile(
     counts: &mut RayCounts,
     first: Option<&mut Vec<SampleInfo>>,
 ) {
+    let tile = Tile(tracer, frame, rect, samples, sums, counts, first);
     #[cfg(target_arch = "x86_64")]
     if let Some(v3) = crate::accel::avx2() {
-        return v3.vectorize(TileAvx2 {
-            tracer,
-            frame,
-            rect,
-            samples,
-            sums,
-            counts,
-            first,
-        });
+        return v3.vectorize(TileAvx2(tile));
     }
-    accumulate_tile_with(tracer, frame, rect, samples, sums, counts, first);
+    tile.accumulate();
 }
 
-/// [`accumulate_tile`] as the function `pulp` compiles with AVX2: its `call` must be inlined
+/// The arguments of [`accumulate_tile`], in its order; its body is [`Tile::accumulate`].
+struct Tile<'a>(
+    &'a Tracer,
+    &'a CameraFrame,
+    Rect,
+    Range<u32>,
+    &'a mut [Vec3],
+    &'a mut RayCounts,
+    Option<&'a mut Vec<SampleInfo>>,
+);
+
+/// [`Tile::accumulate`] as the function `pulp` compiles with AVX2: its `call` must be inlined
 /// there (a closure would not take the target features), hence a type.
 #[cfg(target_arch = "x86_64")]
-struct TileAvx2<'a> {
-    tracer: &'a Tracer,
-    frame: &'a CameraFrame,
-    rect: Rect,
-    samples: Range<u32>,
-    sums: &'a mut [Vec3],
-    counts: &'a mut RayCounts,
-    first: Option<&'a mut Vec<SampleInfo>>,
-}
+struct TileAvx2<'a>(Tile<'a>);
 
 #[cfg(target_arch = "x86_64")]
 impl pulp::NullaryFnOnce for TileAvx2<'_> {
@@ -184,66 +180,52 @@ impl pulp::NullaryFnOnce for TileAvx2<'_> {
 
     #[inline(always)]
     fn call(self) {
-        let TileAvx2 {
-            tracer,
-            frame,
-            rect,
-            samples,
-            sums,
-            counts,
-            first,
-        } = self;
-        accumulate_tile_with(tracer, frame, rect, samples, sums, counts, first);
+        self.0.accumulate();
     }
 }
 
-/// The body of [`accumulate_tile`], inlined into the build it runs in.
-#[inline(always)]
-fn accumulate_tile_with(
-    tracer: &Tracer,
-    frame: &CameraFrame,
-    rect: Rect,
-    samples: Range<u32>,
-    sums: &mut [Vec3],
-    counts: &mut RayCounts,
-    first: Option<&mut Vec<SampleInfo>>,
-) {
-    let (bw, bh) = PACKET_BLOCK;
-    let base = first.as_ref().map_or(0, |f| f.len());
-    let mut first = first.filter(|_| samples.contains(&0));
-    if let Some(f) = first.as_mut() {
-        f.resize(
-            base + (rect.width * rect.height) as usize,
-            SampleInfo::default(),
-        );
-    }
-    let mut rays = [crate::geometry::Ray::new(Vec3::ZERO, Vec3::Z); PACKET_RAYS];
-    let mut out = [(Vec3::ZERO, SampleInfo::default()); PACKET_RAYS];
-    let mut scratch = PacketScratch::default();
-    for by in (0..rect.height).step_by(bh as usize) {
-        for bx in (0..rect.width).step_by(bw as usize) {
-            // The block's pixels inside the rect, row-major: (index in `sums`, x, y).
-            let mut pixels = [(0usize, 0u32, 0u32); PACKET_RAYS];
-            let mut n = 0;
-            for j in by..(by + bh).min(rect.height) {
-                for i in bx..(bx + bw).min(rect.width) {
-                    pixels[n] = ((j * rect.width + i) as usize, rect.x + i, rect.y + j);
-                    n += 1;
+impl Tile<'_> {
+    /// The body of [`accumulate_tile`], inlined into the build it runs in.
+    #[inline(always)]
+    fn accumulate(self) {
+        let Tile(tracer, frame, rect, samples, sums, counts, first) = self;
+        let (bw, bh) = PACKET_BLOCK;
+        let base = first.as_ref().map_or(0, |f| f.len());
+        let mut first = first.filter(|_| samples.contains(&0));
+        if let Some(f) = first.as_mut() {
+            f.resize(
+                base + (rect.width * rect.height) as usize,
+                SampleInfo::default(),
+            );
+        }
+        let mut rays = [crate::geometry::Ray::new(Vec3::ZERO, Vec3::Z); PACKET_RAYS];
+        let mut out = [(Vec3::ZERO, SampleInfo::default()); PACKET_RAYS];
+        let mut scratch = PacketScratch::default();
+        for by in (0..rect.height).step_by(bh as usize) {
+            for bx in (0..rect.width).step_by(bw as usize) {
+                // The block's pixels inside the rect, row-major: (index in `sums`, x, y).
+                let mut pixels = [(0usize, 0u32, 0u32); PACKET_RAYS];
+                let mut n = 0;
+                for j in by..(by + bh).min(rect.height) {
+                    for i in bx..(bx + bw).min(rect.width) {
+                        pixels[n] = ((j * rect.width + i) as usize, rect.x + i, rect.y + j);
+                        n += 1;
+                    }
                 }
-            }
-            // The low `n` bits (`n` is 1 to 32: a shift by 32 would not be defined).
-            let active = u32::MAX >> (32 - n);
-            for s in samples.clone() {
-                for (k, &(_, x, y)) in pixels[..n].iter().enumerate() {
-                    rays[k] = primary_ray(frame, x, y, s);
-                }
-                tracer.trace_packet(&rays, active, counts, &mut out, &mut scratch);
-                for (&(at, _, _), &(c, info)) in pixels[..n].iter().zip(&out[..n]) {
-                    sums[at] += c;
-                    if s == 0
-                        && let Some(first) = first.as_mut()
-                    {
-                        first[base + at] = info;
+                // The low `n` bits (`n` is 1 to 32: a shift by 32 would not be defined).
+                let active = u32::MAX >> (32 - n);
+                for s in samples.clone() {
+                    for (k, &(_, x, y)) in pixels[..n].iter().enumerate() {
+                        rays[k] = primary_ray(frame, x, y, s);
+                    }
+                    tracer.trace_packet(&rays, active, counts, &mut out, &mut scratch);
+                    for (&(at, _, _), &(c, info)) in pixels[..n].iter().zip(&out[..n]) {
+                        sums[at] += c;
+                        if s == 0
+                            && let Some(first) = first.as_mut()
+                        {
+                            first[base + at] = info;
+                        }
                     }
                 }
             }
