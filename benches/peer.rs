@@ -24,8 +24,9 @@
 //!
 //! Each process builds once and renders K frames (`--frames`, default 5): the first frame is
 //! frame 1, the warm frame the median of frames 2..K. Each size starts with `--warmup` rounds
-//! (default 1) that are run and dropped. Rounds alternate (who goes first turns each round); each round's Embree time is divided by the same round's raytree time, and the
-//! median, smallest and largest of those ratios are reported (above 1: raytree faster). Also
+//! (default 1) that are run and dropped. Rounds alternate (who goes first turns each round);
+//! each round's Embree time is divided by the same round's raytree time, and the median,
+//! smallest and largest of those ratios are reported (above 1: raytree faster). Also
 //! load and build seconds, bytes per triangle, peak memory, rays by kind and how many pixels
 //! of the two images differ.
 //!
