@@ -30,7 +30,8 @@ use obvhs::{
 use rayon::prelude::*;
 
 use super::{
-    Bvh, LEAF, MAX_LEAF, MAX_PRIMS, NODE_PAD_REL, Node, Packet, SPHERE, STACK_SIZE, WIDTH,
+    Bvh, LEAF, MAX_LEAF, MAX_PRIMS, NARROW, NARROW_WIDTH, NODE_PAD_REL, Node, Packet, SPHERE,
+    STACK_SIZE, WIDTH,
 };
 use crate::accel::{Prim, Prims, Shape};
 use crate::geometry::Triangles4;
@@ -123,19 +124,20 @@ impl Bvh {
             };
             built = flat
                 .and_then(|flat| collapse_flat(flat, prims))
-                .filter(|b| stack_need(&b.nodes) + WIDTH - 1 <= STACK_SIZE);
+                .filter(|b| stack_need(b) + WIDTH - 1 <= STACK_SIZE);
         }
         built.unwrap_or_else(|| {
             let boxes: Vec<Aabb> = (0..n).into_par_iter().map(bounds).collect();
             let b = collapse(median_bvh2(&boxes), prims).unwrap_or_else(|| Bvh {
                 nodes: Vec::new(),
+                narrow: Vec::new(),
                 packets: Vec::new(),
                 spheres: Vec::new(),
                 depth: 0,
             });
             // A balanced binary tree of 2²⁸ leaves has depth 29; its 8-wide collapse needs
             // fewer than 7·10 + 7 stack entries.
-            debug_assert!(stack_need(&b.nodes) + WIDTH - 1 <= STACK_SIZE);
+            debug_assert!(stack_need(&b) + WIDTH - 1 <= STACK_SIZE);
             b
         })
     }
@@ -380,20 +382,11 @@ fn collapse_flat<P: Prims + ?Sized>(flat: Vec<FlatNode>, prims: &P) -> Option<Bv
         }
     }
 
-    let mut nodes: Vec<Node> = Vec::new();
-    let mut sphere_leaves: Vec<Prim> = Vec::new();
-    // Each triangle leaf's primitive indices, four per leaf (the first repeated); gathered into
-    // packets afterwards in one tight loop, whose independent loads overlap their cache misses.
-    let mut leaf_prims: Vec<[u32; 4]> = Vec::new();
-    let mut depth = 0;
-    // (binary node, wide node to fill, its depth); the root's slots are the root's children,
-    // or the root itself when it is a leaf.
-    let mut todo = vec![(0usize, 0u32, 1usize)];
-    nodes.push(empty_node());
-    while let Some((b, w, d)) = todo.pop() {
-        depth = depth.max(d);
-        // (binary node, how many times opened); a tie in area opens the shallower child, so
-        // equal boxes (a median-split tree of duplicates) collapse evenly.
+    // The children of binary node `b` in the wide tree: its two children, then, while there
+    // are fewer than `WIDTH`, the largest inner child opened into its two. As (binary node,
+    // how many times opened); a tie in area opens the shallower child, so equal boxes (a
+    // median-split tree of duplicates) collapse evenly.
+    let open = |b: usize| -> ([(usize, u32); WIDTH], usize) {
         let mut slots = [(0usize, 0u32); WIDTH];
         let mut len = if leaf[b] {
             slots[0] = (b, 0);
@@ -403,7 +396,6 @@ fn collapse_flat<P: Prims + ?Sized>(flat: Vec<FlatNode>, prims: &P) -> Option<Bv
             slots[1] = (right(b), 0);
             2
         };
-        // Open the largest inner child until there are four.
         while len < WIDTH {
             let mut best: Option<(usize, f32, u32)> = None;
             for (k, &(s, opened)) in slots[..len].iter().enumerate() {
@@ -426,20 +418,27 @@ fn collapse_flat<P: Prims + ?Sized>(flat: Vec<FlatNode>, prims: &P) -> Option<Bv
             slots[k + 1] = (right(s), opened + 1);
             len += 1;
         }
-        let mut node = empty_node();
-        for (slot, &(s, _)) in slots[..len].iter().enumerate() {
-            let (lo, hi) = padded(&flat[s].aabb());
-            for (axis, (l, h)) in [(lo.x, hi.x), (lo.y, hi.y), (lo.z, hi.z)]
-                .into_iter()
-                .enumerate()
-            {
-                node.planes[2 * axis][slot] = l;
-                node.planes[2 * axis + 1][slot] = h;
-            }
-            node.valid |= 1 << slot;
+        (slots, len)
+    };
+
+    let mut nodes: Vec<Node> = vec![Node::empty()];
+    let mut narrow: Vec<Node<NARROW_WIDTH>> = Vec::new();
+    let mut sphere_leaves: Vec<Prim> = Vec::new();
+    // Each triangle leaf's primitive indices, four per leaf (the first repeated); gathered into
+    // packets afterwards in one tight loop, whose independent loads overlap their cache misses.
+    let mut leaf_prims: Vec<[u32; 4]> = Vec::new();
+    let mut depth = 0;
+    // (binary node, word of the wide node to fill, its depth); the root (always a full node)
+    // has the root's children as its slots, or the root itself when it is a leaf.
+    let mut todo = vec![(0usize, 0u32, 1usize)];
+    while let Some((b, w, d)) = todo.pop() {
+        depth = depth.max(d);
+        let (slots, len) = open(b);
+        // The slot's child word: a leaf's, or a new node's (full or narrow by its children).
+        let mut word = |s: usize| -> u32 {
             if leaf[s] && spheres[s] == 1 {
-                node.child[slot] = LEAF | SPHERE | sphere_leaves.len() as u32;
                 sphere_leaves.push(prims.get(flat[s].prim() as usize));
+                LEAF | SPHERE | (sphere_leaves.len() - 1) as u32
             } else if leaf[s] {
                 // The subtree's triangles, left to right: the leaves of its run of
                 // `2·count − 1` nodes, as one packet.
@@ -455,19 +454,37 @@ fn collapse_flat<P: Prims + ?Sized>(flat: Vec<FlatNode>, prims: &P) -> Option<Bv
                 for k in c..4 {
                     ids[k] = ids[0];
                 }
-                node.child[slot] = LEAF | ((leaf_prims.len() as u32) << 2) | (c as u32 - 1);
                 leaf_prims.push(ids);
+                LEAF | ((leaf_prims.len() as u32 - 1) << 2) | (c as u32 - 1)
             } else {
-                let index = nodes.len() as u32;
-                nodes.push(empty_node());
-                node.child[slot] = index;
-                todo.push((s, index, d + 1));
+                let child = if open(s).1 <= NARROW_WIDTH {
+                    narrow.push(Node::empty());
+                    NARROW | (narrow.len() - 1) as u32
+                } else {
+                    nodes.push(Node::empty());
+                    (nodes.len() - 1) as u32
+                };
+                todo.push((s, child, d + 1));
+                child
             }
+        };
+        if w & NARROW != 0 {
+            let mut node = Node::<NARROW_WIDTH>::empty();
+            for (slot, &(s, _)) in slots[..len].iter().enumerate() {
+                node.set(slot, &flat[s].aabb(), word(s));
+            }
+            narrow[(w & !NARROW) as usize] = node;
+        } else {
+            let mut node = Node::<WIDTH>::empty();
+            for (slot, &(s, _)) in slots[..len].iter().enumerate() {
+                node.set(slot, &flat[s].aabb(), word(s));
+            }
+            nodes[w as usize] = node;
         }
-        nodes[w as usize] = node;
     }
     drop(flat);
     nodes.shrink_to_fit();
+    narrow.shrink_to_fit();
     let triangle = |i: u32| match prims.get(i as usize) {
         Prim {
             shape: Shape::Triangle(v),
@@ -492,35 +509,44 @@ fn collapse_flat<P: Prims + ?Sized>(flat: Vec<FlatNode>, prims: &P) -> Option<Bv
         .collect();
     Some(Bvh {
         nodes,
+        narrow,
         packets,
         spheres: sphere_leaves,
         depth,
     })
 }
 
-fn empty_node() -> Node {
-    Node {
-        planes: [[0.0; WIDTH]; 6],
-        child: [0; WIDTH],
-        valid: 0,
+impl<const W: usize> Node<W> {
+    /// Fills slot `slot` with child word `word` and its box `aabb`, padded.
+    fn set(&mut self, slot: usize, aabb: &Aabb, word: u32) {
+        let (lo, hi) = padded(aabb);
+        for (axis, (l, h)) in [(lo.x, hi.x), (lo.y, hi.y), (lo.z, hi.z)]
+            .into_iter()
+            .enumerate()
+        {
+            self.planes[2 * axis][slot] = l;
+            self.planes[2 * axis + 1][slot] = h;
+        }
+        self.valid |= 1 << slot;
+        self.child[slot] = word;
     }
 }
 
 /// The most stack entries a traversal of `nodes` can need: on the worst root-to-leaf path,
 /// each node pushes all its children but one.
-pub(super) fn stack_need(nodes: &[Node]) -> usize {
-    if nodes.is_empty() {
+pub(super) fn stack_need(bvh: &Bvh) -> usize {
+    if bvh.nodes.is_empty() {
         return 0;
     }
     let mut worst = 0;
     let mut todo = vec![(0u32, 0usize)];
-    while let Some((i, above)) = todo.pop() {
-        let node = &nodes[i as usize];
-        let here = above + (node.valid.count_ones() as usize).saturating_sub(1);
+    while let Some((word, above)) = todo.pop() {
+        let children = bvh.children(word, 0);
+        let here = above + bvh.children(word, 0).count().saturating_sub(1);
         worst = worst.max(here);
-        for slot in 0..WIDTH {
-            if node.valid & (1 << slot) != 0 && node.child[slot] & LEAF == 0 {
-                todo.push((node.child[slot], here));
+        for (child, _) in children {
+            if child & LEAF == 0 {
+                todo.push((child, here));
             }
         }
     }
@@ -641,34 +667,22 @@ mod tests {
             let d = (hi - lo).max(Vec3::ZERO);
             f64::from((d.x + d.y) * d.z + d.x * d.y)
         };
-        let (mut total, mut lo, mut hi) = (0.0, Vec3::INFINITY, Vec3::NEG_INFINITY);
-        for node in &bvh.nodes {
-            for slot in 0..WIDTH {
-                if node.valid & (1 << slot) == 0 {
-                    continue;
-                }
-                let a = Vec3::new(
-                    node.planes[0][slot],
-                    node.planes[2][slot],
-                    node.planes[4][slot],
-                );
-                let b = Vec3::new(
-                    node.planes[1][slot],
-                    node.planes[3][slot],
-                    node.planes[5][slot],
-                );
-                let child = node.child[slot];
-                let cost = if child & LEAF == 0 {
-                    NODE_COST
-                } else if child & SPHERE != 0 {
-                    SPHERE_COST
-                } else {
-                    PACKET_COST
-                };
-                total += f64::from(cost) * area(a, b);
-                if std::ptr::eq(node, &bvh.nodes[0]) {
-                    (lo, hi) = (lo.min(a), hi.max(b));
-                }
+        let cost = |child: u32| {
+            if child & LEAF == 0 {
+                NODE_COST
+            } else if child & SPHERE != 0 {
+                SPHERE_COST
+            } else {
+                PACKET_COST
+            }
+        };
+        let (lo, hi) = bvh.root_box();
+        let words =
+            (0..bvh.nodes.len() as u32).chain((0..bvh.narrow.len() as u32).map(|i| i | NARROW));
+        let mut total = 0.0;
+        for word in words {
+            for (child, b) in bvh.children(word, 0) {
+                total += f64::from(cost(child)) * area(b.lo, b.hi);
             }
         }
         total / area(lo, hi)
@@ -739,6 +753,36 @@ mod tests {
         prims
     }
 
+    /// Inner nodes of two to four children are narrow (two cache lines), the others full (four
+    /// lines), the root always full; on a surface like the benchmark's most nodes are narrow,
+    /// and every triangle is reached through exactly one leaf.
+    #[test]
+    fn nodes_of_at_most_four_children_are_narrow() {
+        assert_eq!(size_of::<Node<NARROW_WIDTH>>(), 128);
+        assert_eq!(size_of::<Node>(), 256);
+        let prims = torus(20_000);
+        let bvh = Bvh::build(prims.clone());
+        for node in &bvh.nodes[1..] {
+            assert!(node.valid.count_ones() as usize > NARROW_WIDTH);
+        }
+        for node in &bvh.narrow {
+            assert!((2..=NARROW_WIDTH).contains(&(node.valid.count_ones() as usize)));
+        }
+        assert!(
+            bvh.narrow.len() > bvh.nodes.len(),
+            "{} narrow, {} full",
+            bvh.narrow.len(),
+            bvh.nodes.len()
+        );
+        let mut reached = vec![0u32; prims.len()];
+        bvh.for_each_box(|_, _, leaf| {
+            for id in leaf.map(|w| bvh.leaf_prims(w)).unwrap_or_default() {
+                reached[id as usize] += 1;
+            }
+        });
+        assert!(reached.iter().all(|&r| r == 1));
+    }
+
     /// On uneven input the two-tree build costs a little more than one PLOC tree, but not much.
     #[test]
     fn the_two_tree_build_costs_about_the_same_on_uneven_input() {
@@ -793,10 +837,11 @@ mod tests {
             &prims[..],
         )
         .expect("a tree");
-        assert!(stack_need(&split.nodes) + WIDTH - 1 <= STACK_SIZE);
+        assert!(stack_need(&split) + WIDTH - 1 <= STACK_SIZE);
         // `build_split` takes this path too.
         let built = Bvh::build_split(&prims[..], 0);
         assert_eq!(built.nodes.len(), split.nodes.len());
+        assert_eq!(built.narrow.len(), split.narrow.len());
         let (a, b) = (sah_cost(&whole), sah_cost(&split));
         eprintln!("surface-area cost: two trees {b:.3}, one tree {a:.3}");
         assert!(b < a * 1.03, "split {b:.2} against whole {a:.2}");

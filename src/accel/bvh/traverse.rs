@@ -1,5 +1,6 @@
 //! Traversal of the 8-wide [`Bvh`]: the closest-hit and any-hit walks over one stack and the
-//! SIMD test of a node's eight child boxes (one AVX2 test, or two SSE ones).
+//! SIMD test of a node's eight child boxes (one AVX2 test, or two SSE ones; a narrow node's
+//! four boxes in one SSE test).
 //!
 //! Traversal, and what it must guarantee (the accelerators agree bit for bit with brute force):
 //! child boxes are padded by a few ulp of their magnitude in every axis
@@ -20,7 +21,7 @@
 //! (`StackStack<_, 32>`) silently overwrites its top entry when full.
 use glam::{Vec3, Vec3A, Vec4};
 
-use super::{Bvh, LEAF, SPHERE, STACK_SIZE, WIDTH};
+use super::{Bvh, LEAF, NARROW, NARROW_WIDTH, Node, SPHERE, STACK_SIZE, WIDTH};
 use crate::accel::{Visitor, box_t_slack, prefetch};
 use crate::geometry::Ray;
 
@@ -87,11 +88,18 @@ impl Bvh {
                     return;
                 }
             } else {
-                let node = &self.nodes[word as usize];
-                let (mut mask, t) = test.enter_one(r, node, v.limit());
+                let (mut mask, t, child) = if word & NARROW != 0 {
+                    let node = &self.narrow[(word & !NARROW) as usize];
+                    let (mask, t) = Sse4.enter_one_of(r, node, v.limit());
+                    (mask, t, node.child_words())
+                } else {
+                    let node = &self.nodes[word as usize];
+                    let (mask, t) = test.enter_one(r, node, v.limit());
+                    (mask, t, node.child)
+                };
                 if mask != 0 {
                     if mask & (mask - 1) == 0 {
-                        word = node.child[mask.trailing_zeros() as usize];
+                        word = child[mask.trailing_zeros() as usize];
                         continue;
                     }
                     // Up to `WIDTH` hits; all but the one taken next are pushed with their
@@ -108,7 +116,7 @@ impl Bvh {
                                 j -= 1;
                             }
                         }
-                        hits[j] = (node.child[i], t[i]);
+                        hits[j] = (child[i], t[i]);
                         k += 1;
                     }
                     word = hits[k - 1].0;
@@ -268,10 +276,17 @@ impl Bvh {
                     return;
                 }
             } else {
-                let node = &self.nodes[word as usize];
                 // Per child slot, the rays that enter it, and a `t` no later than any of their
                 // entry ts.
-                let (entered, key) = test.enter::<K, L>(rays4, node, mask);
+                let (entered, key, child) = if word & NARROW != 0 {
+                    let node = &self.narrow[(word & !NARROW) as usize];
+                    let (entered, key) = Sse4.enter_of::<K, L, NARROW_WIDTH>(rays4, node, mask);
+                    (entered, key, node.child_words())
+                } else {
+                    let node = &self.nodes[word as usize];
+                    let (entered, key) = test.enter::<K, L>(rays4, node, mask);
+                    (entered, key, node.child)
+                };
                 // The children entered, nearest first when ordered.
                 let mut hits = [(0u32, 0u32, 0f32); WIDTH];
                 let mut k = 0;
@@ -286,7 +301,7 @@ impl Bvh {
                             j -= 1;
                         }
                     }
-                    hits[j] = (node.child[slot], entered[slot], key[slot]);
+                    hits[j] = (child[slot], entered[slot], key[slot]);
                     k += 1;
                 }
                 if k > 0 {
@@ -345,8 +360,10 @@ impl Bvh {
     /// later: its lines load while the nearer children are walked).
     #[inline(always)]
     fn prefetch_child(&self, word: u32) {
-        if word & LEAF == 0 {
+        if word & (LEAF | NARROW) == 0 {
             prefetch(&self.nodes[word as usize]);
+        } else if word & LEAF == 0 {
+            prefetch(&self.narrow[(word & !NARROW) as usize]);
         } else if word & SPHERE == 0 {
             prefetch(&self.packets[((word & !LEAF) >> 2) as usize]);
         }
@@ -434,6 +451,37 @@ impl<const L: usize> Rays4<L> {
     }
 }
 
+/// The packet test's transpose: `$one` gives the slots ray `$ray` (of `$mask`, a packet of
+/// `$k` rays) meets, and the rays' slot masks (masked by `$valid`), eight rays at a time, form
+/// an 8×8 bit matrix, transposed into each slot's rays (bit `i` of `entered[c]`: ray `i`
+/// enters slot `c`). A macro, not a function taking a closure: a closure is compiled without
+/// the AVX2 features of the walk around it, and the node test in it would not be inlined.
+macro_rules! rays_by_slot {
+    ($k:expr, $mask:expr, $valid:expr, |$ray:ident| $one:expr) => {{
+        const { assert!(WIDTH == 8) };
+        let mut entered = [0u32; WIDTH];
+        for g in 0..$k.div_ceil(8) {
+            let group = ($mask >> (8 * g)) & 0xff;
+            if group == 0 {
+                continue;
+            }
+            let mut rows = 0u64;
+            let mut m = group;
+            while m != 0 {
+                let i = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let $ray = 8 * g + i;
+                rows |= u64::from($one & $valid) << (8 * i);
+            }
+            let columns = transpose8(rows);
+            for (c, e) in entered.iter_mut().enumerate() {
+                *e |= (((columns >> (8 * c)) & 0xff) as u32) << (8 * g);
+            }
+        }
+        entered
+    }};
+}
+
 /// The node test of a packet: for the rays of `mask` (a subset of the packet's), per child
 /// slot, the rays whose widened `(t_min, limit]` interval meets its box (as [`Bvh::walk_from`]
 /// tests each), and the smallest entry `t` of the rays of their lane groups that meet it (no
@@ -441,7 +489,7 @@ impl<const L: usize> Rays4<L> {
 trait NodeTest: Copy {
     /// The single-ray test: the slots of `node` whose widened `(t_min, limit]` interval the
     /// ray `r` meets (bit `i` for slot `i`), and each slot's widened entry `t`.
-    fn enter_one(&self, r: &TravRay, node: &super::Node, limit: f32) -> (u32, [f32; WIDTH]);
+    fn enter_one(&self, r: &TravRay, node: &Node, limit: f32) -> (u32, [f32; WIDTH]);
 
     /// Each slot's nearest entry so far, as the test keeps it.
     type Keys: Copy;
@@ -456,7 +504,7 @@ trait NodeTest: Copy {
     fn one_of<const L: usize>(
         &self,
         r: &Rays4<L>,
-        node: &super::Node,
+        node: &Node,
         ray: usize,
         keys: &mut Self::Keys,
     ) -> u32;
@@ -473,31 +521,22 @@ trait NodeTest: Copy {
     fn enter<const K: usize, const L: usize>(
         &self,
         r: &Rays4<L>,
-        node: &super::Node,
+        node: &Node,
         mask: u32,
     ) -> ([u32; WIDTH], [f32; WIDTH]) {
-        const { assert!(WIDTH == 8) };
-        let mut entered = [0u32; WIDTH];
         let mut keys = self.no_keys();
-        for g in 0..K.div_ceil(8) {
-            let group = (mask >> (8 * g)) & 0xff;
-            if group == 0 {
-                continue;
-            }
-            let mut rows = 0u64;
-            let mut m = group;
-            while m != 0 {
-                let i = m.trailing_zeros() as usize;
-                m &= m - 1;
-                let slots = self.one_of(r, node, 8 * g + i, &mut keys) & node.valid;
-                rows |= u64::from(slots) << (8 * i);
-            }
-            let columns = transpose8(rows);
-            for (c, e) in entered.iter_mut().enumerate() {
-                *e |= (((columns >> (8 * c)) & 0xff) as u32) << (8 * g);
-            }
-        }
+        let entered = rays_by_slot!(K, mask, node.valid, |ray| self
+            .one_of(r, node, ray, &mut keys));
         (entered, self.key_array(keys))
+    }
+}
+
+impl<const W: usize> Node<W> {
+    /// The child words, in `WIDTH` slots (the slots past `W` hold zero, and no test enters
+    /// them).
+    #[inline(always)]
+    fn child_words(&self) -> [u32; WIDTH] {
+        std::array::from_fn(|i| if i < W { self.child[i] } else { 0 })
     }
 }
 
@@ -507,17 +546,8 @@ struct Sse4;
 
 impl NodeTest for Sse4 {
     #[inline(always)]
-    fn enter_one(&self, r: &TravRay, node: &super::Node, limit: f32) -> (u32, [f32; WIDTH]) {
-        let (o, inv) = ([r.ox, r.oy, r.oz], [r.ix, r.iy, r.iz]);
-        let limit = Vec4::splat(limit);
-        let mut mask = 0;
-        let mut t = [0.0; WIDTH];
-        for half in 0..WIDTH / 4 {
-            let (hit, t_near) = Self::slab(node, half, o, inv, r.near, r.t_min, limit);
-            mask |= hit.bitmask() << (4 * half);
-            t[4 * half..4 * half + 4].copy_from_slice(&t_near.to_array());
-        }
-        (mask & node.valid, t)
+    fn enter_one(&self, r: &TravRay, node: &Node, limit: f32) -> (u32, [f32; WIDTH]) {
+        self.enter_one_of(r, node, limit)
     }
 
     type Keys = [Vec4; WIDTH / 4];
@@ -532,21 +562,11 @@ impl NodeTest for Sse4 {
     fn one_of<const L: usize>(
         &self,
         r: &Rays4<L>,
-        node: &super::Node,
+        node: &Node,
         ray: usize,
         keys: &mut Self::Keys,
     ) -> u32 {
-        let o = [0, 1, 2].map(|axis| Vec4::splat(r.o[axis][ray]));
-        let inv = [0, 1, 2].map(|axis| Vec4::splat(r.inv[axis][ray]));
-        let near = r.near[ray].map(|n| n as usize);
-        let (t_min, limit) = (Vec4::splat(r.t_min), Vec4::splat(r.limit[ray]));
-        let mut bits = 0;
-        for (half, key) in keys.iter_mut().enumerate() {
-            let (hit, t_near) = Self::slab(node, half, o, inv, near, t_min, limit);
-            bits |= hit.bitmask() << (4 * half);
-            *key = key.min(Vec4::select(hit, t_near, Vec4::INFINITY));
-        }
-        bits
+        Self::one_of_w(r, node, ray, keys)
     }
 
     #[inline(always)]
@@ -560,12 +580,70 @@ impl NodeTest for Sse4 {
 }
 
 impl Sse4 {
+    /// [`NodeTest::enter_one`] for a node of either width (the slots past `W` are not met).
+    /// Narrow nodes take this test in the AVX2 walks too: compiled there, it is the same
+    /// arithmetic, VEX-encoded.
+    #[inline(always)]
+    fn enter_one_of<const W: usize>(
+        &self,
+        r: &TravRay,
+        node: &Node<W>,
+        limit: f32,
+    ) -> (u32, [f32; WIDTH]) {
+        let (o, inv) = ([r.ox, r.oy, r.oz], [r.ix, r.iy, r.iz]);
+        let limit = Vec4::splat(limit);
+        let mut mask = 0;
+        let mut t = [f32::INFINITY; WIDTH];
+        for half in 0..W / 4 {
+            let (hit, t_near) = Self::slab(node, half, o, inv, r.near, r.t_min, limit);
+            mask |= hit.bitmask() << (4 * half);
+            t[4 * half..4 * half + 4].copy_from_slice(&t_near.to_array());
+        }
+        (mask & node.valid, t)
+    }
+
+    /// [`NodeTest::one_of`] for a node of either width.
+    #[inline(always)]
+    fn one_of_w<const L: usize, const W: usize>(
+        r: &Rays4<L>,
+        node: &Node<W>,
+        ray: usize,
+        keys: &mut [Vec4; WIDTH / 4],
+    ) -> u32 {
+        let o = [0, 1, 2].map(|axis| Vec4::splat(r.o[axis][ray]));
+        let inv = [0, 1, 2].map(|axis| Vec4::splat(r.inv[axis][ray]));
+        let near = r.near[ray].map(|n| n as usize);
+        let (t_min, limit) = (Vec4::splat(r.t_min), Vec4::splat(r.limit[ray]));
+        let mut bits = 0;
+        for (half, key) in keys.iter_mut().enumerate().take(W / 4) {
+            let (hit, t_near) = Self::slab(node, half, o, inv, near, t_min, limit);
+            bits |= hit.bitmask() << (4 * half);
+            *key = key.min(Vec4::select(hit, t_near, Vec4::INFINITY));
+        }
+        bits
+    }
+
+    /// [`NodeTest::enter`] for a node of either width.
+    #[inline(always)]
+    fn enter_of<const K: usize, const L: usize, const W: usize>(
+        &self,
+        r: &Rays4<L>,
+        node: &Node<W>,
+        mask: u32,
+    ) -> ([u32; WIDTH], [f32; WIDTH]) {
+        let mut keys = self.no_keys();
+        let entered = rays_by_slot!(K, mask, node.valid, |ray| Self::one_of_w(
+            r, node, ray, &mut keys
+        ));
+        (entered, self.key_array(keys))
+    }
+
     /// The widened slab test of one ray (origin `o`, clamped `1/d` `inv`, near planes `near`,
     /// each splat over four lanes) against slots `4·half..4·half + 4` of `node`: the slots met
     /// (not yet masked by `valid`) and each slot's widened entry `t`.
     #[inline(always)]
-    fn slab(
-        node: &super::Node,
+    fn slab<const W: usize>(
+        node: &Node<W>,
         half: usize,
         o: [Vec4; 3],
         inv: [Vec4; 3],
@@ -650,7 +728,7 @@ struct Avx8(pulp::x86::V3);
 impl NodeTest for Avx8 {
     /// [`Sse4::enter_one`] on all eight slots at once: the same operations lane by lane.
     #[inline(always)]
-    fn enter_one(&self, r: &TravRay, node: &super::Node, limit: f32) -> (u32, [f32; WIDTH]) {
+    fn enter_one(&self, r: &TravRay, node: &Node, limit: f32) -> (u32, [f32; WIDTH]) {
         let o = [r.ox.x, r.oy.x, r.oz.x];
         let inv = [r.ix.x, r.iy.x, r.iz.x];
         let (hit, t_near) = self.slab(node, o, inv, r.near, r.t_min.x, limit);
@@ -670,7 +748,7 @@ impl NodeTest for Avx8 {
     fn one_of<const L: usize>(
         &self,
         r: &Rays4<L>,
-        node: &super::Node,
+        node: &Node,
         ray: usize,
         keys: &mut Self::Keys,
     ) -> u32 {
@@ -698,7 +776,7 @@ impl Avx8 {
     #[inline(always)]
     fn slab(
         &self,
-        node: &super::Node,
+        node: &Node,
         o: [f32; 3],
         inv: [f32; 3],
         near: [usize; 3],
@@ -818,7 +896,7 @@ mod tests {
     fn overflow_to_the_long_stack_finds_the_same_hits() {
         let (prims, mut rnd) = scattered_triangles(7);
         let bvh = Bvh::build(prims.clone());
-        assert!(stack_need(&bvh.nodes) > 1);
+        assert!(stack_need(&bvh) > 1);
         let m = Methods::default();
         let mut hits = 0;
         for _ in 0..2000 {
