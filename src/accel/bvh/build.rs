@@ -90,12 +90,12 @@ impl Bvh {
     /// tree exist (the leaves' boxes are its node list, filled here; no list of boxes or of
     /// primitives beside it); the primitives are read again for the leaves.
     pub(in crate::accel) fn build_from<P: Prims + ?Sized>(prims: &P) -> Bvh {
-        Self::build_split(prims, SPLIT_BUILD_MIN_PRIMS)
+        Self::build_split(prims, SPLIT_BUILD_MIN_PRIMS, SPLIT_PART_MAX_PRIMS)
     }
 
-    /// [`Bvh::build_from`] with the two-tree build from `split_min` primitives on (at least
-    /// 4; the tests lower it).
-    fn build_split<P: Prims + ?Sized>(prims: &P, split_min: usize) -> Bvh {
+    /// [`Bvh::build_from`] with the split build from `split_min` primitives on (at least 4),
+    /// in parts of at most `part_max` primitives (the tests lower both).
+    fn build_split<P: Prims + ?Sized>(prims: &P, split_min: usize, part_max: usize) -> Bvh {
         let n = prims.count();
         // Loaded scenes stay far below (the file-size caps and the memory budget bound them);
         // beyond this, ids would not fit a leaf word.
@@ -108,7 +108,7 @@ impl Bvh {
         let mut built = None;
         if max_stacked(n, &bounds) <= MAX_STACKED {
             let flat = if n >= split_min.max(4) {
-                split_ploc(n, &bounds, &params)
+                split_ploc(n, &bounds, &params, part_max)
             } else {
                 let leaves: Vec<Bvh2Node> = (0..n)
                     .into_par_iter()
@@ -143,54 +143,50 @@ impl Bvh {
     }
 }
 
-/// From this many primitives on, the binary tree is built as two PLOC trees, one after the
-/// other, under a root that splits the primitives at the median of their centres along the
-/// widest axis: obvhs' PLOC needs about 210 bytes per primitive while it builds (its node
-/// lists of 48-byte nodes: the leaves, their sorted copy and the tree of `2N − 1`), so halves
-/// built one at a time halve that peak. Below this size the peak is small and one tree keeps
+/// From this many primitives on, the binary tree is built as several PLOC trees of at most
+/// [`SPLIT_PART_MAX_PRIMS`] primitives each, one after the other, under a few levels of median
+/// splits: obvhs' PLOC needs about 210 bytes per primitive while it builds (its node lists of
+/// 48-byte nodes: the leaves, their sorted copy and the tree of `2N − 1`), so parts built one
+/// at a time cut that peak to a part's. Below this size the peak is small and one tree keeps
 /// the whole build to PLOC.
 pub const SPLIT_BUILD_MIN_PRIMS: usize = 500_000;
 
-/// The pre-order binary tree of [`SPLIT_BUILD_MIN_PRIMS`]: a root whose children are the PLOC
-/// trees (each optimised by reinsertion) of the lower and upper halves of the primitives
-/// ordered by their box centres along the widest axis of those centres (ties by index).
+/// The most primitives of one PLOC tree in the split build ([`SPLIT_BUILD_MIN_PRIMS`]): parts
+/// are halved until they fit, so 1M triangles are built as four trees of 250k (session 12;
+/// two halves of 500k until then, which peaked at 2.01 times the memory the tracer keeps once
+/// narrow nodes made the kept tree smaller).
+pub const SPLIT_PART_MAX_PRIMS: usize = 1 << 18;
+
+/// The pre-order binary tree of [`SPLIT_BUILD_MIN_PRIMS`]: while a part holds more than
+/// `part_max` primitives, a node splitting it at the median of its box centres along the
+/// widest axis of those centres (ties by index) into a lower and an upper half, and each part
+/// that fits, the PLOC tree (optimised by reinsertion) of its primitives.
 fn split_ploc(
     n: usize,
     bounds: &(impl Fn(usize) -> Aabb + Sync),
     params: &BvhBuildParams,
+    part_max: usize,
 ) -> Option<Vec<FlatNode>> {
-    let centers = (0..n)
-        .into_par_iter()
-        .map(|i| {
-            let c = bounds(i).center();
-            Aabb::new(c, c)
-        })
-        .reduce(Aabb::empty, |a, b| a.union(&b));
-    let axis = centers.largest_axis();
     let mut ids: Vec<u32> = (0..n as u32).collect();
-    {
-        let keys: Vec<f32> = (0..n)
-            .into_par_iter()
-            .map(|i| bounds(i).center()[axis])
-            .collect();
-        ids.select_nth_unstable_by(n / 2, |&a, &b| {
-            keys[a as usize]
-                .total_cmp(&keys[b as usize])
-                .then(a.cmp(&b))
-        });
-    }
-    let (low, high) = ids.split_at_mut(n / 2);
     let mut flat: Vec<FlatNode> = Vec::with_capacity(2 * n - 1);
-    flat.push(FlatNode {
-        min: [0.0; 3],
-        max: [0.0; 3],
-        link: 0,
-    });
-    let mut root = Aabb::empty();
-    for (k, part) in [low, high].into_iter().enumerate() {
+    split_into(&mut ids, bounds, params, part_max.max(1), &mut flat, 1)?;
+    Some(flat)
+}
+
+/// Appends the split tree of the primitives `ids` (see [`split_ploc`]) in pre-order to `flat`,
+/// its root at depth `depth`; returns its box. `None` when deeper than [`MAX_BVH2_DEPTH`].
+fn split_into(
+    ids: &mut [u32],
+    bounds: &(impl Fn(usize) -> Aabb + Sync),
+    params: &BvhBuildParams,
+    part_max: usize,
+    flat: &mut Vec<FlatNode>,
+    depth: usize,
+) -> Option<Aabb> {
+    if ids.len() <= part_max {
         // In index order: neighbours in the input are often neighbours in space.
-        part.par_sort_unstable();
-        let leaves: Vec<Bvh2Node> = part
+        ids.par_sort_unstable();
+        let leaves: Vec<Bvh2Node> = ids
             .par_iter()
             .enumerate()
             .map(|(local, &i)| {
@@ -199,15 +195,43 @@ fn split_ploc(
             .collect();
         let mut bvh2 = ploc(leaves, params);
         ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
-        root = root.union(&bvh2.nodes[0].aabb);
-        if k == 1 {
-            flat[0].link = flat.len() as u32;
-        }
-        preorder_into(&bvh2, part, &mut flat, 2)?;
+        preorder_into(&bvh2, ids, flat, depth)?;
+        return Some(bvh2.nodes[0].aabb);
     }
-    flat[0].min = root.min.to_array();
-    flat[0].max = root.max.to_array();
-    Some(flat)
+    if depth > MAX_BVH2_DEPTH {
+        return None;
+    }
+    let centers = ids
+        .par_iter()
+        .map(|&i| {
+            let c = bounds(i as usize).center();
+            Aabb::new(c, c)
+        })
+        .reduce(Aabb::empty, |a, b| a.union(&b));
+    let axis = centers.largest_axis();
+    let mut keyed: Vec<(f32, u32)> = ids
+        .par_iter()
+        .map(|&i| (bounds(i as usize).center()[axis], i))
+        .collect();
+    let half = ids.len() / 2;
+    keyed.select_nth_unstable_by(half, |a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    for (id, (_, i)) in ids.iter_mut().zip(keyed) {
+        *id = i;
+    }
+    let here = flat.len();
+    flat.push(FlatNode {
+        min: [0.0; 3],
+        max: [0.0; 3],
+        link: 0,
+    });
+    let (low, high) = ids.split_at_mut(half);
+    let a = split_into(low, bounds, params, part_max, flat, depth + 1)?;
+    flat[here].link = flat.len() as u32;
+    let b = split_into(high, bounds, params, part_max, flat, depth + 1)?;
+    let both = a.union(&b);
+    flat[here].min = both.min.to_array();
+    flat[here].max = both.max.to_array();
+    Some(both)
 }
 
 /// obvhs' PLOC over `leaves` (one primitive each, primitive `i` at `i`), as
@@ -783,19 +807,31 @@ mod tests {
         assert!(reached.iter().all(|&r| r == 1));
     }
 
-    /// On uneven input the two-tree build costs a little more than one PLOC tree, but not much.
+    /// On uneven input the split build (two parts, and eight) costs a little more than one
+    /// PLOC tree, but not much.
     #[test]
-    fn the_two_tree_build_costs_about_the_same_on_uneven_input() {
+    fn the_split_build_costs_about_the_same_on_uneven_input() {
         let prims = clusters(40_000);
-        let whole = Bvh::build_split(&prims[..], usize::MAX);
-        let split = Bvh::build_split(&prims[..], 0);
-        let (a, b) = (sah_cost(&whole), sah_cost(&split));
-        eprintln!("clusters, surface-area cost: two trees {b:.3}, one tree {a:.3}");
-        assert!(b < a * 1.05, "split {b:.2} against whole {a:.2}");
+        let whole = Bvh::build_split(&prims[..], usize::MAX, usize::MAX);
+        let a = sah_cost(&whole);
+        for parts in [2, 8] {
+            let split = Bvh::build_split(&prims[..], 0, prims.len().div_ceil(parts));
+            let b = sah_cost(&split);
+            eprintln!("clusters, surface-area cost: {parts} trees {b:.3}, one tree {a:.3}");
+            assert!(b < a * 1.05, "{parts} parts: {b:.2} against whole {a:.2}");
+        }
     }
 
     #[test]
-    fn the_two_tree_build_finds_the_same_hits_at_about_the_same_cost() {
+    fn the_split_build_finds_the_same_hits_at_about_the_same_cost() {
+        for parts in [2, 8] {
+            split_build_finds_the_same_hits(parts);
+        }
+    }
+
+    /// The split build of `parts` parts on a torus with two spheres: its tree costs about what
+    /// one PLOC tree costs, and finds what brute force finds.
+    fn split_build_finds_the_same_hits(parts: usize) {
         let mut prims = torus(40_000);
         // Spheres first, as `Accel` lists them.
         for (k, c) in [Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.35, 0.0, 0.0)]
@@ -833,18 +869,18 @@ mod tests {
         ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
         let whole = collapse_flat(preorder(&bvh2).expect("shallow"), &prims[..]).expect("a tree");
         let split = collapse_flat(
-            split_ploc(n, &bounds, &params).expect("shallow"),
+            split_ploc(n, &bounds, &params, n.div_ceil(parts)).expect("shallow"),
             &prims[..],
         )
         .expect("a tree");
         assert!(stack_need(&split) + WIDTH - 1 <= STACK_SIZE);
         // `build_split` takes this path too.
-        let built = Bvh::build_split(&prims[..], 0);
+        let built = Bvh::build_split(&prims[..], 0, n.div_ceil(parts));
         assert_eq!(built.nodes.len(), split.nodes.len());
         assert_eq!(built.narrow.len(), split.narrow.len());
         let (a, b) = (sah_cost(&whole), sah_cost(&split));
-        eprintln!("surface-area cost: two trees {b:.3}, one tree {a:.3}");
-        assert!(b < a * 1.03, "split {b:.2} against whole {a:.2}");
+        eprintln!("surface-area cost: {parts} trees {b:.3}, one tree {a:.3}");
+        assert!(b < a * 1.03, "{parts} parts: {b:.2} against whole {a:.2}");
         assert!(split.spheres.len() == 2 && split.packets.len() > 40_000 / 4);
         let m = Methods::default();
         let mut seed = 7u32;
