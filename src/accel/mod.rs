@@ -168,6 +168,26 @@ trait Visitor {
     /// Test the triangles in lanes `0..count` of `tris` (ids `ids`), in lane order, with one
     /// four-lane test; the same answer as visiting them one by one. `true` stops.
     fn visit_triangles(&mut self, tris: &Triangles4, ids: &[u32; 4], count: usize) -> bool;
+    /// The query and `t_max` of the four-lane test [`Visitor::visit_triangles`] would run now,
+    /// when a test of two rays at once ([`pair_triangles4`]) may stand in for it; `None`: this
+    /// visitor tests alone.
+    #[inline(always)]
+    fn pair_query(&self) -> Option<(&Query<'_>, f32)> {
+        None
+    }
+    /// [`Visitor::visit_triangles`] given `hits`, the answers of the test of
+    /// [`Visitor::pair_query`] (a visitor without one tests alone).
+    #[inline(always)]
+    fn take_triangles(
+        &mut self,
+        hits: &TriHits4,
+        tris: &Triangles4,
+        ids: &[u32; 4],
+        count: usize,
+    ) -> bool {
+        let _ = hits;
+        self.visit_triangles(tris, ids, count)
+    }
     /// The traversal enters a box: a BVH child word (node or leaf) or a grid cell index. Only
     /// the recording visitor of [`visits`] looks; for the others this compiles away, so the
     /// queries of a render are not slowed by it.
@@ -197,6 +217,12 @@ impl<'a> Query<'a> {
     #[inline(always)]
     fn prim(&self, prim: &Prim, t_max: f32) -> Option<(f32, f32, f32)> {
         prim.intersect(self.m, self.ray, &self.shear, self.t_min, t_max)
+    }
+
+    /// Whether [`pair_triangles4`] can test this query: the watertight method, with a shear.
+    #[inline(always)]
+    fn pairs(&self) -> bool {
+        self.m.triangle == TriangleMethod::Watertight && self.shear.is_some()
     }
 
     #[inline(always)]
@@ -272,23 +298,32 @@ impl Visitor for Closest<'_> {
 
     #[inline(always)]
     fn visit_triangles(&mut self, tris: &Triangles4, ids: &[u32; 4], count: usize) -> bool {
-        let limit = |s: &Self| {
-            if s.prim == u32::MAX {
-                s.t
-            } else {
-                next_float_up(s.t)
-            }
-        };
+        let hits = self.q.triangles4(tris, count, self.tri_limit());
+        self.take_triangles(&hits, tris, ids, count)
+    }
+
+    #[inline(always)]
+    fn pair_query(&self) -> Option<(&Query<'_>, f32)> {
+        Some((&self.q, self.tri_limit()))
+    }
+
+    #[inline(always)]
+    fn take_triangles(
+        &mut self,
+        hits: &TriHits4,
+        _tris: &Triangles4,
+        ids: &[u32; 4],
+        _count: usize,
+    ) -> bool {
         // Each lane's t does not depend on the limit, and the limit only shrinks from lane to
         // lane, so testing all lanes against the first limit and then re-checking each
         // candidate against the current one in lane order is what `visit` one by one does.
-        let hits = self.q.triangles4(tris, count, limit(self));
         let mut mask = hits.mask;
         while mask != 0 {
             let lane = mask.trailing_zeros() as usize;
             mask &= mask - 1;
             let (t, id) = (hits.t[lane], ids[lane]);
-            if t < limit(self) && (t < self.t || (t == self.t && id < self.prim)) {
+            if t < self.tri_limit() && (t < self.t || (t == self.t && id < self.prim)) {
                 self.t = t;
                 self.prim = id;
                 self.b1 = hits.b1[lane];
@@ -296,6 +331,19 @@ impl Visitor for Closest<'_> {
             }
         }
         false
+    }
+}
+
+impl Closest<'_> {
+    /// The `t_max` of a triangle test now: the best `t` itself once there is a hit (the
+    /// tests' `t_max` is exclusive), so an equal `t` with a lower id can still win.
+    #[inline(always)]
+    fn tri_limit(&self) -> f32 {
+        if self.prim == u32::MAX {
+            self.t
+        } else {
+            next_float_up(self.t)
+        }
     }
 }
 
@@ -325,6 +373,55 @@ impl Visitor for AnyHit<'_> {
         self.hit = self.q.triangles4(tris, count, self.t_max).mask != 0;
         self.hit
     }
+
+    #[inline(always)]
+    fn pair_query(&self) -> Option<(&Query<'_>, f32)> {
+        Some((&self.q, self.t_max))
+    }
+
+    #[inline(always)]
+    fn take_triangles(
+        &mut self,
+        hits: &TriHits4,
+        _tris: &Triangles4,
+        _ids: &[u32; 4],
+        _count: usize,
+    ) -> bool {
+        self.hit = hits.mask != 0;
+        self.hit
+    }
+}
+
+/// The four-lane tests of two queries (`a` and `b`, each with the `t_max` its visitor would
+/// test with) against lanes `0..count` of `tris`, as one eight-lane AVX2 test
+/// ([`Shear::intersect4_pair`]): each answer bit for bit its own query's
+/// [`intersect_triangles4`]. `None` when one test cannot hold both (another method, no shear,
+/// or differently permuted shears).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn pair_triangles4(
+    simd: pulp::x86::V3,
+    (a, a_max): (&Query<'_>, f32),
+    (b, b_max): (&Query<'_>, f32),
+    tris: &Triangles4,
+    count: usize,
+) -> Option<(TriHits4, TriHits4)> {
+    let (Some(sa), Some(sb)) = (a.shear.as_ref(), b.shear.as_ref()) else {
+        return None;
+    };
+    if !(a.pairs() && b.pairs()) {
+        return None;
+    }
+    let (mut ha, mut hb) = Shear::intersect4_pair(
+        simd,
+        (sa, a.ray, a.t_min, a_max),
+        (sb, b.ray, b.t_min, b_max),
+        tris,
+    )?;
+    let used = (1u32 << count) - 1;
+    ha.mask &= used;
+    hb.mask &= used;
+    Some((ha, hb))
 }
 
 /// The valid primitives of a build, in the order the accelerators number them (spheres

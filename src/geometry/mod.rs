@@ -2,6 +2,7 @@
 //! Intersection"; robust variants from Ray Tracing Gems ch. 6–7, Woop–Benthin–Wald 2013 and
 //! pbrt-v4). Every method is selectable so the speed/accuracy sweeps can compare them.
 
+pub mod lanes;
 pub mod offset;
 pub mod shading;
 pub mod sphere;

@@ -17,6 +17,7 @@
 use glam::{DVec3, Vec3, Vec3A, Vec3Swizzles, Vec4};
 use serde::{Deserialize, Serialize};
 
+use super::lanes::Lanes;
 use super::{Ray, gamma};
 
 /// How rays meet triangles.
@@ -375,73 +376,94 @@ impl Shear {
         t_min: f32,
         t_max: f32,
     ) -> TriHits4 {
-        let v = &tris.v;
-        let (ox, oy, oz) = (
-            Vec4::splat(ray.origin[KX]),
-            Vec4::splat(ray.origin[KY]),
-            Vec4::splat(ray.origin[KZ]),
-        );
-        let (sx, sy, sz) = (
-            Vec4::splat(self.sx),
-            Vec4::splat(self.sy),
-            Vec4::splat(self.sz),
-        );
-        // Translate, permute and shear, as the scalar test.
-        let vertex = |k: usize| {
-            let z = v[3 * k + KZ] - oz;
-            (v[3 * k + KX] - ox + sx * z, v[3 * k + KY] - oy + sy * z, z)
-        };
-        let (p0x, p0y, p0z) = vertex(0);
-        let (p1x, p1y, p1z) = vertex(1);
-        let (p2x, p2y, p2z) = vertex(2);
-        let e0 = p1x * p2y - p1y * p2x;
-        let e1 = p2x * p0y - p2y * p0x;
-        let e2 = p0x * p1y - p0y * p1x;
-        let zero = Vec4::ZERO;
-        let on_edge = (e0.cmpeq(zero) | e1.cmpeq(zero) | e2.cmpeq(zero)).bitmask();
-        let negative = e0.cmplt(zero) | e1.cmplt(zero) | e2.cmplt(zero);
-        let positive = e0.cmpgt(zero) | e1.cmpgt(zero) | e2.cmpgt(zero);
-        let det = e0 + e1 + e2;
-        let t_scaled = e0 * (sz * p0z) + e1 * (sz * p1z) + e2 * (sz * p2z);
-        let inv_det = Vec4::ONE / det;
-        let t = t_scaled * inv_det;
-        // Every rejection of the scalar test, negated: inside, det ≠ 0 and not NaN, T of det's
-        // sign (and not NaN), t in range.
-        let inside = !(negative & positive);
-        let det_ok = det.cmpne(zero) & det.cmpeq(det);
-        let t_sign_ok =
-            (det.cmplt(zero) & t_scaled.cmplt(zero)) | (det.cmpgt(zero) & t_scaled.cmpgt(zero));
-        let in_range = t.cmpgt(Vec4::splat(t_min)) & t.cmplt(Vec4::splat(t_max));
-        let mut mask = (inside & det_ok & t_sign_ok & in_range).bitmask() & !on_edge;
-        if mask != 0 {
-            // pbrt-v4's conservative t > δt, as in the scalar test.
-            let (z0, z1, z2) = ((sz * p0z).abs(), (sz * p1z).abs(), (sz * p2z).abs());
-            let max_z = z0.max(z1).max(z2);
-            let max_x = p0x.abs().max(p1x.abs()).max(p2x.abs());
-            let max_y = p0y.abs().max(p1y.abs()).max(p2y.abs());
-            let g = |n: u32| Vec4::splat(gamma(n));
-            let delta_z = g(3) * max_z;
-            let delta_x = g(5) * (max_x + max_z);
-            let delta_y = g(5) * (max_y + max_z);
-            let delta_e =
-                Vec4::splat(2.0) * (g(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
-            let max_e = e0.abs().max(e1.abs()).max(e2.abs());
-            let delta_t = Vec4::splat(3.0)
-                * (g(3) * max_e * max_z + delta_e * max_z + delta_z * max_e)
-                * inv_det.abs();
-            // `t <= δt` rejects (a NaN δt accepts, as in the scalar test).
-            mask &= !t.cmple(delta_t).bitmask();
-        }
+        let o = [KX, KY, KZ].map(|k| Vec4::splat(ray.origin[k]));
+        let s = [self.sx, self.sy, self.sz].map(Vec4::splat);
+        let (min, max) = (Vec4::splat(t_min), Vec4::splat(t_max));
+        let found = watertight_lanes::<Vec4, KX, KY, KZ>(&tris.v, o, s, min, max);
         let mut hits = TriHits4 {
-            mask,
-            t: t.to_array(),
-            b1: (e1 * inv_det).to_array(),
-            b2: (e2 * inv_det).to_array(),
+            mask: found.mask,
+            t: found.t.to_array(),
+            b1: found.b1.to_array(),
+            b2: found.b2.to_array(),
         };
-        if on_edge != 0 {
-            self.on_edges(&mut hits, on_edge, tris, ray, t_min, t_max);
+        if found.on_edge != 0 {
+            self.on_edges(&mut hits, found.on_edge, tris, ray, t_min, t_max);
         }
         hits
+    }
+
+    /// [`Shear::intersect4`] of two rays (`a` and `b`: each its shear, ray, `t_min` and
+    /// `t_max`) against the same four triangles in one eight-lane test (AVX2): each ray's
+    /// answers are those of its own four-lane test, bit for bit (the same operations, see
+    /// [`super::lanes`]). `None` when the rays' shears permute differently (a different
+    /// largest direction component), which one test cannot hold.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub fn intersect4_pair(
+        simd: pulp::x86::V3,
+        a: (&Shear, &Ray, f32, f32),
+        b: (&Shear, &Ray, f32, f32),
+        tris: &Triangles4,
+    ) -> Option<(TriHits4, TriHits4)> {
+        if a.0.kz != b.0.kz {
+            return None;
+        }
+        Some(match a.0.kz {
+            0 => Self::pair_k::<1, 2, 0>(simd, a, b, tris),
+            1 => Self::pair_k::<2, 0, 1>(simd, a, b, tris),
+            _ => Self::pair_k::<0, 1, 2>(simd, a, b, tris),
+        })
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn pair_k<const KX: usize, const KY: usize, const KZ: usize>(
+        simd: pulp::x86::V3,
+        (sa, ra, a_min, a_max): (&Shear, &Ray, f32, f32),
+        (sb, rb, b_min, b_max): (&Shear, &Ray, f32, f32),
+        tris: &Triangles4,
+    ) -> (TriHits4, TriHits4) {
+        // No closures (see `watertight_lanes`).
+        use super::lanes::F32x8;
+        let mut v = [F32x8::pair(simd, 0.0, 0.0); 9];
+        for (to, c) in v.iter_mut().zip(&tris.v) {
+            *to = F32x8::halves(simd, *c, *c);
+        }
+        let o = [
+            F32x8::pair(simd, ra.origin[KX], rb.origin[KX]),
+            F32x8::pair(simd, ra.origin[KY], rb.origin[KY]),
+            F32x8::pair(simd, ra.origin[KZ], rb.origin[KZ]),
+        ];
+        let s = [
+            F32x8::pair(simd, sa.sx, sb.sx),
+            F32x8::pair(simd, sa.sy, sb.sy),
+            F32x8::pair(simd, sa.sz, sb.sz),
+        ];
+        let (min, max) = (
+            F32x8::pair(simd, a_min, b_min),
+            F32x8::pair(simd, a_max, b_max),
+        );
+        let found = watertight_lanes::<F32x8, KX, KY, KZ>(&v, o, s, min, max);
+        let (t, b1, b2) = (found.t.split(), found.b1.split(), found.b2.split());
+        let mut ha = TriHits4 {
+            mask: found.mask & 0xf,
+            t: t.0,
+            b1: b1.0,
+            b2: b2.0,
+        };
+        let mut hb = TriHits4 {
+            mask: found.mask >> 4,
+            t: t.1,
+            b1: b1.1,
+            b2: b2.1,
+        };
+        if found.on_edge & 0xf != 0 {
+            sa.on_edges(&mut ha, found.on_edge & 0xf, tris, ra, a_min, a_max);
+        }
+        if found.on_edge >> 4 != 0 {
+            sb.on_edges(&mut hb, found.on_edge >> 4, tris, rb, b_min, b_max);
+        }
+        (ha, hb)
     }
 
     /// The lanes in `lanes` (an edge function exactly 0), answered by the scalar test.
@@ -464,6 +486,101 @@ impl Shear {
                 self.intersect(&tris.triangle(lane), ray, t_min, t_max),
             );
         }
+    }
+}
+
+/// What [`watertight_lanes`] finds: bit `i` of `mask` when lane `i` hits (lanes with an edge
+/// function exactly 0 excluded: they are in `on_edge`, for the scalar test), and every lane's
+/// `t` and barycentrics.
+struct LaneHits<L> {
+    mask: u32,
+    on_edge: u32,
+    t: L,
+    b1: L,
+    b2: L,
+}
+
+/// The watertight test lane by lane (one triangle and one ray per lane), with the scalar
+/// test's operations in its order: the vertices `v` (by component, as [`Triangles4::v`]),
+/// the ray's origin `o` and shear `s` already permuted (`[x, y, z]` of the sheared frame),
+/// and the interval `(t_min, t_max)`.
+#[inline(always)]
+fn watertight_lanes<L: Lanes, const KX: usize, const KY: usize, const KZ: usize>(
+    v: &[L; 9],
+    o: [L; 3],
+    s: [L; 3],
+    t_min: L,
+    t_max: L,
+) -> LaneHits<L> {
+    // No closures here: a closure is compiled without the AVX2 features of the test around
+    // it, and the eight-lane operations in it would not be inlined.
+    let [ox, oy, oz] = o;
+    let [sx, sy, sz] = s;
+    // Translate, permute and shear, as the scalar test.
+    let (p0z, p1z, p2z) = (v[KZ] - oz, v[3 + KZ] - oz, v[6 + KZ] - oz);
+    let (p0x, p0y) = (v[KX] - ox + sx * p0z, v[KY] - oy + sy * p0z);
+    let (p1x, p1y) = (v[3 + KX] - ox + sx * p1z, v[3 + KY] - oy + sy * p1z);
+    let (p2x, p2y) = (v[6 + KX] - ox + sx * p2z, v[6 + KY] - oy + sy * p2z);
+    let e0 = p1x * p2y - p1y * p2x;
+    let e1 = p2x * p0y - p2y * p0x;
+    let e2 = p0x * p1y - p0y * p1x;
+    let zero = ox.splat_as(0.0);
+    let on_edge = L::bits(e0.cmp_eq(zero) | e1.cmp_eq(zero) | e2.cmp_eq(zero));
+    let negative = e0.cmp_lt(zero) | e1.cmp_lt(zero) | e2.cmp_lt(zero);
+    let positive = e0.cmp_gt(zero) | e1.cmp_gt(zero) | e2.cmp_gt(zero);
+    let det = e0 + e1 + e2;
+    let t_scaled = e0 * (sz * p0z) + e1 * (sz * p1z) + e2 * (sz * p2z);
+    let inv_det = zero.splat_as(1.0) / det;
+    let t = t_scaled * inv_det;
+    // Every rejection of the scalar test, negated: inside, det ≠ 0 and not NaN, T of det's
+    // sign (and not NaN), t in range.
+    let inside = !(negative & positive);
+    let det_ok = det.cmp_ne(zero) & det.cmp_eq(det);
+    let t_sign_ok =
+        (det.cmp_lt(zero) & t_scaled.cmp_lt(zero)) | (det.cmp_gt(zero) & t_scaled.cmp_gt(zero));
+    let in_range = t.cmp_gt(t_min) & t.cmp_lt(t_max);
+    let mut mask = L::bits(inside & det_ok & t_sign_ok & in_range) & !on_edge;
+    if mask != 0 {
+        // pbrt-v4's conservative t > δt, as in the scalar test.
+        let (z0, z1, z2) = (
+            (sz * p0z).abs_lanes(),
+            (sz * p1z).abs_lanes(),
+            (sz * p2z).abs_lanes(),
+        );
+        let max_z = z0.max_lanes(z1).max_lanes(z2);
+        let max_x = p0x
+            .abs_lanes()
+            .max_lanes(p1x.abs_lanes())
+            .max_lanes(p2x.abs_lanes());
+        let max_y = p0y
+            .abs_lanes()
+            .max_lanes(p1y.abs_lanes())
+            .max_lanes(p2y.abs_lanes());
+        let (g2, g3, g5) = (
+            zero.splat_as(gamma(2)),
+            zero.splat_as(gamma(3)),
+            zero.splat_as(gamma(5)),
+        );
+        let delta_z = g3 * max_z;
+        let delta_x = g5 * (max_x + max_z);
+        let delta_y = g5 * (max_y + max_z);
+        let delta_e = zero.splat_as(2.0) * (g2 * max_x * max_y + delta_y * max_x + delta_x * max_y);
+        let max_e = e0
+            .abs_lanes()
+            .max_lanes(e1.abs_lanes())
+            .max_lanes(e2.abs_lanes());
+        let delta_t = zero.splat_as(3.0)
+            * (g3 * max_e * max_z + delta_e * max_z + delta_z * max_e)
+            * inv_det.abs_lanes();
+        // `t <= δt` rejects (a NaN δt accepts, as in the scalar test).
+        mask &= !L::bits(t.cmp_le(delta_t));
+    }
+    LaneHits {
+        mask,
+        on_edge,
+        t,
+        b1: e1 * inv_det,
+        b2: e2 * inv_det,
     }
 }
 
@@ -539,4 +656,127 @@ pub fn triangle_hit_f64(v: &[Vec3; 3], ray: &Ray) -> Option<(f64, f64, f64, f64)
     let b2 = d.dot(q) / det;
     let t = e2.dot(q) / det;
     Some((t, 1.0 - b1 - b2, b1, b2))
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod pair_tests {
+    use super::*;
+
+    /// Two rays in one eight-lane test ([`Shear::intersect4_pair`]) get, bit for bit, what
+    /// their own four-lane tests give: hits, misses, lanes exactly on an edge or a vertex
+    /// (answered by the scalar test), degenerate triangles; and rays whose shears permute
+    /// differently are refused, not answered.
+    /// A test's answers as bits (a degenerate lane's NaN `t` is not equal to itself).
+    fn bits(h: &TriHits4) -> (u32, [[u32; 4]; 3]) {
+        (h.mask, [h.t, h.b1, h.b2].map(|a| a.map(f32::to_bits)))
+    }
+
+    /// Both rays' answers as bits.
+    fn both(h: &(TriHits4, TriHits4)) -> [(u32, [[u32; 4]; 3]); 2] {
+        [bits(&h.0), bits(&h.1)]
+    }
+
+    #[test]
+    fn two_rays_in_one_test_answer_as_each_alone() {
+        let simd = pulp::x86::V3::try_new()
+            .expect("this test needs a CPU with AVX2 and FMA (x86-64-v3), as the bench machines");
+        let mut seed = 0x2545_f491u32;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed as f32 / u32::MAX as f32 * 2.0 - 1.0
+        };
+        let (mut compared, mut hits, mut refused) = (0, 0, 0);
+        for round in 0..4000 {
+            // Small integer coordinates on some rounds, so rays through grid points land
+            // exactly on edges and vertices.
+            let grid = round % 3 == 0;
+            let mut point = || {
+                let p = Vec3::new(rnd(), rnd(), rnd()) * 2.0;
+                if grid { p.round() } else { p }
+            };
+            let tris: Vec<[Vec3; 3]> = (0..4)
+                .map(|k| {
+                    if k == 3 && round % 5 == 0 {
+                        let a = point();
+                        [a, a, point()]
+                    } else {
+                        [point(), point(), point()]
+                    }
+                })
+                .collect();
+            let packet = Triangles4::new(&tris);
+            let mut ray = |grid: bool| {
+                let o = Vec3::new(rnd(), rnd(), rnd()).normalize_or(Vec3::Z) * 5.0;
+                let aim = if grid {
+                    Vec3::new(rnd(), rnd(), rnd()).round()
+                } else {
+                    Vec3::new(rnd(), rnd(), rnd())
+                };
+                Ray::new(o, (aim - o).normalize())
+            };
+            let (ra, rb) = (ray(grid), ray(grid && round % 2 == 0));
+            let (Some(sa), Some(sb)) = (Shear::new(ra.dir), Shear::new(rb.dir)) else {
+                continue;
+            };
+            let (a_min, a_max) = (0.0, if round % 7 == 0 { 4.5 } else { f32::INFINITY });
+            let (b_min, b_max) = (1e-3, f32::INFINITY);
+            let alone = (
+                sa.intersect4(&packet, &ra, a_min, a_max),
+                sb.intersect4(&packet, &rb, b_min, b_max),
+            );
+            match Shear::intersect4_pair(
+                simd,
+                (&sa, &ra, a_min, a_max),
+                (&sb, &rb, b_min, b_max),
+                &packet,
+            ) {
+                Some(pair) => {
+                    assert_eq!(both(&pair), both(&alone), "round {round}");
+                    compared += 1;
+                    hits += (alone.0.mask | alone.1.mask).count_ones();
+                }
+                None => {
+                    assert_ne!(sa.kz, sb.kz);
+                    refused += 1;
+                }
+            }
+        }
+        // Rays straight down onto an edge shared by two triangles and onto a vertex: edge
+        // functions exactly 0, answered by the scalar test in both.
+        let z = |x: f32, y: f32| Vec3::new(x, y, 0.0);
+        let tris = [
+            [z(-1.0, -1.0), z(1.0, -1.0), z(0.0, 1.0)],
+            [z(-1.0, -1.0), z(0.0, -3.0), z(1.0, -1.0)],
+            [z(0.0, 1.0), z(1.0, -1.0), z(2.0, 1.0)],
+            [z(3.0, 3.0), z(4.0, 3.0), z(3.0, 4.0)],
+        ];
+        let packet = Triangles4::new(&tris);
+        let down = |x: f32, y: f32| Ray::new(Vec3::new(x, y, 5.0), Vec3::NEG_Z);
+        for (ra, rb) in [
+            (down(0.0, -1.0), down(0.0, 1.0)),
+            (down(1.0, -1.0), down(0.5, 0.0)),
+        ] {
+            let shear = |r: &Ray| Shear::new(r.dir).expect("a straight-down ray has a shear");
+            let (sa, sb) = (shear(&ra), shear(&rb));
+            let alone = (
+                sa.intersect4(&packet, &ra, 0.0, f32::INFINITY),
+                sb.intersect4(&packet, &rb, 0.0, f32::INFINITY),
+            );
+            let pair = Shear::intersect4_pair(
+                simd,
+                (&sa, &ra, 0.0, f32::INFINITY),
+                (&sb, &rb, 0.0, f32::INFINITY),
+                &packet,
+            );
+            assert_eq!(pair.map(|p| both(&p)), Some(both(&alone)));
+            assert!(alone.0.mask != 0 && alone.1.mask != 0, "{alone:?}");
+        }
+        assert!(
+            compared > 1000 && hits > 500,
+            "{compared} compared, {hits} hits"
+        );
+        assert!(refused > 0, "no pair of differently permuted rays");
+    }
 }

@@ -22,8 +22,10 @@
 use glam::{Vec3, Vec3A, Vec4};
 
 use super::{Bvh, LEAF, NARROW, NARROW_WIDTH, Node, SPHERE, STACK_SIZE, WIDTH};
+#[cfg(target_arch = "x86_64")]
+use crate::accel::pair_triangles4;
 use crate::accel::{Visitor, box_t_slack, prefetch};
-use crate::geometry::Ray;
+use crate::geometry::{Ray, Triangles4};
 
 /// Entries of the stack a query starts with; deeper queries continue on a [`STACK_SIZE`] one.
 const SHORT_STACK: usize = 32;
@@ -259,6 +261,23 @@ impl Bvh {
                 while m != 0 {
                     let i = m.trailing_zeros() as usize;
                     m &= m - 1;
+                    if T::PAIRS && m != 0 && word & SPHERE == 0 {
+                        // Two rays against the leaf's triangles in one test.
+                        let j = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        let packet = &self.packets[((word & !LEAF) >> 2) as usize];
+                        let count = (word & 3) as usize + 1;
+                        let [a, b] = vs.get_disjoint_mut([i, j]).expect("two rays of the packet");
+                        let stops = test.visit_pair(a, b, &packet.tris, &packet.ids, count);
+                        for (k, stop) in [(i, stops.0), (j, stops.1)] {
+                            if stop {
+                                active &= !(1 << k);
+                            } else if V::ORDERED {
+                                rays4.set_limit(k, vs[k].limit());
+                            }
+                        }
+                        continue;
+                    }
                     let v = &mut vs[i];
                     let stop = if word & SPHERE != 0 {
                         v.visit(&self.spheres[(word & !(LEAF | SPHERE)) as usize])
@@ -487,6 +506,24 @@ macro_rules! rays_by_slot {
 /// tests each), and the smallest entry `t` of the rays of their lane groups that meet it (no
 /// later than any of theirs, so a child popped behind it is behind every one of them).
 trait NodeTest: Copy {
+    /// Whether [`NodeTest::visit_pair`] tests two rays at once (the packet walk then hands it
+    /// a leaf's rays two by two).
+    const PAIRS: bool = false;
+
+    /// Rays `a` and `b` against lanes `0..count` of `tris` (ids `ids`), each as its
+    /// [`Visitor::visit_triangles`]: whether each stops.
+    #[inline(always)]
+    fn visit_pair<V: Visitor>(
+        &self,
+        a: &mut V,
+        b: &mut V,
+        tris: &Triangles4,
+        ids: &[u32; 4],
+        count: usize,
+    ) -> (bool, bool) {
+        visit_each(a, b, tris, ids, count)
+    }
+
     /// The single-ray test: the slots of `node` whose widened `(t_min, limit]` interval the
     /// ray `r` meets (bit `i` for slot `i`), and each slot's widened entry `t`.
     fn enter_one(&self, r: &TravRay, node: &Node, limit: f32) -> (u32, [f32; WIDTH]);
@@ -529,6 +566,21 @@ trait NodeTest: Copy {
             .one_of(r, node, ray, &mut keys));
         (entered, self.key_array(keys))
     }
+}
+
+/// [`NodeTest::visit_pair`] one ray after the other.
+#[inline(always)]
+fn visit_each<V: Visitor>(
+    a: &mut V,
+    b: &mut V,
+    tris: &Triangles4,
+    ids: &[u32; 4],
+    count: usize,
+) -> (bool, bool) {
+    (
+        a.visit_triangles(tris, ids, count),
+        b.visit_triangles(tris, ids, count),
+    )
 }
 
 impl<const W: usize> Node<W> {
@@ -726,6 +778,32 @@ struct Avx8(pulp::x86::V3);
 
 #[cfg(target_arch = "x86_64")]
 impl NodeTest for Avx8 {
+    const PAIRS: bool = true;
+
+    /// Both rays in one eight-lane test when their queries allow it
+    /// ([`crate::accel::pair_triangles4`]), each on its own otherwise.
+    #[inline(always)]
+    fn visit_pair<V: Visitor>(
+        &self,
+        a: &mut V,
+        b: &mut V,
+        tris: &Triangles4,
+        ids: &[u32; 4],
+        count: usize,
+    ) -> (bool, bool) {
+        let pair = match (a.pair_query(), b.pair_query()) {
+            (Some(qa), Some(qb)) => pair_triangles4(self.0, qa, qb, tris, count),
+            _ => None,
+        };
+        match pair {
+            Some((ha, hb)) => (
+                a.take_triangles(&ha, tris, ids, count),
+                b.take_triangles(&hb, tris, ids, count),
+            ),
+            None => visit_each(a, b, tris, ids, count),
+        }
+    }
+
     /// [`Sse4::enter_one`] on all eight slots at once: the same operations lane by lane.
     #[inline(always)]
     fn enter_one(&self, r: &TravRay, node: &Node, limit: f32) -> (u32, [f32; WIDTH]) {
