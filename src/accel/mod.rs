@@ -171,6 +171,7 @@ trait Visitor {
     /// The query and `t_max` of the four-lane test [`Visitor::visit_triangles`] would run now,
     /// when a test of two rays at once ([`pair_triangles4`]) may stand in for it; `None`: this
     /// visitor tests alone.
+    #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn pair_query(&self) -> Option<(&Query<'_>, f32)> {
         None
@@ -220,6 +221,7 @@ impl<'a> Query<'a> {
     }
 
     /// Whether [`pair_triangles4`] can test this query: the watertight method, with a shear.
+    #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn pairs(&self) -> bool {
         self.m.triangle == TriangleMethod::Watertight && self.shear.is_some()
@@ -302,6 +304,7 @@ impl Visitor for Closest<'_> {
         self.take_triangles(&hits, tris, ids, count)
     }
 
+    #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn pair_query(&self) -> Option<(&Query<'_>, f32)> {
         Some((&self.q, self.tri_limit()))
@@ -374,6 +377,7 @@ impl Visitor for AnyHit<'_> {
         self.hit
     }
 
+    #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn pair_query(&self) -> Option<(&Query<'_>, f32)> {
         Some((&self.q, self.t_max))
