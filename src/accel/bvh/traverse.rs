@@ -1,6 +1,7 @@
 //! Traversal of the 8-wide [`Bvh`]: the closest-hit and any-hit walks over one stack and the
 //! SIMD test of a node's eight child boxes (one AVX2 test, or two SSE ones; a narrow node's
-//! four boxes in one SSE test).
+//! four boxes in one SSE test). With AVX2, a packet's rays that reach a leaf are tested
+//! against its triangles two at a time ([`NodeTest::visit_pair`]).
 //!
 //! Traversal, and what it must guarantee (the accelerators agree bit for bit with brute force):
 //! child boxes are padded by a few ulp of their magnitude in every axis
