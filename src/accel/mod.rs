@@ -220,13 +220,6 @@ impl<'a> Query<'a> {
         prim.intersect(self.m, self.ray, &self.shear, self.t_min, t_max)
     }
 
-    /// Whether [`pair_triangles4`] can test this query: the watertight method, with a shear.
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    fn pairs(&self) -> bool {
-        self.m.triangle == TriangleMethod::Watertight && self.shear.is_some()
-    }
-
     #[inline(always)]
     fn triangles4(&self, tris: &Triangles4, count: usize, t_max: f32) -> TriHits4 {
         let shear = self.shear.as_ref();
@@ -413,7 +406,7 @@ fn pair_triangles4(
     let (Some(sa), Some(sb)) = (a.shear.as_ref(), b.shear.as_ref()) else {
         return None;
     };
-    if !(a.pairs() && b.pairs()) {
+    if a.m.triangle != TriangleMethod::Watertight || b.m.triangle != TriangleMethod::Watertight {
         return None;
     }
     let (mut ha, mut hb) = Shear::intersect4_pair(

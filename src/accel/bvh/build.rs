@@ -566,7 +566,7 @@ pub(super) fn stack_need(bvh: &Bvh) -> usize {
     let mut todo = vec![(0u32, 0usize)];
     while let Some((word, above)) = todo.pop() {
         let children = bvh.children(word, 0);
-        let here = above + bvh.children(word, 0).count().saturating_sub(1);
+        let here = above + children.clone().count().saturating_sub(1);
         worst = worst.max(here);
         for (child, _) in children {
             if child & LEAF == 0 {

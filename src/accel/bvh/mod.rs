@@ -206,7 +206,7 @@ impl Bvh {
     }
 
     /// The child words and boxes (at `level`) of inner node `word`, in slot order.
-    fn children(&self, word: u32, level: u32) -> impl Iterator<Item = (u32, VisitedBox)> {
+    fn children(&self, word: u32, level: u32) -> impl Iterator<Item = (u32, VisitedBox)> + Clone {
         debug_assert!(word & LEAF == 0);
         let slots = if word & NARROW != 0 {
             self.narrow[(word & !NARROW) as usize].children(level)
