@@ -282,8 +282,24 @@ static inline float highlight_cos(vec3 n, vec3 l, vec3 view) {
     return dot(reflect(neg(l), n), view);
 }
 
+/* x^shininess as raytree's shade::highlight_power, so both sides do the same shading work: a
+ * whole-number shininess up to 1024 by repeated squaring in double, rounded to float once;
+ * powf otherwise. */
+static inline float highlight_power(float x, float shininess) {
+    if (!(shininess >= 0.0f && shininess <= 1024.0f)) return powf(x, shininess);
+    unsigned n = (unsigned)shininess;
+    if ((float)n != shininess) return powf(x, shininess);
+    double base = (double)x, power = 1.0;
+    while (n > 0) {
+        if (n & 1u) power *= base;
+        base *= base;
+        n >>= 1;
+    }
+    return (float)power;
+}
+
 static inline float highlight(vec3 n, vec3 l, vec3 view, float shininess) {
-    return powf(fmaxf(highlight_cos(n, l, view), 0.0f), shininess);
+    return highlight_power(fmaxf(highlight_cos(n, l, view), 0.0f), shininess);
 }
 
 static int flush_denormals;

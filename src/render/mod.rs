@@ -122,7 +122,7 @@ pub fn trace_tile_single(
 
 /// Width and height in pixels of the block of neighbouring camera rays traced as one packet
 /// ([`Tracer::trace_packet`]).
-pub const PACKET_BLOCK: (u32, u32) = (4, 4);
+pub const PACKET_BLOCK: (u32, u32) = (8, 4);
 const PACKET_RAYS: usize = (PACKET_BLOCK.0 * PACKET_BLOCK.1) as usize;
 
 /// The one tile loop of the batch render ([`trace_tile`]) and the viewer's session: adds
