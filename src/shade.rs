@@ -165,23 +165,14 @@ mod tests {
 
     const H: f32 = std::f32::consts::FRAC_1_SQRT_2;
 
-    /// Numbers in `[0, 1]` from a xorshift generator started at `seed` (not 0).
-    fn uniform(mut seed: u32) -> impl FnMut() -> f32 {
-        move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 17;
-            seed ^= seed << 5;
-            seed as f32 / u32::MAX as f32
-        }
-    }
+    use crate::geometry::test_rng::{signed, uniform};
 
     /// Skipping the power where `C_l ⊙ ks` is zero gives the full product's bits: random
     /// cosines (negative, above 1, NaN), colours and specular coefficients with `+0` and `−0`
     /// channels, every shininess up to the bound.
     #[test]
     fn zero_specular_skips_the_power_bit_for_bit() {
-        let mut unit = uniform(99);
-        let mut rnd = || unit() * 2.0 - 1.0;
+        let mut rnd = signed(99);
         let mut skipped = 0;
         for k in 0..20000 {
             let cos = match k % 7 {

@@ -365,9 +365,9 @@ impl Visitor for AnyHit<'_> {
     }
 
     #[inline(always)]
-    fn visit_triangles(&mut self, tris: &Triangles4, _ids: &[u32; 4], count: usize) -> bool {
-        self.hit = self.q.triangles4(tris, count, self.t_max).mask != 0;
-        self.hit
+    fn visit_triangles(&mut self, tris: &Triangles4, ids: &[u32; 4], count: usize) -> bool {
+        let hits = self.q.triangles4(tris, count, self.t_max);
+        self.take_triangles(&hits, tris, ids, count)
     }
 
     #[cfg(target_arch = "x86_64")]

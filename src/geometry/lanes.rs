@@ -136,59 +136,28 @@ mod avx2 {
         }
     }
 
-    impl Add for F32x8 {
-        type Output = Self;
-        #[inline(always)]
-        fn add(self, o: Self) -> Self {
-            self.with(self.simd.avx._mm256_add_ps(self.v, o.v))
-        }
-    }
-
-    impl Sub for F32x8 {
-        type Output = Self;
-        #[inline(always)]
-        fn sub(self, o: Self) -> Self {
-            self.with(self.simd.avx._mm256_sub_ps(self.v, o.v))
-        }
-    }
-
-    impl Mul for F32x8 {
-        type Output = Self;
-        #[inline(always)]
-        fn mul(self, o: Self) -> Self {
-            self.with(self.simd.avx._mm256_mul_ps(self.v, o.v))
-        }
-    }
-
-    impl Div for F32x8 {
-        type Output = Self;
-        #[inline(always)]
-        fn div(self, o: Self) -> Self {
-            self.with(self.simd.avx._mm256_div_ps(self.v, o.v))
-        }
-    }
-
-    impl BitAnd for M32x8 {
-        type Output = Self;
-        #[inline(always)]
-        fn bitand(self, o: Self) -> Self {
-            M32x8 {
-                v: self.simd.avx._mm256_and_ps(self.v, o.v),
-                simd: self.simd,
+    /// `impl $trait for $ty` by one two-operand AVX intrinsic on the lanes.
+    macro_rules! lane_op {
+        ($ty:ident, $trait:ident, $method:ident, $intrinsic:ident) => {
+            impl $trait for $ty {
+                type Output = Self;
+                #[inline(always)]
+                fn $method(self, o: Self) -> Self {
+                    $ty {
+                        v: self.simd.avx.$intrinsic(self.v, o.v),
+                        simd: self.simd,
+                    }
+                }
             }
-        }
+        };
     }
 
-    impl BitOr for M32x8 {
-        type Output = Self;
-        #[inline(always)]
-        fn bitor(self, o: Self) -> Self {
-            M32x8 {
-                v: self.simd.avx._mm256_or_ps(self.v, o.v),
-                simd: self.simd,
-            }
-        }
-    }
+    lane_op!(F32x8, Add, add, _mm256_add_ps);
+    lane_op!(F32x8, Sub, sub, _mm256_sub_ps);
+    lane_op!(F32x8, Mul, mul, _mm256_mul_ps);
+    lane_op!(F32x8, Div, div, _mm256_div_ps);
+    lane_op!(M32x8, BitAnd, bitand, _mm256_and_ps);
+    lane_op!(M32x8, BitOr, bitor, _mm256_or_ps);
 
     impl Not for M32x8 {
         type Output = Self;

@@ -6,6 +6,8 @@ pub mod lanes;
 pub mod offset;
 pub mod shading;
 pub mod sphere;
+#[cfg(test)]
+pub(crate) mod test_rng;
 pub mod triangle;
 
 use glam::Vec3;
