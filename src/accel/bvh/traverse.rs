@@ -445,24 +445,23 @@ impl<const L: usize> Rays4<L> {
         // `walk_packet` picks `L ≥ K`; its other branches, where `L < K`, are never taken.
         const { assert!(L.is_multiple_of(8)) };
         assert!(K <= L);
-        let mut o = [[0.0f32; L]; 3];
-        let mut inv = [[1.0f32; L]; 3];
-        let mut near = [[0u32; 3]; L];
+        // Formed in place, field by field: arrays built apart and moved in are copied.
+        let mut r = Rays4 {
+            o: [[0.0f32; L]; 3],
+            inv: [[1.0f32; L]; 3],
+            near: [[0u32; 3]; L],
+            t_min,
+            limit: [f32::NEG_INFINITY; L],
+        };
         for (i, ray) in rays.iter().enumerate() {
             let d = trav_inv(ray.dir);
             for axis in 0..3 {
-                o[axis][i] = ray.origin[axis];
-                inv[axis][i] = d[axis];
-                near[i][axis] = 2 * axis as u32 + u32::from(d[axis] < 0.0);
+                r.o[axis][i] = ray.origin[axis];
+                r.inv[axis][i] = d[axis];
+                r.near[i][axis] = 2 * axis as u32 + u32::from(d[axis] < 0.0);
             }
         }
-        Rays4 {
-            o,
-            inv,
-            near,
-            t_min,
-            limit: [f32::NEG_INFINITY; L],
-        }
+        r
     }
 
     #[inline(always)]
