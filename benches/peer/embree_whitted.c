@@ -278,7 +278,11 @@ static vec3 reflect(vec3 u, vec3 n) { return sub(u, scale(2.0f * dot(u, n), n));
 /* max(cos, 0)^shininess, cos of the halfway vector (Blinn-Phong) or of the mirrored light
  * (Phong), as raytree's shade::light_terms_with. */
 static inline float highlight_cos(vec3 n, vec3 l, vec3 view) {
-    if (S.blinn) return dot(n, normalize_or_zero(add(l, view)));
+    if (S.blinn) { /* as raytree's shade::cos_halfway: N·(L + V) / |L + V| */
+        vec3 s = add(l, view);
+        float len = length(s);
+        return (len > 0.0f && isfinite(len)) ? dot(n, s) / len : 0.0f;
+    }
     return dot(reflect(neg(l), n), view);
 }
 
