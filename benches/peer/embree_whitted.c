@@ -56,10 +56,6 @@ static inline vec3 cross(vec3 a, vec3 b) {
 static inline float length(vec3 a) { return sqrtf(dot(a, a)); }
 /* As glam: multiply by the reciprocal of the length. */
 static inline vec3 normalize(vec3 a) { return scale(1.0f / length(a), a); }
-static inline vec3 normalize_or_zero(vec3 a) {
-    float r = 1.0f / length(a);
-    return (isfinite(r) && r > 0.0f) ? scale(r, a) : v3(0, 0, 0);
-}
 static inline int is_zero(vec3 a) { return a.x == 0.0f && a.y == 0.0f && a.z == 0.0f; }
 static inline float comp(vec3 a, int i) { return i == 0 ? a.x : (i == 1 ? a.y : a.z); }
 
