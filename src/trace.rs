@@ -716,6 +716,10 @@ impl Tracer {
         for i in set_bits(active) {
             // In place: the facts are written where the caller reads them.
             let (color, info) = &mut out[i];
+            if let Some(c) = self.shade_given_local(&rays[i], &given[i], counts, info) {
+                *color = c;
+                continue;
+            }
             *info = SampleInfo::default();
             let s = &mut Sample {
                 counts: &mut *counts,
@@ -724,6 +728,64 @@ impl Tracer {
             };
             *color = self.trace_ray_given(&rays[i], primary, s, Some(&given[i]));
         }
+    }
+
+    /// [`Tracer::trace_ray_given`] of a packet's primary ray `ray` whose hit is on a surface
+    /// without reflection or refraction (the camera- and shadow-ray frame's every hit), its
+    /// shadow rays set up and answered in `g` for each of the scene's lights: the same colour
+    /// and facts, bit for bit (the same local terms in the same order; no child, so no end
+    /// reason), without the general path's bookkeeping for children, recorders and lights
+    /// beyond [`GIVEN_LIGHTS`]. `None`, with nothing counted or written, where the general
+    /// path is needed. The caller checked that primary rays are traced at all.
+    #[inline(always)]
+    fn shade_given_local(
+        &self,
+        ray: &Ray,
+        g: &Given,
+        counts: &mut RayCounts,
+        info: &mut SampleInfo,
+    ) -> Option<Vec3> {
+        let scene = &*self.scene;
+        if !g.has_surface || scene.lights.len() > GIVEN_LIGHTS {
+            return None;
+        }
+        let surface = &g.surface.0;
+        let material = scene.material(surface.material);
+        if material.reflectivity != Vec3::ZERO || material.transparency != Vec3::ZERO {
+            return None;
+        }
+        let lights = &g.lights[..scene.lights.len()];
+        if lights.iter().any(Option::is_none) {
+            return None;
+        }
+        let (n, v) = (surface.normal, -ray.dir);
+        let kd = texelled(material.diffuse, surface.texel_kd);
+        let ka = texelled(material.ambient, surface.texel_ka);
+        let ambient = ka * scene.render.ambient_light;
+        let (mut diffuse, mut specular) = (Vec3::ZERO, Vec3::ZERO);
+        let mut shadows = 0;
+        for (li, (light, lr)) in scene.lights.iter().zip(lights.iter().flatten()).enumerate() {
+            if lr.ray.is_none() {
+                continue;
+            }
+            shadows += 1;
+            if g.blocked >> li & 1 == 0 {
+                let shading = scene.render.shading;
+                let terms = light_terms_with(shading, material, kd, light.color, n, lr.l, v);
+                diffuse += terms.diffuse;
+                specular += terms.specular;
+            }
+        }
+        counts.primary += 1;
+        counts.shadow += u64::from(shadows);
+        *info = SampleInfo {
+            depth_reached: 0,
+            rays: 1 + shadows,
+            ends: 0,
+            normal: n,
+            hit_t: surface.t,
+        };
+        Some(ambient + diffuse + specular)
     }
 
     /// Why a ray ends before it is traced, if it does: past the maximum depth; below the weight

@@ -175,6 +175,74 @@ fn tile_facts_are_the_single_paths() {
     assert!(later.is_empty());
 }
 
+/// Hits on surfaces without reflection or refraction take the packet's local-only shading
+/// (`Tracer::shade_given_local`), the others and scenes of more lights than a packet keeps
+/// the general path: the same colours, facts and ray counts as ray by ray either way, with
+/// one to six lights (one of them black, one below the floor, one a visible ball), every
+/// material opaque or the scene's own, on the textured `default` scene and `smooth`.
+#[test]
+fn local_only_shading_is_the_general_paths() {
+    let extra = [
+        (Vec3::new(2.0, 7.0, 4.0), Vec3::splat(0.3), 0.0),
+        (Vec3::new(0.0, -3.0, 0.0), Vec3::splat(0.6), 0.0),
+        (Vec3::new(-3.0, 2.0, -4.0), Vec3::ZERO, 0.0),
+        (Vec3::new(1.5, 3.0, 3.0), Vec3::new(0.2, 0.5, 0.1), 0.1),
+    ];
+    for name in ["default", "smooth"] {
+        for opaque in [true, false] {
+            for lights in 1..=6 {
+                let mut scene = sized(name, 45, 37);
+                if opaque {
+                    for m in scene.materials.iter_mut() {
+                        m.reflectivity = Vec3::ZERO;
+                        m.transparency = Vec3::ZERO;
+                    }
+                }
+                for (k, &(position, color, radius)) in extra.iter().cycle().enumerate() {
+                    if scene.lights.len() >= lights {
+                        break;
+                    }
+                    let mut light = scene.lights[0].clone();
+                    light.name = format!("extra {k}");
+                    (light.position, light.color, light.radius) = (position, color, radius);
+                    light.follow_camera = false;
+                    scene.lights.push(light);
+                }
+                scene.lights.truncate(lights);
+                let what = format!("{name}, opaque {opaque}, {lights} lights");
+                let tracer = Tracer::new(Arc::new(scene.clone()), TraceSettings::default());
+                let (w, h) = (scene.render.width, scene.render.height);
+                let frame = CameraFrame::new(&scene.camera, w, h);
+                let rect = Rect {
+                    x: 0,
+                    y: 0,
+                    width: w,
+                    height: h,
+                };
+                let n = (w * h) as usize;
+                let (mut sums_p, mut sums_s) = (vec![Vec3::ZERO; n], vec![Vec3::ZERO; n]);
+                let (mut counts_p, mut counts_s) = (RayCounts::default(), RayCounts::default());
+                let (mut facts_p, mut facts_s) = (Vec::new(), Vec::new());
+                let (p, s) = (&mut sums_p, &mut counts_p);
+                accumulate_tile(&tracer, &frame, rect, 0..2, p, s, Some(&mut facts_p));
+                let (p, s) = (&mut sums_s, &mut counts_s);
+                accumulate_tile_single(&tracer, &frame, rect, 0..2, p, s, Some(&mut facts_s));
+                assert_eq!(counts_p, counts_s, "{what}: ray counts");
+                assert!(counts_p.shadow > 0, "{what}: {counts_p:?}");
+                assert_eq!(facts_p, facts_s, "{what}: pixel facts");
+                let (a, b) = (sums_p.iter(), sums_s.iter());
+                let differ = a
+                    .zip(b)
+                    .filter(|(x, y)| {
+                        x.to_array().map(f32::to_bits) != y.to_array().map(f32::to_bits)
+                    })
+                    .count();
+                assert_eq!(differ, 0, "{what}: {differ} pixels differ");
+            }
+        }
+    }
+}
+
 /// The viewer's coarse preview traces its block centres in packets: the same colours, facts
 /// and ray counts as one ray at a time, on every built-in scene, for whole tiles, tiles cut by
 /// the image's edge (centres clamped into it) and a block size that does not divide the tile.

@@ -16,7 +16,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::scene::budget::{MemoryError, batch_memory_estimate, memory_limit};
-use crate::scene::{CameraFrame, primary_ray};
+use crate::scene::{CameraFrame, primary_ray, primary_rays};
 use crate::trace::{
     NoRecord, PacketScratch, RayCounts, RayKind, SampleInfo, TraceSettings, Tracer,
 };
@@ -206,19 +206,20 @@ impl Tile<'_> {
             for bx in (0..rect.width).step_by(bw as usize) {
                 // The block's pixels inside the rect, row-major: (index in `sums`, x, y).
                 let mut pixels = [(0usize, 0u32, 0u32); PACKET_RAYS];
+                // Their image positions alone, lane by lane, for the camera rays.
+                let mut xy = [(0u32, 0u32); PACKET_RAYS];
                 let mut n = 0;
                 for j in by..(by + bh).min(rect.height) {
                     for i in bx..(bx + bw).min(rect.width) {
                         pixels[n] = ((j * rect.width + i) as usize, rect.x + i, rect.y + j);
+                        xy[n] = (rect.x + i, rect.y + j);
                         n += 1;
                     }
                 }
                 // The low `n` bits (`n` is 1 to 32: a shift by 32 would not be defined).
                 let active = u32::MAX >> (32 - n);
                 for s in samples.clone() {
-                    for (k, &(_, x, y)) in pixels[..n].iter().enumerate() {
-                        rays[k] = primary_ray(frame, x, y, s);
-                    }
+                    primary_rays(frame, &xy, n, s, &mut rays);
                     tracer.trace_packet(&rays, active, counts, &mut out, &mut scratch);
                     for (&(at, _, _), &(c, info)) in pixels[..n].iter().zip(&out[..n]) {
                         sums[at] += c;

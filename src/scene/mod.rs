@@ -27,7 +27,7 @@ use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
 pub use builtin::load_builtin;
-pub use camera::{Camera, CameraFrame, primary_ray};
+pub use camera::{Camera, CameraFrame, primary_ray, primary_rays};
 pub use diag::SceneError;
 pub use files::{fs_resolver, load_scene_file, load_scene_str, open_scene_arg};
 pub use load::{load_scene_str_with, load_scene_str_with_files};
