@@ -764,14 +764,17 @@ impl Tracer {
         let ambient = ka * scene.render.ambient_light;
         let (mut diffuse, mut specular) = (Vec3::ZERO, Vec3::ZERO);
         let mut shadows = 0;
-        for (li, (light, lr)) in scene.lights.iter().zip(lights.iter().flatten()).enumerate() {
-            if lr.ray.is_none() {
+        for (li, light) in scene.lights.iter().enumerate() {
+            let Some(LightRay {
+                l, ray: Some(_), ..
+            }) = lights[li]
+            else {
                 continue;
-            }
+            };
             shadows += 1;
             if g.blocked >> li & 1 == 0 {
                 let shading = scene.render.shading;
-                let terms = light_terms_with(shading, material, kd, light.color, n, lr.l, v);
+                let terms = light_terms_with(shading, material, kd, light.color, n, l, v);
                 diffuse += terms.diffuse;
                 specular += terms.specular;
             }
