@@ -794,6 +794,20 @@ fn box_t_slack() -> f32 {
     2.0 * crate::geometry::gamma(3)
 }
 
+/// [`box_t_slack`] as the factors the BVH's node tests scale a box's entry and exit `t` by,
+/// `(1 − slack, 1 + slack)`: one product each instead of `t ∓ |t|·slack`. For `t ≥ 0` that is
+/// the same widening but for the last rounding. A negative entry gives way to the query's
+/// `t_min` either way, as long as `t_min ≥ 0` (it is 0 for every query the tracer, the
+/// packets and the experiments ask; the BVH walks assert it in debug builds); a negative exit
+/// stays negative either way: the rounded slab products keep the signs of the exact ones, so
+/// the box lies behind the origin. The clamped `1/d` keeps the products finite for any scene
+/// within bounds, so no `∞ − ∞` appears.
+#[inline(always)]
+pub(crate) fn box_t_scales() -> (f32, f32) {
+    let slack = box_t_slack();
+    (1.0 - slack, 1.0 + slack)
+}
+
 /// Asks for the cache lines of `at` ahead of their use: a hint, with no effect on any answer.
 /// (`pulp`'s SSE token makes the prefetch instruction a safe call; SSE is part of x86-64.)
 #[inline(always)]

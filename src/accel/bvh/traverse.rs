@@ -25,7 +25,7 @@ use glam::{Vec3, Vec3A, Vec4};
 use super::{Bvh, LEAF, NARROW, NARROW_WIDTH, Node, SPHERE, STACK_SIZE, WIDTH};
 #[cfg(target_arch = "x86_64")]
 use crate::accel::pair_triangles4;
-use crate::accel::{Visitor, box_t_slack, prefetch};
+use crate::accel::{Visitor, box_t_scales, prefetch};
 use crate::geometry::{Ray, Triangles4};
 
 /// Entries of the stack a query starts with; deeper queries continue on a [`STACK_SIZE`] one.
@@ -40,6 +40,8 @@ impl Bvh {
     /// nearest child first when [`Visitor::ORDERED`].
     #[inline]
     pub(in crate::accel) fn walk<V: Visitor>(&self, ray: &Ray, t_min: f32, v: &mut V) {
+        // The node tests' widening needs it (`box_t_scales`).
+        debug_assert!(t_min >= 0.0, "BVH walk from t_min {t_min} < 0");
         if self.nodes.is_empty() {
             return;
         }
@@ -179,6 +181,7 @@ impl Bvh {
         active: u32,
     ) {
         const { assert!(K <= 32) };
+        debug_assert!(t_min >= 0.0, "BVH packet walk from t_min {t_min} < 0");
         if self.nodes.is_empty() || active == 0 {
             return;
         }
@@ -715,9 +718,9 @@ impl Sse4 {
             .min((p(fz) - o[2]) * inv[2]);
         // Widen both ends by the rounding of the slab arithmetic *and* of the primitives'
         // own t: a tie (equal t, lower id) in a flat box must not be culled by an ulp.
-        let slack = Vec4::splat(box_t_slack());
-        let t_near = (t_near - t_near.abs() * slack).max(t_min);
-        let t_far = (t_far + t_far.abs() * slack).min(limit);
+        let (shrink, grow) = box_t_scales();
+        let t_near = (t_near * Vec4::splat(shrink)).max(t_min);
+        let t_far = (t_far * Vec4::splat(grow)).min(limit);
         (t_near.cmple(t_far), t_near)
     }
 }
@@ -875,7 +878,6 @@ impl Avx8 {
             |a, b| avx._mm256_sub_ps(a, b),
             |a, b| avx._mm256_mul_ps(a, b),
         );
-        let abs = |a| avx._mm256_andnot_ps(splat(-0.0), a);
         let p = |k: usize| -> __m256 { pulp::cast(node.planes[k]) };
         let (ox, oy, oz) = (splat(o[0]), splat(o[1]), splat(o[2]));
         let (ix, iy, iz) = (splat(inv[0]), splat(inv[1]), splat(inv[2]));
@@ -887,12 +889,9 @@ impl Avx8 {
             min(mul(sub(p(fx), ox), ix), mul(sub(p(fy), oy), iy)),
             mul(sub(p(fz), oz), iz),
         );
-        let slack = splat(box_t_slack());
-        let t_near = max(sub(t_near, mul(abs(t_near), slack)), splat(t_min));
-        let t_far = min(
-            avx._mm256_add_ps(t_far, mul(abs(t_far), slack)),
-            splat(limit),
-        );
+        let (shrink, grow) = box_t_scales();
+        let t_near = max(mul(t_near, splat(shrink)), splat(t_min));
+        let t_far = min(mul(t_far, splat(grow)), splat(limit));
         (avx._mm256_cmp_ps::<_CMP_LE_OQ>(t_near, t_far), t_near)
     }
 }
