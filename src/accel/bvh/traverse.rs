@@ -232,7 +232,7 @@ impl Bvh {
         active: u32,
         test: T,
     ) {
-        let mut rays4 = Rays4::<L>::new(rays, t_min);
+        let mut rays4 = Rays4::<L>::new(rays, active, t_min);
         for (i, v) in vs.iter().enumerate() {
             rays4.set_limit(i, v.limit());
         }
@@ -443,8 +443,11 @@ struct Rays4<const L: usize> {
 }
 
 impl<const L: usize> Rays4<L> {
+    /// The lanes of the rays of `active` (bit `i` for `rays[i]`); the others are never
+    /// tested, and keep placeholder values (a shadow packet leaves out the lanes without a
+    /// shadow ray: their rays are last packet's).
     #[inline(always)]
-    fn new<const K: usize>(rays: &[Ray; K], t_min: f32) -> Self {
+    fn new<const K: usize>(rays: &[Ray; K], active: u32, t_min: f32) -> Self {
         // `walk_packet` picks `L ≥ K`; its other branches, where `L < K`, are never taken.
         const { assert!(L.is_multiple_of(8)) };
         assert!(K <= L);
@@ -456,7 +459,11 @@ impl<const L: usize> Rays4<L> {
             t_min,
             limit: [f32::NEG_INFINITY; L],
         };
-        for (i, ray) in rays.iter().enumerate() {
+        let mut rest = active;
+        while rest != 0 {
+            let i = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            let Some(ray) = rays.get(i) else { break };
             let d = trav_inv(ray.dir);
             for axis in 0..3 {
                 r.o[axis][i] = ray.origin[axis];
