@@ -1015,7 +1015,7 @@ mod tests {
             let mut closest = rays
                 .each_ref()
                 .map(|r| Closest::new(&m, r, 0.0, f32::INFINITY));
-            let mut rays4 = Rays4::<8>::new(&rays, 0.0);
+            let mut rays4 = Rays4::<8>::new(&rays, 0xff, 0.0);
             for (i, v) in closest.iter().enumerate() {
                 rays4.set_limit(i, v.limit());
             }
@@ -1033,7 +1033,7 @@ mod tests {
                 t_max: length,
                 hit: false,
             });
-            let mut rays4 = Rays4::<8>::new(&rays, 0.0);
+            let mut rays4 = Rays4::<8>::new(&rays, 0xff, 0.0);
             for (i, v) in any.iter().enumerate() {
                 rays4.set_limit(i, v.limit());
             }
