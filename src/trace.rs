@@ -762,6 +762,7 @@ impl Tracer {
         let kd = texelled(material.diffuse, surface.texel_kd);
         let ka = texelled(material.ambient, surface.texel_ka);
         let ambient = ka * scene.render.ambient_light;
+        let shading = scene.render.shading;
         let (mut diffuse, mut specular) = (Vec3::ZERO, Vec3::ZERO);
         let mut shadows = 0;
         for (li, light) in scene.lights.iter().enumerate() {
@@ -773,7 +774,6 @@ impl Tracer {
             };
             shadows += 1;
             if g.blocked >> li & 1 == 0 {
-                let shading = scene.render.shading;
                 let terms = light_terms_with(shading, material, kd, light.color, n, l, v);
                 diffuse += terms.diffuse;
                 specular += terms.specular;

@@ -12,16 +12,16 @@ use raytree::accel::{Accel, AccelKind, PrimSet};
 use raytree::choice::Choice;
 use raytree::geometry::{Methods, OffsetMethod, Ray, ShadingNormals, SphereMethod, TriangleMethod};
 use raytree::render::{
-    Image, Rect, accumulate_tile, accumulate_tile_single, preview_tile, preview_tile_single,
-    render, render_with, trace_tile_single,
+    Rect, accumulate_tile, accumulate_tile_single, preview_tile, preview_tile_single, render,
+    render_with, trace_tile_single,
 };
 use raytree::scene::builtin::{NAMES, load_builtin};
 use raytree::scene::{CameraFrame, Scene};
 use raytree::trace::{RayCounts, TraceSettings, Tracer};
 
-fn bits(image: &Image) -> Vec<[u32; 3]> {
-    image
-        .pixels
+/// Each colour's bits, to compare images (or sums) exactly.
+fn bits(pixels: &[Vec3]) -> Vec<[u32; 3]> {
+    pixels
         .iter()
         .map(|p| p.to_array().map(f32::to_bits))
         .collect()
@@ -35,7 +35,7 @@ fn assert_same(scene: &Scene, settings: TraceSettings, samples: u32, what: &str)
     let (single, ss) =
         render_with(&tracer, samples, 2, &|_, _| {}, &trace_tile_single).expect("single render");
     assert_eq!(ps.rays, ss.rays, "{what}: ray counts");
-    let (a, b) = (bits(&packets), bits(&single));
+    let (a, b) = (bits(&packets.pixels), bits(&single.pixels));
     let differ = a.iter().zip(&b).filter(|(x, y)| x != y).count();
     assert_eq!(differ, 0, "{what}: {differ} pixels differ");
     ps.rays
@@ -230,13 +230,8 @@ fn local_only_shading_is_the_general_paths() {
                 assert_eq!(counts_p, counts_s, "{what}: ray counts");
                 assert!(counts_p.shadow > 0, "{what}: {counts_p:?}");
                 assert_eq!(facts_p, facts_s, "{what}: pixel facts");
-                let (a, b) = (sums_p.iter(), sums_s.iter());
-                let differ = a
-                    .zip(b)
-                    .filter(|(x, y)| {
-                        x.to_array().map(f32::to_bits) != y.to_array().map(f32::to_bits)
-                    })
-                    .count();
+                let (a, b) = (bits(&sums_p), bits(&sums_s));
+                let differ = a.iter().zip(&b).filter(|(x, y)| x != y).count();
                 assert_eq!(differ, 0, "{what}: {differ} pixels differ");
             }
         }
@@ -275,9 +270,6 @@ fn coarse_preview_is_bit_identical() {
                 assert_eq!(counts_p, counts_s, "{what}");
                 assert!(counts_p.primary > 0, "{what}");
                 assert_eq!(facts_p, facts_s, "{what}");
-                let bits = |p: &[Vec3]| -> Vec<[u32; 3]> {
-                    p.iter().map(|c| c.to_array().map(f32::to_bits)).collect()
-                };
                 assert_eq!(bits(&pixels_p), bits(&pixels_s), "{what}");
                 // Every pixel of a block shows its centre's sample.
                 let b = block as usize;
@@ -324,7 +316,7 @@ fn avx2_and_sse_node_tests_are_bit_identical() {
             assert_eq!(wide, has_avx2 && simd != PacketSimd::Sse, "{simd:?}");
             let (image, ps) = render(&tracer, 1, 2, &|_, _| {}).expect("packet render");
             assert_eq!(ps.rays, ss.rays, "{name} {simd:?}: ray counts");
-            let (a, b) = (bits(&image), bits(&single));
+            let (a, b) = (bits(&image.pixels), bits(&single.pixels));
             let differ = a.iter().zip(&b).filter(|(x, y)| x != y).count();
             assert_eq!(
                 differ, 0,

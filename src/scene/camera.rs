@@ -65,18 +65,27 @@ impl CameraFrame {
         }
     }
 
-    /// The primary ray through image position (`x`, `y`) in pixels, where pixel (i, j) covers
-    /// `[i, i+1) × [j, j+1)` and its centre is (i + 0.5, j + 0.5).
     /// The image's width and height in pixels.
     pub fn size(&self) -> (u32, u32) {
         (self.width as u32, self.height as u32)
     }
 
+    /// The primary ray through image position (`x`, `y`) in pixels, where pixel (i, j) covers
+    /// `[i, i+1) × [j, j+1)` and its centre is (i + 0.5, j + 0.5).
     pub fn ray(&self, x: f32, y: f32) -> Ray {
-        let cx = (2.0 * x / self.width - 1.0) * self.aspect * self.tan_half_fov_y;
-        let cy = (1.0 - 2.0 * y / self.height) * self.tan_half_fov_y;
+        let (cx, cy) = self.image_plane(x, y);
         let dir = (cx * self.right + cy * self.up - self.back).normalize();
         Ray::new(self.origin, dir)
+    }
+
+    /// Image position (`x`, `y`) in pixels on the camera's image plane at distance 1, in units
+    /// of `right` and `up`: the one place [`CameraFrame::ray`] and [`primary_rays`] take it
+    /// from.
+    #[inline(always)]
+    fn image_plane(&self, x: f32, y: f32) -> (f32, f32) {
+        let cx = (2.0 * x / self.width - 1.0) * self.aspect * self.tan_half_fov_y;
+        let cy = (1.0 - 2.0 * y / self.height) * self.tan_half_fov_y;
+        (cx, cy)
     }
 
     /// Projects a world point to image position in pixels, or `None` when it is behind the
@@ -119,8 +128,7 @@ pub fn primary_rays<const K: usize>(
     for k in 0..K {
         // `CameraFrame::ray`'s arithmetic, operation for operation (glam's `Vec3` is scalar:
         // `cx * right + cy * up - back` rounds each component in this order).
-        let cx = (2.0 * x[k] / f.width - 1.0) * f.aspect * f.tan_half_fov_y;
-        let cy = (1.0 - 2.0 * y[k] / f.height) * f.tan_half_fov_y;
+        let (cx, cy) = f.image_plane(x[k], y[k]);
         dx[k] = (cx * r.x + cy * up.x) - back.x;
         dy[k] = (cx * r.y + cy * up.y) - back.y;
         dz[k] = (cx * r.z + cy * up.z) - back.z;
