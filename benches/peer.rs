@@ -18,7 +18,9 @@
 //! (Embree's advice); `user-high` is the same with the spheres as an Embree user geometry
 //! (whose callback is raytree's robust intersection), which measured faster than the built-in
 //! spheres on this scene; `issue7` is the configuration of issue 7 (user-geometry spheres,
-//! medium quality, denormals kept); `SPHERES:QUALITY[:ftz]` (e.g. `builtin:medium`) any other.
+//! medium quality, denormals kept); `SPHERES:QUALITY[:ftz][:robust]` (e.g. `builtin:medium`,
+//! `builtin:high:ftz:robust`) any other, `:robust` setting `RTC_SCENE_FLAG_ROBUST` (Embree's
+//! watertight mode; without it the scene flags are `RTC_SCENE_FLAG_NONE`, its fastest).
 //! The harness is compiled with `-O3 -march=native -ffp-contract=off` (no FMA contraction: its
 //! shading rounds as raytree's).
 //!
@@ -32,6 +34,9 @@
 //!
 //! Run: `cargo bench --bench peer` (80k, 320k and 1.28M triangles, 2 threads, 5 rounds), or
 //! e.g. `cargo bench --bench peer -- --sizes 1000,1000000 --threads 1 --runs 3 --keep /tmp/b`.
+//! With `--keep DIR` each scene's directory also gets `differences_N.png` for peer N: raytree's
+//! image with every pixel that differs by more than 2 of 255 marked red (the peer's is the
+//! brighter) or blue (raytree's is).
 //! `--size 1280x960` renders more rays than the scene's 640×480 (a longer, steadier render
 //! phase on a noisy machine). `--scene A,B` races on other scenes instead of the generated
 //! ones: built-in names, scene files or bare OBJ files, within the peer's reach (point lights,
@@ -57,13 +62,17 @@ struct PeerConfig {
     quality: String,
     /// Flush-to-zero and denormals-are-zero on the tracing threads (Embree's advice).
     ftz: bool,
+    /// `RTC_SCENE_FLAG_ROBUST`: Embree's watertight mode, for a race at equal robustness
+    /// (raytree's triangle test is watertight).
+    robust: bool,
 }
 
 impl PeerConfig {
     /// `best` (built-in spheres, high quality, FTZ/DAZ: the peer at its best as issue 15 names
     /// it), `user-high` (the same with user-geometry spheres, which measure faster here),
     /// `issue7` (user-geometry spheres, medium quality, denormals kept: the configuration of
-    /// issue 7), or `SPHERES:QUALITY` with `:ftz` after it for FTZ/DAZ.
+    /// issue 7), or `SPHERES:QUALITY` with `:ftz` after it for FTZ/DAZ and `:robust` for
+    /// Embree's watertight mode.
     fn parse(text: &str) -> Self {
         let text = match text {
             "best" => "builtin:high:ftz",
@@ -75,14 +84,19 @@ impl PeerConfig {
         let (spheres, quality) = (
             parts.next().unwrap_or_default(),
             parts.next().unwrap_or_else(|| {
-                panic!("--peer-config: best, issue7 or SPHERES:QUALITY[:ftz], not {text}")
+                panic!("--peer-config: best, issue7 or SPHERES:QUALITY[:ftz][:robust], not {text}")
             }),
         );
-        let ftz = match parts.next() {
-            None => false,
-            Some("ftz") => true,
-            Some(other) => panic!("--peer-config: after the quality only :ftz, not {other}"),
-        };
+        let (mut ftz, mut robust) = (false, false);
+        for flag in parts {
+            match flag {
+                "ftz" => ftz = true,
+                "robust" => robust = true,
+                other => {
+                    panic!("--peer-config: after the quality only :ftz and :robust, not {other}")
+                }
+            }
+        }
         assert!(
             matches!(spheres, "builtin" | "user"),
             "--peer-config: spheres are builtin or user, not {spheres}"
@@ -95,6 +109,7 @@ impl PeerConfig {
             spheres: spheres.into(),
             quality: quality.into(),
             ftz,
+            robust,
         }
     }
 
@@ -105,7 +120,8 @@ impl PeerConfig {
             "user-geometry spheres"
         };
         let ftz = if self.ftz { ", FTZ/DAZ" } else { "" };
-        format!("{spheres}, {} quality{ftz}", self.quality)
+        let robust = if self.robust { ", robust" } else { "" };
+        format!("{spheres}, {} quality{ftz}{robust}", self.quality)
     }
 }
 
@@ -514,6 +530,7 @@ fn harness_run(
         .args(["--spheres", &config.spheres, "--quality", &config.quality])
         .args(["--frames", &frames.to_string()])
         .args(["--ftz", if config.ftz { "1" } else { "0" }])
+        .args(["--robust", if config.robust { "1" } else { "0" }])
         .arg(scene_bin)
         .arg(threads.to_string())
         .arg(image)
@@ -551,7 +568,18 @@ fn harness_run(
 
 /// Pixels whose 8-bit sRGB values differ at all, and by more than 2, in some channel:
 /// raytree's PNG against the harness's linear float image.
-fn differing_pixels(png_path: &Path, f32_path: &Path, width: u32, height: u32) -> [usize; 2] {
+/// How many pixels of raytree's PNG and the harness's linear `f32` image differ at all and by
+/// more than 2 of 255 (after the same sRGB encoding). With `marks`, also writes raytree's image
+/// there with each pixel of the second kind marked by a 3×3 dot: red where the peer's pixel is
+/// the brighter, blue where raytree's is (on the `cracks` scene, red inside the panel is sky
+/// seen through a crack of the peer's).
+fn differing_pixels(
+    png_path: &Path,
+    f32_path: &Path,
+    width: u32,
+    height: u32,
+    marks: Option<&Path>,
+) -> [usize; 2] {
     let decoder = png::Decoder::new(std::io::BufReader::new(
         std::fs::File::open(png_path).expect("open raytree's PNG"),
     ));
@@ -564,7 +592,9 @@ fn differing_pixels(png_path: &Path, f32_path: &Path, width: u32, height: u32) -
         .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
         .collect();
     let mut counts = [0, 0];
-    for i in 0..(width * height) as usize {
+    let mut marked = ours.clone();
+    let (w, h) = (width as usize, height as usize);
+    for i in 0..w * h {
         let c = glam::Vec3::new(theirs[3 * i], theirs[3 * i + 1], theirs[3 * i + 2]);
         let t = raytree::export::to_srgb8(c);
         let most = (0..3)
@@ -573,6 +603,31 @@ fn differing_pixels(png_path: &Path, f32_path: &Path, width: u32, height: u32) -
             .unwrap_or(0);
         counts[0] += usize::from(most > 0);
         counts[1] += usize::from(most > 2);
+        if most > 2 {
+            let sum = |p: &[u8]| p.iter().map(|&v| u32::from(v)).sum::<u32>();
+            let colour = if sum(&t) > sum(&ours[3 * i..3 * i + 3]) {
+                [255, 0, 0]
+            } else {
+                [0, 0, 255]
+            };
+            let (x, y) = (i % w, i / w);
+            for yy in y.saturating_sub(1)..(y + 2).min(h) {
+                for xx in x.saturating_sub(1)..(x + 2).min(w) {
+                    let j = 3 * (yy * w + xx);
+                    marked[j..j + 3].copy_from_slice(&colour);
+                }
+            }
+        }
+    }
+    if let Some(path) = marks {
+        let file = std::fs::File::create(path).expect("create the differences image");
+        let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), width, height);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header().expect("PNG header");
+        writer
+            .write_image_data(&marked)
+            .expect("write the differences image");
     }
     counts
 }
@@ -635,10 +690,11 @@ fn peer_comparison(o: &Options, root: &Path) {
     }
     for (i, c) in configs.iter().enumerate() {
         println!(
-            "peer {}: Embree 3 ({}), {}; triangles in Embree's own BVH, scene flags none, rtcIntersect1/rtcOccluded1, pthreads over 32x32 tiles",
+            "peer {}: Embree 3 ({}), {}; triangles in Embree's own BVH, scene flags {}, rtcIntersect1/rtcOccluded1, pthreads over 32x32 tiles",
             i + 1,
             embree_version(),
-            c.label()
+            c.label(),
+            if c.robust { "robust" } else { "none" }
         );
     }
     let mut results = Vec::new();
@@ -713,7 +769,14 @@ fn peer_comparison(o: &Options, root: &Path) {
         let (w, h) = (scene.render.width, scene.render.height);
         let differing = images
             .iter()
-            .map(|image| differing_pixels(&ours_png, image, w, h))
+            .enumerate()
+            .map(|(i, image)| {
+                let marks = o
+                    .keep
+                    .is_some()
+                    .then(|| dir.join(format!("differences_{}.png", i + 1)));
+                differing_pixels(&ours_png, image, w, h, marks.as_deref())
+            })
             .collect();
         println!(
             "{} done; load average {}",

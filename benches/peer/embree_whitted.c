@@ -5,15 +5,17 @@
  * `src/trace.rs`, on N pthreads over 32x32 tiles taken from an atomic counter.
  *
  * Usage: embree_whitted [--spheres builtin|user] [--quality low|medium|high] [--frames K]
- *                       [--ftz 0|1] SCENE.bin THREADS [IMAGE.f32]
+ *                       [--ftz 0|1] [--robust 0|1] SCENE.bin THREADS [IMAGE.f32]
  *
  * --spheres builtin (the default) gives the spheres to Embree as its own sphere geometry
  *   (RTC_GEOMETRY_TYPE_SPHERE_POINT, a float4 centre and radius each): Embree's ray-sphere
  *   intersector, the fast path an Embree user takes. `user` is the configuration of issue 7: an
  *   Embree user geometry whose callback is raytree's robust (Ray Tracing Gems ch. 7) root pair.
  * --quality sets the scene's and every geometry's build quality (default high: the triangles'
- *   BVH with spatial splits, as an Embree user after render speed chooses). Scene flags stay
- *   RTC_SCENE_FLAG_NONE (not robust, not dynamic, no filter callbacks).
+ *   BVH with spatial splits, as an Embree user after render speed chooses).
+ * --robust 1 sets RTC_SCENE_FLAG_ROBUST (Embree's watertight mode: no ray slips between two
+ *   triangles that share an edge, at some cost in speed); the default 0 leaves the scene flags
+ *   RTC_SCENE_FLAG_NONE (not robust, not dynamic, no filter callbacks), Embree's fastest.
  * --frames K renders the image K times after one build: frame 1 is the first frame, the rest
  *   are warm frames (default 1).
  * --ftz 1 sets flush-to-zero and denormals-are-zero on every tracing thread, as Embree's
@@ -511,7 +513,7 @@ static void rtc_error(void *user, enum RTCError code, const char *str) {
 
 static const char *usage =
     "usage: embree_whitted [--spheres builtin|user] [--quality low|medium|high] [--frames K] "
-    "[--ftz 0|1] SCENE.bin THREADS [IMAGE.f32]";
+    "[--ftz 0|1] [--robust 0|1] SCENE.bin THREADS [IMAGE.f32]";
 
 /* One frame on `threads` pthreads: its render-phase seconds; its ray counts in `total`. */
 static double render_frame(int threads, Worker *workers, pthread_t *ids, Counts *total) {
@@ -534,7 +536,7 @@ static double render_frame(int threads, Worker *workers, pthread_t *ids, Counts 
 
 int main(int argc, char **argv) {
     const char *spheres_name = "builtin", *quality_name = "high";
-    int frames = 1;
+    int frames = 1, robust = 0;
     int argi = 1;
     while (argi < argc && strncmp(argv[argi], "--", 2) == 0) {
         if (argi + 1 >= argc) die(usage);
@@ -542,6 +544,7 @@ int main(int argc, char **argv) {
         else if (strcmp(argv[argi], "--quality") == 0) quality_name = argv[argi + 1];
         else if (strcmp(argv[argi], "--frames") == 0) frames = atoi(argv[argi + 1]);
         else if (strcmp(argv[argi], "--ftz") == 0) flush_denormals = atoi(argv[argi + 1]);
+        else if (strcmp(argv[argi], "--robust") == 0) robust = atoi(argv[argi + 1]);
         else die(usage);
         argi += 2;
     }
@@ -569,7 +572,7 @@ int main(int argc, char **argv) {
     rtcSetDeviceErrorFunction(device, rtc_error, NULL);
     rtcSetDeviceMemoryMonitorFunction(device, memory_monitor, NULL);
     scene = rtcNewScene(device);
-    rtcSetSceneFlags(scene, RTC_SCENE_FLAG_NONE);
+    rtcSetSceneFlags(scene, robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
     rtcSetSceneBuildQuality(scene, quality);
 
     uint32_t *indices = alloc(sizeof(uint32_t) * 3 * (size_t)S.n_triangles);
@@ -645,6 +648,7 @@ int main(int argc, char **argv) {
     printf("spheres_geometry %s\n", builtin_spheres ? "builtin" : "user");
     printf("build_quality %s\n", quality_name);
     printf("flush_denormals %d\n", flush_denormals);
+    printf("scene_robust %d\n", robust);
     printf("triangles %u\nspheres %u\n", S.n_triangles, S.n_spheres);
     printf("load_secs %.6f\nbuild_secs %.6f\nrender_secs %.6f\n", t1 - t0, t2 - t1, frame_secs[0]);
     printf("frame_secs");
