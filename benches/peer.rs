@@ -566,8 +566,6 @@ fn harness_run(
     }
 }
 
-/// Pixels whose 8-bit sRGB values differ at all, and by more than 2, in some channel:
-/// raytree's PNG against the harness's linear float image.
 /// How many pixels of raytree's PNG and the harness's linear `f32` image differ at all and by
 /// more than 2 of 255 (after the same sRGB encoding). With `marks`, also writes raytree's image
 /// there with each pixel of the second kind marked by a 3×3 dot: red where the peer's pixel is
@@ -592,7 +590,8 @@ fn differing_pixels(
         .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
         .collect();
     let mut counts = [0, 0];
-    let mut marked = ours.clone();
+    // Only when asked for: the marks go on a copy of raytree's image.
+    let mut marked = marks.map(|_| ours.clone());
     let (w, h) = (width as usize, height as usize);
     for i in 0..w * h {
         let c = glam::Vec3::new(theirs[3 * i], theirs[3 * i + 1], theirs[3 * i + 2]);
@@ -603,7 +602,7 @@ fn differing_pixels(
             .unwrap_or(0);
         counts[0] += usize::from(most > 0);
         counts[1] += usize::from(most > 2);
-        if most > 2 {
+        if let (true, Some(marked)) = (most > 2, marked.as_mut()) {
             let sum = |p: &[u8]| p.iter().map(|&v| u32::from(v)).sum::<u32>();
             let colour = if sum(&t) > sum(&ours[3 * i..3 * i + 3]) {
                 [255, 0, 0]
@@ -619,7 +618,7 @@ fn differing_pixels(
             }
         }
     }
-    if let Some(path) = marks {
+    if let (Some(path), Some(marked)) = (marks, marked) {
         let file = std::fs::File::create(path).expect("create the differences image");
         let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), width, height);
         encoder.set_color(png::ColorType::Rgb);
