@@ -299,33 +299,65 @@ impl Bvh {
                     return;
                 }
             } else {
-                // Per child slot, the rays that enter it, and a `t` no later than any of their
-                // entry ts.
-                let (entered, key, child) = if word & NARROW != 0 {
-                    let node = &self.narrow[(word & !NARROW) as usize];
-                    let (entered, key) = Sse4.enter_of::<K, L, NARROW_WIDTH>(rays4, node, mask);
-                    (entered, key, node.child_words())
-                } else {
-                    let node = &self.nodes[word as usize];
-                    let (entered, key) = test.enter::<K, L>(rays4, node, mask);
-                    (entered, key, node.child)
-                };
-                // The children entered, nearest first when ordered.
+                // The children entered, nearest first when ordered: (child word, its rays, a
+                // `t` no later than any of their entry ts).
                 let mut hits = [(0u32, 0u32, 0f32); WIDTH];
                 let mut k = 0;
-                for slot in 0..WIDTH {
-                    if entered[slot] == 0 {
-                        continue;
-                    }
-                    let mut j = k;
-                    if V::ORDERED {
-                        while j > 0 && hits[j - 1].2 < key[slot] {
-                            hits[j] = hits[j - 1];
-                            j -= 1;
+                // A macro, not a closure: see `rays_by_slot`.
+                macro_rules! add {
+                    ($child:expr, $rays:expr, $t:expr) => {{
+                        let t = $t;
+                        let mut j = k;
+                        if V::ORDERED {
+                            while j > 0 && hits[j - 1].2 < t {
+                                hits[j] = hits[j - 1];
+                                j -= 1;
+                            }
                         }
+                        hits[j] = ($child, $rays, t);
+                        k += 1;
+                    }};
+                }
+                if mask & (mask - 1) == 0 {
+                    // One ray left (deep in the tree, where a packet's rays have parted): its own
+                    // test, its slots taken straight from its hit mask (no transpose), in slot
+                    // order as below: the same children, order and keys.
+                    let ray = mask.trailing_zeros() as usize;
+                    let (mut slots, key, child) = if word & NARROW != 0 {
+                        let node = &self.narrow[(word & !NARROW) as usize];
+                        let mut keys = Sse4.no_keys();
+                        let slots = Sse4::one_of_w(rays4, node, ray, &mut keys) & node.valid;
+                        (slots, Sse4.key_array(keys), node.child_words())
+                    } else {
+                        let node = &self.nodes[word as usize];
+                        let mut keys = test.no_keys();
+                        let slots = test.one_of(rays4, node, ray, &mut keys) & node.valid;
+                        (slots, test.key_array(keys), node.child)
+                    };
+                    while slots != 0 {
+                        let slot = slots.trailing_zeros() as usize;
+                        slots &= slots - 1;
+                        add!(child[slot], mask, key[slot]);
                     }
-                    hits[j] = (child[slot], entered[slot], key[slot]);
-                    k += 1;
+                } else {
+                    // Per child slot, the rays that enter it, and a `t` no later than any of
+                    // their entry ts.
+                    let (entered, key, mut slots, child) = if word & NARROW != 0 {
+                        let node = &self.narrow[(word & !NARROW) as usize];
+                        let (entered, key, any) =
+                            Sse4.enter_of::<K, L, NARROW_WIDTH>(rays4, node, mask);
+                        (entered, key, any, node.child_words())
+                    } else {
+                        let node = &self.nodes[word as usize];
+                        let (entered, key, any) = test.enter::<K, L>(rays4, node, mask);
+                        (entered, key, any, node.child)
+                    };
+                    // Slot by slot, one step per slot entered.
+                    while slots != 0 {
+                        let slot = slots.trailing_zeros() as usize;
+                        slots &= slots - 1;
+                        add!(child[slot], entered[slot], key[slot]);
+                    }
                 }
                 if k > 0 {
                     let next = (hits[k - 1].0, hits[k - 1].1);
@@ -483,12 +515,14 @@ impl<const L: usize> Rays4<L> {
 /// The packet test's transpose: `$one` gives the slots ray `$ray` (of `$mask`, a packet of
 /// `$k` rays) meets, and the rays' slot masks (masked by `$valid`), eight rays at a time, form
 /// an 8×8 bit matrix, transposed into each slot's rays (bit `i` of `entered[c]`: ray `i`
-/// enters slot `c`). A macro, not a function taking a closure: a closure is compiled without
+/// enters slot `c`); with them, the slots any ray enters (bit `c`). A macro, not a function taking a closure: a closure is compiled without
 /// the AVX2 features of the walk around it, and the node test in it would not be inlined.
 macro_rules! rays_by_slot {
     ($k:expr, $mask:expr, $valid:expr, |$ray:ident| $one:expr) => {{
         const { assert!(WIDTH == 8) };
         let mut entered = [0u32; WIDTH];
+        // The slots any ray enters.
+        let mut any = 0u32;
         for g in 0..$k.div_ceil(8) {
             let group = ($mask >> (8 * g)) & 0xff;
             if group == 0 {
@@ -500,14 +534,16 @@ macro_rules! rays_by_slot {
                 let i = m.trailing_zeros() as usize;
                 m &= m - 1;
                 let $ray = 8 * g + i;
-                rows |= u64::from($one & $valid) << (8 * i);
+                let slots = $one & $valid;
+                any |= slots;
+                rows |= u64::from(slots) << (8 * i);
             }
             let columns = transpose8(rows);
             for (c, e) in entered.iter_mut().enumerate() {
                 *e |= (((columns >> (8 * c)) & 0xff) as u32) << (8 * g);
             }
         }
-        entered
+        (entered, any)
     }};
 }
 
@@ -563,18 +599,19 @@ trait NodeTest: Copy {
     /// tests them: deep in the tree a packet's rays have parted, and a box tested against all
     /// its lanes pays for rays no longer in the packet. The rays' slot masks, eight rays at a
     /// time, form an 8×8 bit matrix, transposed into each slot's rays (bit `i` of
-    /// `entered[c]`: ray `i` enters slot `c`).
+    /// `entered[c]`: ray `i` enters slot `c`). Returns those, each slot's key, and the slots
+    /// any ray enters (bit `c`), so the caller steps through those alone.
     #[inline(always)]
     fn enter<const K: usize, const L: usize>(
         &self,
         r: &Rays4<L>,
         node: &Node,
         mask: u32,
-    ) -> ([u32; WIDTH], [f32; WIDTH]) {
+    ) -> ([u32; WIDTH], [f32; WIDTH], u32) {
         let mut keys = self.no_keys();
-        let entered = rays_by_slot!(K, mask, node.valid, |ray| self
+        let (entered, any) = rays_by_slot!(K, mask, node.valid, |ray| self
             .one_of(r, node, ray, &mut keys));
-        (entered, self.key_array(keys))
+        (entered, self.key_array(keys), any)
     }
 }
 
@@ -692,12 +729,12 @@ impl Sse4 {
         r: &Rays4<L>,
         node: &Node<W>,
         mask: u32,
-    ) -> ([u32; WIDTH], [f32; WIDTH]) {
+    ) -> ([u32; WIDTH], [f32; WIDTH], u32) {
         let mut keys = self.no_keys();
-        let entered = rays_by_slot!(K, mask, node.valid, |ray| Self::one_of_w(
+        let (entered, any) = rays_by_slot!(K, mask, node.valid, |ray| Self::one_of_w(
             r, node, ray, &mut keys
         ));
-        (entered, self.key_array(keys))
+        (entered, self.key_array(keys), any)
     }
 
     /// The widened slab test of one ray (origin `o`, clamped `1/d` `inv`, near planes `near`,
