@@ -318,26 +318,42 @@ impl Bvh {
                         k += 1;
                     }};
                 }
-                if mask & (mask - 1) == 0 {
-                    // One ray left (deep in the tree, where a packet's rays have parted): its own
-                    // test, its slots taken straight from its hit mask (no transpose), in slot
-                    // order as below: the same children, order and keys.
-                    let ray = mask.trailing_zeros() as usize;
-                    let (mut slots, key, child) = if word & NARROW != 0 {
+                let rest = mask & (mask - 1);
+                if rest & rest.wrapping_sub(1) == 0 {
+                    // One or two rays left (deep in the tree, where a packet's rays have
+                    // parted): each ray's own test, the slots taken straight from their hit
+                    // masks (no transpose), in slot order as below: the same children, order
+                    // and keys (the keys folded over the rays in the same order).
+                    let a = mask.trailing_zeros() as usize;
+                    // Ray `b` only when `rest` holds it; its slots are none otherwise.
+                    let b = (rest.trailing_zeros() & 31) as usize;
+                    let (sa, sb, key, child) = if word & NARROW != 0 {
                         let node = &self.narrow[(word & !NARROW) as usize];
                         let mut keys = Sse4.no_keys();
-                        let slots = Sse4::one_of_w(rays4, node, ray, &mut keys) & node.valid;
-                        (slots, Sse4.key_array(keys), node.child_words())
+                        let sa = Sse4::one_of_w(rays4, node, a, &mut keys) & node.valid;
+                        let sb = if rest != 0 {
+                            Sse4::one_of_w(rays4, node, b, &mut keys) & node.valid
+                        } else {
+                            0
+                        };
+                        (sa, sb, Sse4.key_array(keys), node.child_words())
                     } else {
                         let node = &self.nodes[word as usize];
                         let mut keys = test.no_keys();
-                        let slots = test.one_of(rays4, node, ray, &mut keys) & node.valid;
-                        (slots, test.key_array(keys), node.child)
+                        let sa = test.one_of(rays4, node, a, &mut keys) & node.valid;
+                        let sb = if rest != 0 {
+                            test.one_of(rays4, node, b, &mut keys) & node.valid
+                        } else {
+                            0
+                        };
+                        (sa, sb, test.key_array(keys), node.child)
                     };
+                    let mut slots = sa | sb;
                     while slots != 0 {
                         let slot = slots.trailing_zeros() as usize;
                         slots &= slots - 1;
-                        add!(child[slot], mask, key[slot]);
+                        let rays = ((sa >> slot) & 1) << a | ((sb >> slot) & 1) << b;
+                        add!(child[slot], rays, key[slot]);
                     }
                 } else {
                     // Per child slot, the rays that enter it, and a `t` no later than any of
