@@ -327,26 +327,36 @@ impl Bvh {
                     let a = mask.trailing_zeros() as usize;
                     // Ray `b` only when `rest` holds it; its slots are none otherwise.
                     let b = (rest.trailing_zeros() & 31) as usize;
-                    let (sa, sb, key, child) = if word & NARROW != 0 {
+                    // Ray `a`, then ray `b` when there is one, by the node test `$t`, its keys
+                    // folded as `rays_by_slot` folds them.
+                    macro_rules! one_or_two {
+                        ($t:expr, |$ray:ident, $keys:ident| $one:expr) => {{
+                            let mut $keys = $t.no_keys();
+                            let sa = {
+                                let $ray = a;
+                                $one
+                            };
+                            let sb = if rest != 0 {
+                                let $ray = b;
+                                $one
+                            } else {
+                                0
+                            };
+                            (sa, sb, $t.key_array($keys))
+                        }};
+                    }
+                    let ((sa, sb, key), child) = if word & NARROW != 0 {
                         let node = &self.narrow[(word & !NARROW) as usize];
-                        let mut keys = Sse4.no_keys();
-                        let sa = Sse4::one_of_w(rays4, node, a, &mut keys) & node.valid;
-                        let sb = if rest != 0 {
-                            Sse4::one_of_w(rays4, node, b, &mut keys) & node.valid
-                        } else {
-                            0
-                        };
-                        (sa, sb, Sse4.key_array(keys), node.child_words())
+                        let found = one_or_two!(Sse4, |ray, keys| {
+                            Sse4::one_of_w(rays4, node, ray, &mut keys) & node.valid
+                        });
+                        (found, node.child_words())
                     } else {
                         let node = &self.nodes[word as usize];
-                        let mut keys = test.no_keys();
-                        let sa = test.one_of(rays4, node, a, &mut keys) & node.valid;
-                        let sb = if rest != 0 {
-                            test.one_of(rays4, node, b, &mut keys) & node.valid
-                        } else {
-                            0
-                        };
-                        (sa, sb, test.key_array(keys), node.child)
+                        let found = one_or_two!(test, |ray, keys| {
+                            test.one_of(rays4, node, ray, &mut keys) & node.valid
+                        });
+                        (found, node.child)
                     };
                     let mut slots = sa | sb;
                     while slots != 0 {
@@ -531,8 +541,9 @@ impl<const L: usize> Rays4<L> {
 /// The packet test's transpose: `$one` gives the slots ray `$ray` (of `$mask`, a packet of
 /// `$k` rays) meets, and the rays' slot masks (masked by `$valid`), eight rays at a time, form
 /// an 8×8 bit matrix, transposed into each slot's rays (bit `i` of `entered[c]`: ray `i`
-/// enters slot `c`); with them, the slots any ray enters (bit `c`). A macro, not a function taking a closure: a closure is compiled without
-/// the AVX2 features of the walk around it, and the node test in it would not be inlined.
+/// enters slot `c`); with them, the slots any ray enters (bit `c`). A macro, not a function
+/// taking a closure: a closure is compiled without the AVX2 features of the walk around it,
+/// and the node test in it would not be inlined.
 macro_rules! rays_by_slot {
     ($k:expr, $mask:expr, $valid:expr, |$ray:ident| $one:expr) => {{
         const { assert!(WIDTH == 8) };
