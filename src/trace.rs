@@ -245,10 +245,12 @@ pub struct Tracer {
 
 /// Memory for a batch render's per-pixel sums: anonymous pages straight from the kernel,
 /// zeroed, with transparent huge pages asked for where the system offers them on request
-/// (Linux's default `madvise` mode; Embree asks the same for its large allocations). A
-/// 640×480 render's 3.7 MB is then two 2 MiB faults instead of 900 4 KiB ones: its first
-/// frame (the bench's `--opaque` 80k scene, 12 alternating runs) went 27.9 → 26.4 ms; the
-/// warm frames, which reuse the buffer, are unchanged. The allocator's memory where mapping fails.
+/// (Linux's default `madvise` mode; Embree asks the same for its large allocations). Only
+/// the whole 2 MiB pages inside the mapping can be huge: a 640×480 render's 3.7 MB holds one,
+/// so its first frame takes one 2 MiB fault and about 450 of 4 KiB instead of 900 (the
+/// bench's `--opaque` 80k first frame, 12 alternating runs: 27.9 → 26.4 ms). Aligning the
+/// buffer so that both of its pages are huge was measured no faster (session 18). The warm
+/// frames reuse the buffer. The allocator's memory where mapping fails.
 pub(crate) enum SumsBuffer {
     Mapped(memmap2::MmapMut),
     Heap(Vec<[f32; 3]>),

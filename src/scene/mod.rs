@@ -407,19 +407,102 @@ impl Scene {
     }
 
     /// Axis-aligned bounds of all spheres and triangles (not lights), or `None` when empty.
+    /// The viewer asks every frame; the triangles' part is remembered for the last triangle
+    /// list asked about (a camera move shares it), so a million-triangle scene is not walked
+    /// again each frame.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        let mut lo = Vec3::splat(f32::INFINITY);
-        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        let (mut lo, mut hi) = triangle_bounds(&self.triangles);
         for s in &self.spheres {
             lo = lo.min(s.center - Vec3::splat(s.radius));
             hi = hi.max(s.center + Vec3::splat(s.radius));
         }
-        for t in self.triangles.iter() {
-            for v in t.vertices {
-                lo = lo.min(v);
-                hi = hi.max(v);
-            }
-        }
         (lo.x <= hi.x).then_some((lo, hi))
+    }
+}
+
+/// The smallest and largest corner of `triangles` (`+inf`, `-inf` when empty), remembered for
+/// the last list asked about. The memo holds a `Weak` of that list: its allocation cannot be
+/// reused while the memo lives, so the same address is the same list, and a list changed
+/// through `Arc::make_mut` while the memo refers to it moves to a new allocation.
+fn triangle_bounds(triangles: &Arc<Vec<Triangle>>) -> (Vec3, Vec3) {
+    type Memo = Option<(std::sync::Weak<Vec<Triangle>>, (Vec3, Vec3))>;
+    static LAST: std::sync::Mutex<Memo> = std::sync::Mutex::new(None);
+    if let Ok(last) = LAST.lock()
+        && let Some((list, bounds)) = &*last
+        && std::ptr::eq(list.as_ptr(), Arc::as_ptr(triangles))
+    {
+        return *bounds;
+    }
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    for t in triangles.iter() {
+        for v in t.vertices {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+    }
+    if let Ok(mut last) = LAST.lock() {
+        *last = Some((Arc::downgrade(triangles), (lo, hi)));
+    }
+    (lo, hi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn naive_bounds(scene: &Scene) -> Option<(Vec3, Vec3)> {
+        let points = scene.triangles.iter().flat_map(|t| t.vertices).chain(
+            scene
+                .spheres
+                .iter()
+                .flat_map(|s| [s.center - s.radius, s.center + s.radius]),
+        );
+        points.fold(None, |b, p| match b {
+            None => Some((p, p)),
+            Some((lo, hi)) => Some((p.min(lo), p.max(hi))),
+        })
+    }
+
+    /// The remembered triangle bounds follow every way the triangles change: a camera move
+    /// (shared list), an edit through `Arc::make_mut` (while the memo refers to the list, and
+    /// after), another scene asked about in between, and an emptied list.
+    #[test]
+    fn remembered_bounds_follow_the_triangles() {
+        let mut scene = load_builtin("default").expect("built-in");
+        let tri = |a: Vec3| Triangle {
+            vertices: [a, a + Vec3::X, a + Vec3::Y],
+            material: MaterialId(0),
+            object: ObjectId(0),
+        };
+        Arc::make_mut(&mut scene.triangles).push(tri(Vec3::new(-50.0, 2.0, 3.0)));
+        assert_eq!(scene.bounds(), naive_bounds(&scene));
+        let (lo, _) = scene.bounds().expect("bounds");
+        assert_eq!(lo.x, -50.0);
+
+        let mut moved = scene.clone();
+        moved.camera.position += Vec3::ONE;
+        assert_eq!(moved.bounds(), scene.bounds());
+        // Changed while another scene shares the list (make_mut copies it).
+        Arc::make_mut(&mut scene.triangles)[0].vertices[0] = Vec3::new(0.0, 0.0, 900.0);
+        assert_eq!(scene.bounds().expect("bounds").1.z, 900.0);
+        assert_eq!(moved.bounds(), naive_bounds(&moved));
+        assert_ne!(moved.bounds(), scene.bounds());
+        drop(moved);
+
+        // Changed in place while only the memo refers to the list (make_mut moves it).
+        assert_eq!(scene.bounds(), naive_bounds(&scene));
+        Arc::make_mut(&mut scene.triangles)[0].vertices[0] = Vec3::new(0.0, -700.0, 0.0);
+        assert_eq!(scene.bounds(), naive_bounds(&scene));
+        assert_eq!(scene.bounds().expect("bounds").0.y, -700.0);
+
+        let other = load_builtin("glass").expect("built-in");
+        assert_eq!(other.bounds(), naive_bounds(&other));
+        assert_eq!(scene.bounds(), naive_bounds(&scene));
+
+        Arc::make_mut(&mut scene.triangles).clear();
+        assert_eq!(scene.bounds(), naive_bounds(&scene));
+        scene.spheres.clear();
+        assert_eq!(scene.bounds(), None);
     }
 }
