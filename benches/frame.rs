@@ -5,7 +5,8 @@
 //! is one `Harness::step` (the app's UI, layout and tessellation) after both renders finished;
 //! the baseline is the same frame without trees or boxes, measured in the same run.
 //!
-//! Run: `cargo bench --bench frame`
+//! Run: `cargo bench --bench frame`, or e.g. `cargo bench --bench frame -- --triangles 1000000
+//! --level deepest` for the deepest level of a million-triangle tree.
 
 use std::time::{Duration, Instant};
 
@@ -42,8 +43,25 @@ fn frames(h: &mut Harness<'static, ViewerApp>, n: usize) -> (f64, f64) {
 }
 
 fn main() {
+    // `--triangles N` (default 60,000) sizes the mesh; `--level K` draws BVH level K instead of
+    // the middle one (`--level deepest` the last).
+    let (mut triangles, mut level_arg) = (60_000usize, None::<String>);
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--triangles" => {
+                triangles = args
+                    .next()
+                    .and_then(|v| v.parse().ok())
+                    .expect("--triangles: a number")
+            }
+            "--level" => level_arg = Some(args.next().expect("--level: a number or deepest")),
+            "--bench" => {}
+            other => panic!("unknown option {other}"),
+        }
+    }
     let dir = tempfile::tempdir().expect("a temporary folder");
-    let path = write_bench_scene(dir.path(), 60_000).expect("the bench scene is written");
+    let path = write_bench_scene(dir.path(), triangles).expect("the bench scene is written");
     let scene = load_scene_file(&path).expect("the bench scene loads");
     let (w, h_px) = (scene.render.width, scene.render.height);
     let triangles = scene.triangles.len();
@@ -73,8 +91,17 @@ fn main() {
     let nodes: usize = h.state().trees().map(|t| t.nodes).sum();
     // The selected ray's visits are on by default; add every box of one BVH level.
     let levels = h.state().accel().levels();
-    let level = (levels / 2).max(1).min(levels.saturating_sub(1));
-    let boxes = h.state().accel().level_boxes(level).len();
+    let last = levels.saturating_sub(1);
+    let level = match level_arg.as_deref() {
+        None => (levels / 2).max(1).min(last),
+        Some("deepest") => last,
+        Some(k) => k
+            .parse::<u32>()
+            .expect("--level: a number or deepest")
+            .min(last),
+    };
+    let shown = raytree::scene_view::level_segments(h.state().accel(), level);
+    let boxes = format!("{} of {} boxes drawn", shown.drawn, shown.total);
     h.state_mut().scene_view.bvh_level = Some(level);
     settle(&mut h);
     let (full, full_worst) = frames(&mut h, 60);
@@ -88,7 +115,7 @@ fn main() {
         base_worst * 1e3
     );
     println!(
-        "  {trees} trees ({nodes} nodes), visits, BVH level {level} ({boxes} boxes): median {:.2} ms ({:.2}x the baseline), worst {:.2} ms",
+        "  {trees} trees ({nodes} nodes), visits, BVH level {level} ({boxes}): median {:.2} ms ({:.2}x the baseline), worst {:.2} ms",
         full * 1e3,
         full / base,
         full_worst * 1e3

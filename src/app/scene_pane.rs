@@ -13,7 +13,7 @@
 //!
 //! Orbiting, panning or zooming restarts only this session; the trees are never re-traced.
 
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, Weak};
 use std::time::{Duration, Instant};
 
 use eframe::egui::containers::menu::{self, MenuButton, MenuConfig};
@@ -25,10 +25,11 @@ use super::modes::ImageMode;
 use super::paint3d::{self, Drawn, Look, ScreenView};
 use super::viewport::{DisplayCallback, DisplayId, DisplayState, SharedDisplay};
 use super::{ViewerApp, tree_view};
+use crate::accel::Accel;
 use crate::render::session::{Session, SessionEvent, View};
 use crate::scene::camera::FRAME_MARGIN;
 use crate::scene::{Camera, CameraFrame, Scene};
-use crate::scene_view::{self, Filter, Segment, box_corner};
+use crate::scene_view::{self, Filter, LevelSegments, Segment, box_corner};
 use crate::trace::{EndReason, Tracer};
 
 /// The longest side of the scene view's image, in pixels.
@@ -64,6 +65,9 @@ pub struct SceneView {
     pub show_visits: bool,
     /// Draw every box of this BVH level (or the grid's cells).
     pub bvh_level: Option<u32>,
+    /// The boxes of the level last drawn, and the accelerator and level they are of: worked
+    /// out once, not every frame (a camera edit keeps the accelerator).
+    level_cache: Option<(Weak<Accel>, u32, Arc<LevelSegments>)>,
 }
 
 impl SceneView {
@@ -84,7 +88,23 @@ impl SceneView {
             finished: false,
             show_visits: true,
             bvh_level: None,
+            level_cache: None,
         })
+    }
+
+    /// The boxes of the BVH level shown, `None` when none is; worked out once per accelerator
+    /// and level.
+    pub fn level_segments(&mut self, accel: &Arc<Accel>) -> Option<Arc<LevelSegments>> {
+        let level = self.bvh_level?;
+        if let Some((of, l, segments)) = &self.level_cache
+            && *l == level
+            && std::ptr::eq(of.as_ptr(), Arc::as_ptr(accel))
+        {
+            return Some(segments.clone());
+        }
+        let segments = Arc::new(scene_view::level_segments(accel, level));
+        self.level_cache = Some((Arc::downgrade(accel), level, segments.clone()));
+        Some(segments)
     }
 
     /// Frames the camera on the scene's bounds and the render camera's eye, from the render
@@ -349,6 +369,18 @@ fn filters(app: &mut ViewerApp, ui: &mut Ui) {
             ui.add(egui::DragValue::new(level).range(0..=levels.saturating_sub(1)));
         }
     });
+    let accel = app.tracer.accel.clone();
+    if let Some(level) = app.scene_view.level_segments(&accel) {
+        let text = match (level.drawn, level.total) {
+            (_, 1) => "1 box".to_owned(),
+            (drawn, total) if drawn < total => format!("the largest {drawn} of {total} boxes"),
+            (_, total) => format!("{total} boxes"),
+        };
+        ui.label(egui::RichText::new(text).small()).on_hover_text(format!(
+            "a level's boxes are drawn up to {} at a time, the largest first (each costs its edges cut against the view's depth every frame)",
+            scene_view::MAX_LEVEL_BOXES
+        ));
+    }
     let f = &mut app.scene_view.filter;
     let ends = |ui: &mut Ui| {
         for end in [
@@ -528,14 +560,13 @@ pub fn scene_view_ui(app: &mut ViewerApp, ui: &mut Ui) {
     {
         camera.extend(boxes);
     }
-    if let Some(level) = app.scene_view.bvh_level {
-        camera.extend(scene_view::level_segments(&app.tracer, level));
-    }
+    let accel = app.tracer.accel.clone();
+    let level = app.scene_view.level_segments(&accel);
     paint3d::draw_segments(
         &painter,
         &view,
         &depth,
-        &camera,
+        camera.iter().chain(level.iter().flat_map(|l| &l.segments)),
         usize::MAX,
         &[],
         Look::default(),
@@ -641,6 +672,34 @@ impl SceneView {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The level's boxes are worked out once for an accelerator and level, and again for
+    /// another level or another accelerator (a rebuild).
+    #[test]
+    fn level_boxes_are_worked_out_once_per_accelerator_and_level() {
+        let scene = Arc::new(crate::scene::load_builtin("default").expect("built-in"));
+        let settings = crate::trace::TraceSettings {
+            accel: crate::accel::AccelKind::Bvh,
+            ..Default::default()
+        };
+        let tracer = Tracer::new(scene.clone(), settings);
+        let mut view = SceneView::new(1).expect("a scene view");
+        assert!(view.level_segments(&tracer.accel).is_none());
+        let deepest = tracer.accel.levels() - 1;
+        view.bvh_level = Some(deepest);
+        let first = view.level_segments(&tracer.accel).expect("boxes");
+        assert!(first.total > 1);
+        let again = view.level_segments(&tracer.accel).expect("boxes");
+        assert!(Arc::ptr_eq(&first, &again));
+        view.bvh_level = Some(0);
+        let root = view.level_segments(&tracer.accel).expect("boxes");
+        assert_eq!((root.drawn, root.total), (1, 1));
+        let rebuilt = Tracer::new(scene, settings);
+        view.bvh_level = Some(deepest);
+        let other = view.level_segments(&rebuilt.accel).expect("boxes");
+        assert!(!Arc::ptr_eq(&first, &other));
+        assert_eq!(other.total, first.total);
+    }
 
     /// Where a point lands in a view from `eye` towards `target`: tangents across and up.
     fn tangents(eye: Vec3, target: Vec3, up: Vec3, p: Vec3) -> (f32, f32) {

@@ -10,7 +10,7 @@ pub mod raster;
 
 use glam::Vec3;
 
-use crate::accel::Visits;
+use crate::accel::{Accel, Visits};
 use crate::export::to_srgb8;
 use crate::ray_tree::{Node, RayTree};
 use crate::scene::{CameraFrame, Scene};
@@ -370,14 +370,50 @@ pub fn visit_segments(
     Some((segments, visits))
 }
 
-/// Every box of level `level` of the tracer's BVH (or the grid's non-empty cells) as segments.
-pub fn level_segments(tracer: &Tracer, level: u32) -> Vec<Segment> {
-    tracer
-        .accel
-        .level_boxes(level)
-        .into_iter()
-        .flat_map(|(lo, hi)| box_segments(lo, hi, Style::LevelBox))
-        .collect()
+/// The most boxes of one BVH level the scene view draws. Each box costs its twelve edges cut
+/// against the view's depth every frame (about 4 µs a box); the deepest level of a
+/// million-triangle tree holds 300,000 boxes, which took 2.7 s a frame drawn whole.
+pub const MAX_LEVEL_BOXES: usize = 2048;
+
+/// The boxes of one BVH level as the scene view draws them.
+#[derive(Clone, Debug, Default)]
+pub struct LevelSegments {
+    /// The edges of the boxes drawn.
+    pub segments: Vec<Segment>,
+    /// How many boxes are drawn: all of the level's, or the [`MAX_LEVEL_BOXES`] with the
+    /// largest surface area when it holds more.
+    pub drawn: usize,
+    /// How many boxes the level holds.
+    pub total: usize,
+}
+
+/// The boxes of level `level` of the BVH `accel` (or the grid's non-empty cells) as segments:
+/// all of them, or the [`MAX_LEVEL_BOXES`] with the largest surface area (the ones that cost
+/// a ray the most, and that are seen at all from a distance), in the tree's order.
+pub fn level_segments(accel: &Accel, level: u32) -> LevelSegments {
+    let boxes = accel.level_boxes(level);
+    let total = boxes.len();
+    let area = |(lo, hi): &(Vec3, Vec3)| {
+        let d = (*hi - *lo).max(Vec3::ZERO);
+        d.x * d.y + d.y * d.z + d.z * d.x
+    };
+    let mut keep: Vec<usize> = (0..total).collect();
+    if total > MAX_LEVEL_BOXES {
+        // Largest first; ties by the tree's order, so the choice is the same every time.
+        keep.select_nth_unstable_by(MAX_LEVEL_BOXES - 1, |&i, &j| {
+            area(&boxes[j]).total_cmp(&area(&boxes[i])).then(i.cmp(&j))
+        });
+        keep.truncate(MAX_LEVEL_BOXES);
+        keep.sort_unstable();
+    }
+    LevelSegments {
+        segments: keep
+            .iter()
+            .flat_map(|&i| box_segments(boxes[i].0, boxes[i].1, Style::LevelBox))
+            .collect(),
+        drawn: keep.len(),
+        total,
+    }
 }
 
 #[cfg(test)]
@@ -515,6 +551,74 @@ mod tests {
                     && p.cmple(b.hi + Vec3::splat(1e-3)).all())
         );
         assert!(visit_segments(&tracer, &tree, &[7, 7]).is_none());
-        assert!(!level_segments(&tracer, 0).is_empty());
+        let root = level_segments(&tracer.accel, 0);
+        assert_eq!((root.drawn, root.total), (1, 1));
+        assert_eq!(root.segments.len(), 12);
+    }
+
+    /// A level with more boxes than are drawn keeps the largest: every box drawn is at least
+    /// as large as every box left out, and the count drawn is the cap.
+    #[test]
+    fn a_level_of_more_boxes_than_drawn_keeps_the_largest() {
+        use crate::scene::{MaterialId, ObjectId, Triangle};
+        let mut scene = load_builtin("default").expect("built-in");
+        // 30,000 triangles of many sizes on a grid, so the deep levels hold many boxes of
+        // different areas.
+        let triangles: Vec<Triangle> = (0..30_000)
+            .map(|i| {
+                let p = Vec3::new((i % 200) as f32, 0.5 * (i % 7) as f32, (i / 200) as f32);
+                let size = 0.1 + (i % 13) as f32 * 0.07;
+                Triangle {
+                    vertices: [p, p + Vec3::X * size, p + Vec3::new(0.0, size, size)],
+                    material: MaterialId(0),
+                    object: ObjectId(0),
+                }
+            })
+            .collect();
+        scene.triangles = Arc::new(triangles);
+        let settings = TraceSettings {
+            accel: crate::accel::AccelKind::Bvh,
+            ..TraceSettings::default()
+        };
+        let tracer = Tracer::new(Arc::new(scene), settings);
+        let accel = &tracer.accel;
+        let level = (0..accel.levels())
+            .find(|&l| accel.level_boxes(l).len() > MAX_LEVEL_BOXES)
+            .expect("a level with more boxes than are drawn");
+        let all = accel.level_boxes(level);
+        let shown = level_segments(accel, level);
+        assert_eq!((shown.drawn, shown.total), (MAX_LEVEL_BOXES, all.len()));
+        assert_eq!(shown.segments.len(), 12 * MAX_LEVEL_BOXES);
+        let area = |lo: Vec3, hi: Vec3| {
+            let d = hi - lo;
+            d.x * d.y + d.y * d.z + d.z * d.x
+        };
+        // Each box's twelve edges span its corners.
+        let drawn: Vec<(Vec3, Vec3)> = shown
+            .segments
+            .chunks(12)
+            .map(|edges| {
+                edges.iter().fold(
+                    (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                    |(lo, hi), s| (lo.min(s.a).min(s.b), hi.max(s.a).max(s.b)),
+                )
+            })
+            .collect();
+        assert!(drawn.iter().all(|b| all.contains(b)));
+        let smallest_drawn = drawn
+            .iter()
+            .map(|&(lo, hi)| area(lo, hi))
+            .fold(f32::INFINITY, f32::min);
+        let left_out: Vec<f32> = all
+            .iter()
+            .filter(|b| !drawn.contains(b))
+            .map(|&(lo, hi)| area(lo, hi))
+            .collect();
+        assert!(!left_out.is_empty());
+        let largest_left_out = left_out.iter().copied().fold(0.0, f32::max);
+        assert!(
+            smallest_drawn >= largest_left_out,
+            "a box of area {largest_left_out} left out for one of {smallest_drawn}"
+        );
     }
 }
