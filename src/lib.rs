@@ -1,8 +1,9 @@
-//! raytree: recursive (Whitted) ray tracing as in the lecture notes in `shared/seed`, with the
-//! ray tracing tree of any pixel.
+//! raytree: recursive (Whitted) ray tracing as in the lecture the model follows (its rules are in
+//! docs/design.md), with the ray tracing tree of any pixel.
 //!
 //! Layers, bottom to top; a module imports only from the layers below it, never in a circle:
-//! 1. [`choice`] and [`geometry`]: named options; rays, hits, ray-origin offsets, the sphere
+//! 1. [`choice`], [`rng`], [`sync`] and [`geometry`]: named options; the seeded random numbers;
+//!    locks that outlive a panic; rays, hits, ray-origin offsets, the sphere
 //!    and triangle intersection methods.
 //! 2. [`scene`]: plain scene data, the camera ([`scene::camera`]), the rules and limits every
 //!    input is held to ([`scene::rules`]), TOML and OBJ loading, built-in scenes.
@@ -32,7 +33,9 @@ pub mod export;
 pub mod geometry;
 pub mod ray_tree;
 pub mod render;
+pub mod rng;
 pub mod scene;
 pub mod scene_view;
 pub mod shade;
+pub mod sync;
 pub mod trace;

@@ -179,7 +179,7 @@ mod tests {
 
     const H: f32 = std::f32::consts::FRAC_1_SQRT_2;
 
-    use crate::geometry::test_rng::{signed, uniform};
+    use crate::rng::{signed, uniform};
 
     /// Skipping the power where `C_l ⊙ ks` is zero gives the full product's bits: random
     /// cosines (negative, above 1, NaN), colours and specular coefficients with `+0` and `−0`

@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 use raytree::accel::AccelKind;
-use raytree::experiments::rng::Pcg;
+use raytree::rng::Pcg;
 use raytree::experiments::stability::{
     SelfHits, centroid_misses, closed_mesh_case, contact_leaks, count_leaks, inside_origin_wrong,
     sphere_cell, sphere_self_hits, triangle_self_hits,

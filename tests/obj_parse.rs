@@ -186,21 +186,16 @@ fn hostile_lines_read_as_tobj_reads_them_or_go_to_tobj() {
     assert!(taken * 3 >= total, "only {taken} of {total} taken");
 }
 
-/// A xorshift generator from a non-zero `seed`: each call gives a number below `n`.
-fn xorshift(seed: u32) -> impl FnMut(u32) -> u32 {
-    let mut x = seed;
-    move |n: u32| {
-        x ^= x << 13;
-        x ^= x >> 17;
-        x ^= x << 5;
-        x % n
-    }
+/// Seeded numbers: each call gives a number below `n`.
+fn below(seed: u64) -> impl FnMut(u32) -> u32 {
+    let mut pcg = raytree::rng::Pcg::new(seed);
+    move |n: u32| pcg.below(n as usize) as u32
 }
 
 /// A file of many groups, materials and kinds of faces, over 1 MiB so that it is read in
 /// several chunks, whose statements fall on both sides of the chunk boundaries.
 fn big_file(seed: u32) -> String {
-    let mut rnd = xorshift(seed.wrapping_mul(2_654_435_761).max(1));
+    let mut rnd = below(u64::from(seed));
     let mut out = String::from("mtllib m.mtl\n");
     let (mut v, mut vt, mut vn) = (0u32, 0u32, 0u32);
     while out.len() < 3 << 20 {
@@ -365,7 +360,7 @@ fn faces_with_mixed_corners_are_flagged_alike_on_either_path() {
         "newmtl t\nKd 1 1 1\nmap_Kd checker.png\n",
     )
     .expect("write");
-    let mut rnd = xorshift(12_345);
+    let mut rnd = below(12_345);
     let mut text = String::from("mtllib m.mtl\nusemtl t\n");
     for k in 0..400 {
         let a = k as f32 * 0.01;

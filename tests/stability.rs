@@ -9,7 +9,7 @@ use std::sync::Arc;
 
 use raytree::accel::AccelKind;
 use raytree::experiments::metrics::differing_pixels;
-use raytree::experiments::rng::Pcg;
+use raytree::rng::Pcg;
 use raytree::experiments::stability::*;
 use raytree::geometry::{Methods, OffsetMethod, SphereMethod, TriangleMethod};
 use raytree::render::{Image, render};

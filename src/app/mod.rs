@@ -532,9 +532,7 @@ impl ViewerApp {
         }
         self.film.resize(w, h);
         self.scene = scene;
-        self.display
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
+        crate::sync::lock(&self.display)
             .resize(w, h);
         // The tree follows the scene: re-trace the clicked pixel with the new settings.
         if let Some(tree) = &self.tree {
@@ -788,7 +786,7 @@ impl ViewerApp {
         self.scene_view.poll();
         let budget = Instant::now();
         let shared = self.display.clone();
-        let mut display = shared.lock().unwrap_or_else(|p| p.into_inner());
+        let mut display = crate::sync::lock(&shared);
         let mode = self.prefs.mode;
         while let Some(event) =
             self.session
@@ -805,7 +803,7 @@ impl ViewerApp {
                             self.install_tracer(tracer, scene_view);
                             self.progress.pass_label = "preview".into();
                         }
-                        display = shared.lock().unwrap_or_else(|p| p.into_inner());
+                        display = crate::sync::lock(&shared);
                     }
                     if self.film.holds(tile.rect) {
                         let max_depth = self.scene.render.max_depth;
@@ -837,7 +835,7 @@ impl ViewerApp {
 
     /// Rewrites the whole display buffer for the current image mode.
     fn refresh_display(&mut self) {
-        let mut display = self.display.lock().unwrap_or_else(|p| p.into_inner());
+        let mut display = crate::sync::lock(&self.display);
         let mode = self.prefs.mode;
         self.film
             .paint(mode, self.scene.render.max_depth, &mut display);
@@ -1401,9 +1399,7 @@ impl ViewerApp {
     pub(super) fn image_rect(&mut self, ctx: &egui::Context, avail: egui::Rect) -> egui::Rect {
         let (w, h) = self.render_size();
         let (rect, scale) = viewport::fit_image(avail, w, h, ctx.pixels_per_point());
-        self.display
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
+        crate::sync::lock(&self.display)
             .params
             .smooth = viewport::smooth_at(scale);
         rect
@@ -1460,7 +1456,7 @@ impl ViewerApp {
 
     fn refresh_if_mode_changed(&mut self) {
         let (mode, exposure, tonemap) = {
-            let d = self.display.lock().unwrap_or_else(|p| p.into_inner());
+            let d = crate::sync::lock(&self.display);
             (d.params.raw, d.params.exposure, d.params.tonemap)
         };
         let want_raw = self.prefs.mode != ImageMode::Render;

@@ -74,7 +74,7 @@ impl OpenProgress {
     }
 
     fn enter(&self, stage: OpenStage) {
-        *self.stage_since.lock().unwrap_or_else(|p| p.into_inner()) = Instant::now();
+        *crate::sync::lock(&self.stage_since) = Instant::now();
         self.stage.store(stage as u8, Ordering::SeqCst);
     }
 
@@ -83,9 +83,7 @@ impl OpenProgress {
     }
 
     fn stage_secs(&self) -> f64 {
-        self.stage_since
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
+        crate::sync::lock(&self.stage_since)
             .elapsed()
             .as_secs_f64()
     }

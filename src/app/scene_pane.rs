@@ -174,9 +174,7 @@ impl SceneView {
         };
         let samples = tracer.scene.render.samples.clamp(1, SAMPLES);
         self.film.resize(w, h);
-        self.display
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
+        crate::sync::lock(&self.display)
             .resize(w, h);
         self.finished = false;
         self.generation = self.session.start_view(tracer.clone(), view, samples);
@@ -185,7 +183,7 @@ impl SceneView {
     /// Takes the tiles that arrived, within a time budget.
     pub fn poll(&mut self) {
         let budget = Instant::now();
-        let mut display = self.display.lock().unwrap_or_else(|p| p.into_inner());
+        let mut display = crate::sync::lock(&self.display);
         while let Some(event) =
             self.session
                 .next_within(self.generation, budget, Duration::from_millis(4))
@@ -205,7 +203,7 @@ impl SceneView {
 
     /// Matches the display's exposure and tonemap to the render view's.
     fn set_params(&self, exposure: f32, tonemap: u32) {
-        let mut d = self.display.lock().unwrap_or_else(|p| p.into_inner());
+        let mut d = crate::sync::lock(&self.display);
         if d.params.exposure != exposure || d.params.tonemap != tonemap {
             d.params.exposure = exposure;
             d.params.tonemap = tonemap;

@@ -320,7 +320,7 @@ impl CallbackTrait for DisplayCallback {
         let Some(gpu) = resources.get_mut::<GpuDisplay>() else {
             return Vec::new();
         };
-        let mut state = self.shared.lock().unwrap_or_else(|p| p.into_inner());
+        let mut state = crate::sync::lock(&self.shared);
         if state.width == 0 || state.height == 0 {
             return Vec::new();
         }

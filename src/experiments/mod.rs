@@ -11,7 +11,7 @@
 //! - [`rows`]: the matrix's rows built from them over log-spaced sweeps (table, charts, JSON);
 //! - [`metrics`]: image error (FLIP, RMSE, PSNR, differing pixels);
 //! - [`chart`]: charts as plain data, drawn to SVG and PNG;
-//! - [`meshes`], [`rng`]: procedural closed meshes and the seeded generator the sweeps share.
+//! - [`meshes`]: procedural closed meshes (random numbers from [`crate::rng`]).
 
 pub mod chart;
 pub mod measure;
@@ -19,7 +19,6 @@ pub mod meshes;
 pub mod metrics;
 pub mod pareto;
 pub mod report;
-pub mod rng;
 pub mod rows;
 pub mod scaling;
 pub mod stability;

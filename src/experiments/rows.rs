@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use super::chart::{Chart, Series, write_chart};
 use super::measure::value_name;
-use super::rng::Pcg;
+use crate::rng::Pcg;
 use super::stability::*;
 use crate::accel::AccelKind;
 use crate::export::{ExportError, write_text};

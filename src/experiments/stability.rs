@@ -15,7 +15,7 @@ use glam::{DVec3, Vec3};
 use serde::Serialize;
 
 use super::meshes::{octasphere, triangles};
-use super::rng::Pcg;
+use crate::rng::Pcg;
 use crate::accel::{Accel, AccelKind, PrimSet};
 use crate::geometry::sphere::sphere_roots_f64;
 use crate::geometry::triangle::triangle_hit_f64;

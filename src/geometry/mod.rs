@@ -7,7 +7,6 @@ pub mod offset;
 pub mod shading;
 pub mod sphere;
 #[cfg(test)]
-pub(crate) mod test_rng;
 pub mod triangle;
 
 use glam::Vec3;

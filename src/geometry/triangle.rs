@@ -680,7 +680,7 @@ mod pair_tests {
     fn two_rays_in_one_test_answer_as_each_alone() {
         let simd = pulp::x86::V3::try_new()
             .expect("this test needs a CPU with AVX2 and FMA (x86-64-v3), as the bench machines");
-        let mut rnd = crate::geometry::test_rng::signed(0x2545_f491);
+        let mut rnd = crate::rng::signed(0x2545_f491);
         let (mut compared, mut hits, mut refused) = (0, 0, 0);
         for round in 0..4000 {
             // Small integer coordinates on some rounds, so rays through grid points land

@@ -249,7 +249,7 @@ impl Session {
     /// The tracer built for the current generation by [`Self::start_build`], once, when it is
     /// ready; `None` before, after it was taken, and for superseded builds.
     pub fn take_built(&self) -> Option<Arc<Tracer>> {
-        let mut slot = self.built.lock().unwrap_or_else(|p| p.into_inner());
+        let mut slot = crate::sync::lock(&self.built);
         match slot.take() {
             Some((generation, tracer)) if generation == self.generation() => {
                 self.building.set(None);
@@ -295,7 +295,7 @@ impl Session {
                     match catch_unwind(AssertUnwindSafe(|| Tracer::new(scene, settings))) {
                         Ok(tracer) => {
                             let tracer = Arc::new(tracer);
-                            let mut slot = built.lock().unwrap_or_else(|p| p.into_inner());
+                            let mut slot = crate::sync::lock(&built);
                             // Superseded while building: the result is dropped here.
                             if current.load(Ordering::SeqCst) != generation {
                                 return;
@@ -472,7 +472,7 @@ impl Job {
             let pass = Pass::Samples(batch.end);
             self.stats.pixels_done.store(0, Ordering::Relaxed);
             self.pass(&order, pass, |rect, i| {
-                let mut tile_sums = sums[i].lock().unwrap_or_else(|p| p.into_inner());
+                let mut tile_sums = crate::sync::lock(&sums[i]);
                 let mut counts = RayCounts::default();
                 let mut aux = (batch.start == 0).then(Vec::new);
                 accumulate_tile(

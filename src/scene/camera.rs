@@ -246,7 +246,7 @@ mod tests {
     /// lanes written.
     #[test]
     fn primary_rays_are_primary_ray_bit_for_bit() {
-        let mut rnd = crate::geometry::test_rng::signed(7);
+        let mut rnd = crate::rng::signed(7);
         for case in 0..400 {
             let cam = Camera {
                 position: Vec3::new(rnd(), rnd(), rnd()) * 50.0,

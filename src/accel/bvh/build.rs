@@ -751,7 +751,7 @@ mod tests {
     /// its tree costs about what one PLOC tree costs (surface-area cost within 3 %).
     /// `n` small triangles in clusters scattered in a box (uneven, unlike the torus).
     fn clusters(n: usize) -> Vec<Prim> {
-        let mut rnd = crate::geometry::test_rng::uniform(99);
+        let mut rnd = crate::rng::uniform(99);
         let mut prims = Vec::new();
         while prims.len() < n {
             let c = Vec3::new(rnd() * 8.0 - 4.0, rnd() * 2.0, rnd() * 3.0);
@@ -877,7 +877,7 @@ mod tests {
         assert!(b < a * 1.03, "{parts} parts: {b:.2} against whole {a:.2}");
         assert!(split.spheres.len() == 2 && split.packets.len() > 40_000 / 4);
         let m = Methods::default();
-        let mut rnd = crate::geometry::test_rng::signed(7);
+        let mut rnd = crate::rng::signed(7);
         let mut hits = 0;
         for _ in 0..3000 {
             let o = Vec3::new(rnd(), rnd(), rnd()) * 3.0;

@@ -1019,7 +1019,7 @@ mod tests {
     /// 3000 small triangles scattered in a box of side 4, and the pseudo-random numbers in
     /// `[−1, 1]` (seeded by `seed`) that placed them, to go on with.
     fn scattered_triangles(seed: u32) -> (Vec<Prim>, impl FnMut() -> f32) {
-        let mut rnd = crate::geometry::test_rng::signed(seed);
+        let mut rnd = crate::rng::signed(u64::from(seed));
         let prims = (0..3000u32)
             .map(|id| {
                 let c = Vec3::new(rnd(), rnd(), rnd()) * 2.0;

@@ -1,5 +1,5 @@
-//! A small seeded random number generator for the stability sweeps and the tests that assert
-//! them: PCG32 (O'Neill 2014, "PCG: A Family of Simple Fast Space-Efficient Statistically Good
+//! The crate's one seeded random number generator, for the stability sweeps, the procedural
+//! meshes and every test that needs random cases: PCG32 (O'Neill 2014, "PCG: A Family of Simple Fast Space-Efficient Statistically Good
 //! Algorithms for Random Number Generation"), XSH-RR output. Not cryptographic; the point is
 //! that every sweep replays exactly from its seed on every machine.
 
@@ -76,6 +76,19 @@ impl Pcg {
             }
         }
     }
+}
+
+/// Numbers in `[0, 1)` from a generator started at `seed`, as a closure (for tests that draw
+/// many coordinates inline).
+pub fn uniform(seed: u64) -> impl FnMut() -> f32 {
+    let mut pcg = Pcg::new(seed);
+    move || pcg.f32()
+}
+
+/// Numbers in `[−1, 1)` from a generator started at `seed`, as a closure.
+pub fn signed(seed: u64) -> impl FnMut() -> f32 {
+    let mut pcg = Pcg::new(seed);
+    move || pcg.range(-1.0, 1.0)
 }
 
 #[cfg(test)]
