@@ -6,7 +6,6 @@ pub mod lanes;
 pub mod offset;
 pub mod shading;
 pub mod sphere;
-#[cfg(test)]
 pub mod triangle;
 
 use glam::Vec3;
