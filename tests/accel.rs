@@ -1,6 +1,6 @@
 //! `Accel`: none, grid and BVH must give the identical closest hit (same t, same primitive, same
 //! barycentrics; ties to the lower id) and the identical occlusion verdict for every ray, over
-//! random and degenerate scenes (docs/stability.md, rows B1, B2, T1 "including through the BVH",
+//! random and degenerate scenes (docs/stability.md, rows B2, T1 "including through the BVH",
 //! T4).
 
 use glam::Vec3;

@@ -63,7 +63,7 @@ impl<const K: usize> Default for PacketScratch<K> {
 }
 
 /// Lights whose shadow-ray setup a packet keeps for shading (the rest are set up again).
-pub(super) const GIVEN_LIGHTS: usize = 4;
+const GIVEN_LIGHTS: usize = 4;
 
 impl Given {
     #[inline(always)]
