@@ -5,8 +5,8 @@
 use glam::Vec3;
 use raytree::accel::{AUTO_MIN_BVH_PRIMS, Accel, AccelKind, PrimHit, PrimSet, auto_kind};
 use raytree::experiments::meshes::octasphere;
-use raytree::rng::Pcg;
 use raytree::geometry::{Methods, Ray, SphereMethod, TriangleMethod};
+use raytree::rng::Pcg;
 
 const KINDS: [AccelKind; 3] = [AccelKind::None, AccelKind::Grid, AccelKind::Bvh];
 
