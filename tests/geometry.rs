@@ -4,7 +4,6 @@
 
 use glam::Vec3;
 use raytree::accel::AccelKind;
-use raytree::rng::Pcg;
 use raytree::experiments::stability::{
     SelfHits, centroid_misses, closed_mesh_case, contact_leaks, count_leaks, inside_origin_wrong,
     sphere_cell, sphere_self_hits, triangle_self_hits,
@@ -15,6 +14,7 @@ use raytree::geometry::{
     OffsetMethod, Ray, SphereMethod, TriangleMethod, intersect_sphere, intersect_triangle,
     next_float_down, next_float_up, offset_ray_origin, triangle_hit_point,
 };
+use raytree::rng::Pcg;
 
 const ALL_TRIANGLE_METHODS: [TriangleMethod; 3] = [
     TriangleMethod::Lecture,
