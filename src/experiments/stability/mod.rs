@@ -196,6 +196,17 @@ fn fmt_g(v: f64) -> String {
     }
 }
 
+/// The value at sweep point `x` of `points` (sweep value, value), or the default (0, an empty
+/// cell) where the sweep has no such point. A point matches within 0.1%: [`log_sweep`] computes
+/// `10^(k/steps)` in `f32`, which need not round to the literal `1e3`.
+fn at<X: Copy + Into<f64>, T: Clone + Default>(points: &[(X, T)], x: f64) -> T {
+    points
+        .iter()
+        .find(|(p, _)| ((*p).into() / x - 1.0).abs() < 1e-3)
+        .map(|(_, v)| v.clone())
+        .unwrap_or_default()
+}
+
 /// The rows as a Markdown table.
 pub fn markdown_table(rows: &[Row]) -> String {
     let esc = |s: &str| s.replace('|', "\\|");

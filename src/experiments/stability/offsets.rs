@@ -5,7 +5,7 @@
 use glam::Vec3;
 use serde::Serialize;
 
-use super::{Row, StabilityOptions, chart, p10, ulp, yes_if};
+use super::{Row, StabilityOptions, at, chart, p10, ulp, yes_if};
 use crate::experiments::chart::Series;
 use crate::geometry::{
     OffsetMethod, Ray, SphereMethod, TriangleMethod, intersect_sphere, intersect_triangle,
@@ -261,11 +261,6 @@ pub(super) fn row_a1(o: &StabilityOptions, rng: &mut Pcg) -> Row {
         }
         min_gap = g;
     }
-    let at = |v: &[(f64, f64)], s: f64| {
-        v.iter()
-            .find(|p| (p.0 / s - 1.0).abs() < 1e-3)
-            .map_or(0.0, |p| p.1)
-    };
     let eb_acne = acne[2]
         .iter()
         .chain(&tri_acne[2])
@@ -500,11 +495,6 @@ pub(super) fn row_a3(o: &StabilityOptions, rng: &mut Pcg) -> Row {
                 .map(|p| p.1)
                 .fold(0.0, f64::max);
         } else {
-            let at = |v: &[(f64, f64)], s: f64| {
-                v.iter()
-                    .find(|p| (p.0 / s - 1.0).abs() < 1e-3)
-                    .map_or(0.0, |p| p.1)
-            };
             naive_text.push(format!(
                 "fixed: sphere reflected {:.0}% / transmitted {:.0}% @1e4, MT triangle {:.0}% @1e4",
                 at(&refl, 1e4),

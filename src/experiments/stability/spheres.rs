@@ -6,7 +6,7 @@ use glam::{DVec3, Vec3};
 use serde::Serialize;
 
 use super::{
-    Row, StabilityOptions, Verdict, chart, fmt_g, log_sweep, p10, pct, trials, ulp, yes_if,
+    Row, StabilityOptions, Verdict, at, chart, fmt_g, log_sweep, p10, pct, trials, ulp, yes_if,
 };
 use crate::experiments::chart::Series;
 use crate::geometry::sphere::sphere_roots_f64;
@@ -102,22 +102,14 @@ pub(super) fn row_s1(o: &StabilityOptions, rng: &mut Pcg) -> Row {
             .map(|(d, c)| (*d, c.wrong_pct()))
     };
     let naive = match first_bad(&lecture) {
-        Some((d, p)) => {
-            let at = |x: f32| {
-                lecture
-                    .iter()
-                    .find(|(d, _)| (*d / x - 1.0).abs() < 1e-3)
-                    .map_or(0.0, |(_, c)| c.wrong_pct())
-            };
-            format!(
-                "first wrong at D/r = {}: {:.2}%; {:.1}% @1e3, {:.1}% @1e4, {:.1}% @1e5",
-                fmt_g(d as f64),
-                p,
-                at(1e3),
-                at(1e4),
-                at(1e5)
-            )
-        }
+        Some((d, p)) => format!(
+            "first wrong at D/r = {}: {:.2}%; {:.1}% @1e3, {:.1}% @1e4, {:.1}% @1e5",
+            fmt_g(d as f64),
+            p,
+            at(&lecture, 1e3).wrong_pct(),
+            at(&lecture, 1e4).wrong_pct(),
+            at(&lecture, 1e5).wrong_pct()
+        ),
         None => "never wrong in the sweep".into(),
     };
     let exact_to = robust
@@ -131,10 +123,7 @@ pub(super) fn row_s1(o: &StabilityOptions, rng: &mut Pcg) -> Row {
         .map(|(_, c)| c.max_t_err_eps)
         .fold(0.0, f64::max);
     let robust_fail = first_bad(&robust);
-    let wrong_at_1e6 = robust
-        .iter()
-        .find(|(d, _)| (*d / 1e6 - 1.0).abs() < 1e-3)
-        .map_or(0.0, |(_, c)| c.wrong_pct());
+    let wrong_at_1e6 = at(&robust, 1e6).wrong_pct();
     let robust_text = format!(
         "0 misses / 0 false hits up to D/r = {}; {:.2}% wrong at 1e6 (rays within ~ε·D of the \
          silhouette: f + b·u carries an absolute error of about ε·D); max rel t err {:.1} \
@@ -189,12 +178,7 @@ pub(super) fn row_s2(o: &StabilityOptions, rng: &mut Pcg) -> Row {
         .iter()
         .map(|&d| (d, sphere_cell(SphereMethod::Robust, d, o.rays, rng)))
         .collect();
-    let at = |x: f32| {
-        cells
-            .iter()
-            .find(|(d, _)| (*d / x - 1.0).abs() < 1e-3)
-            .map_or(0.0, |(_, c)| c.max_unprojected_rel)
-    };
+    let unprojected = |x: f64| at(&cells, x).max_unprojected_rel;
     let worst_ulp = cells
         .iter()
         .map(|(_, c)| c.max_point_err_ulp)
@@ -207,12 +191,12 @@ pub(super) fn row_s2(o: &StabilityOptions, rng: &mut Pcg) -> Row {
         sweep: format!("D/r = 1…1e6, {} rays per cell", o.rays),
         naive: format!(
             "|‖P−C‖−r|/r = {} @1e3, {} @1e6",
-            fmt_g(at(1e3)),
-            fmt_g(at(1e6))
+            fmt_g(unprojected(1e3)),
+            fmt_g(unprojected(1e6))
         ),
         robust: format!("≤ {worst_ulp:.2} ulp(r) at every D/r"),
         target: "≤ 2 ulp after centre-relative re-projection",
-        verdict: yes_if(worst_ulp <= 2.0 && at(1e6) > 1e-3),
+        verdict: yes_if(worst_ulp <= 2.0 && unprojected(1e6) > 1e-3),
         chart: Some(chart(
             "S2: hit point distance from the sphere",
             "D / r",
@@ -309,22 +293,17 @@ pub(super) fn row_s3(o: &StabilityOptions, rng: &mut Pcg) -> Row {
     let radii = log_sweep(2, 6, 1);
     let heights = [1e-3f32, 1e-2, 1e-1, 1.0, 1e1, 1e2];
     let n = (o.rays / 4).max(100);
-    let mut cells = Vec::new();
+    // Per radius, the cells of every height.
+    let mut cells: Vec<(f32, Vec<(f32, GroundCell)>)> = Vec::new();
     for &r in &radii {
-        for &h in &heights {
-            cells.push((r, h, ground_cell(r, h, n, rng)));
-        }
+        let row = heights.iter().map(|&h| (h, ground_cell(r, h, n, rng)));
+        cells.push((r, row.collect()));
     }
-    let get = |r: f32, h: f32| {
-        cells
-            .iter()
-            .find(|(cr, ch, _)| (*cr / r - 1.0).abs() < 1e-3 && *ch == h)
-            .map(|(_, _, c)| *c)
-            .unwrap_or_default()
-    };
+    let get = |r: f32, h: f32| at(&at(&cells, f64::from(r)), f64::from(h));
     let plane_worst = cells
         .iter()
-        .map(|(_, _, c)| c.plane_max_rel_t_err)
+        .flat_map(|(_, row)| row)
+        .map(|(_, c)| c.plane_max_rel_t_err)
         .fold(0.0, f64::max);
     let mut series = Vec::new();
     for h in [1e-3f32, 1.0] {
