@@ -224,7 +224,7 @@ pub fn terminator_cell(
     cell
 }
 
-/// N1–N3 sweep the octasphere from 32 to 8192 triangles (levels 1…5).
+/// N1 sweeps the octasphere from 32 to 8192 triangles (levels 1…5; N2 takes levels 1, 3, 5).
 const N_LEVELS: [u32; 5] = [1, 2, 3, 4, 5];
 
 pub(super) fn row_n1(o: &StabilityOptions, rng: &mut Pcg) -> Row {
