@@ -1,4 +1,4 @@
-//! The stability matrix (`STABILITY.md`) beyond what `tests/geometry.rs` and `tests/accel.rs`
+//! The stability matrix (docs/stability.md) beyond what `tests/geometry.rs` and `tests/accel.rs`
 //! already assert: each test measures with the very functions `raytree stability` uses
 //! (`raytree::experiments::stability`), with fewer rays, and asserts both where the naive
 //! method fails (so the sweep really shows a contrast) and that the robust one meets its
@@ -21,7 +21,7 @@ use raytree::trace::{TraceSettings, Tracer};
 
 /// S1/S2 at the far end (tests/geometry.rs stops at D/r = 1e5). Exact to 3e5; at 1e6 the
 /// Hearn–Baker vector `f + b·u` (|f| = D) carries an absolute error of about ε·D = 0.06 r, so
-/// the few rays within ~6% of the silhouette may be misjudged: STABILITY's "0/0 to 1e6" holds
+/// the few rays within ~6% of the silhouette may be misjudged: the target's "0/0 to 1e6" holds
 /// for all but those (≤ 0.1%); t and the re-projected point stay exact. The lecture's formula
 /// starts failing by D/r = 1e3; the robust one is rounding noise at its documented limit.
 #[test]

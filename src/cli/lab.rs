@@ -6,7 +6,7 @@ use std::sync::atomic::AtomicBool;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use raytree::experiments::{measure, report, rows, scaling, sweep};
+use raytree::experiments::{measure, report, scaling, stability as rows, sweep};
 use raytree::scene::rules;
 
 use super::{count, load_scene, print_warnings, threads, use_threads};

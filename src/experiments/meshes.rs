@@ -1,7 +1,7 @@
 //! Procedural closed meshes for the sweeps: an octahedron subdivided onto a sphere. Every
 //! shared vertex is one `f32` value used by all its triangles (indexed), so the mesh is closed
 //! exactly as a mesh loaded from a file is: any ray that slips between two triangles is the
-//! intersection method's fault (STABILITY T1), not the mesh's.
+//! intersection method's fault (docs/stability.md, row T1), not the mesh's.
 
 use std::collections::HashMap;
 

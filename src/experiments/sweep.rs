@@ -1,4 +1,4 @@
-//! The speed-against-accuracy sweep (SPEC §7, STABILITY M1).
+//! The speed-against-accuracy sweep (docs/speed-accuracy.md).
 //!
 //! [`run_sweep`] renders one scene once per setting of each knob that trades time for
 //! accuracy — max depth, samples per pixel, the ray-weight cutoff, the sphere, triangle and
@@ -176,8 +176,8 @@ pub struct BenchOptions {
 }
 
 impl BenchOptions {
-    /// The full sweep of issue 5 at 320×240 (a few minutes on two cores): depth 0–12, 1–64
-    /// samples, 5 runs, a 256-sample reference.
+    /// The full sweep that docs/speed-accuracy.md reports, at 320×240 (a few minutes on two
+    /// cores): depth 0–12, 1–64 samples, 5 runs, a 256-sample reference.
     pub fn full() -> Self {
         Self {
             width: Some(320),
