@@ -6,7 +6,7 @@ use std::sync::atomic::AtomicBool;
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use raytree::experiments::{measure, report, scaling, stability as rows, sweep};
+use raytree::experiments::{measure, report, scaling, stability, sweep};
 use raytree::scene::rules;
 
 use super::{count, load_scene, print_warnings, threads, use_threads};
@@ -146,16 +146,16 @@ pub fn run_bench(args: &BenchArgs) -> Result<()> {
 
 pub fn run_stability(args: &StabilityArgs) -> Result<()> {
     let opts = if args.quick {
-        rows::StabilityOptions::quick()
+        stability::StabilityOptions::quick()
     } else {
-        rows::StabilityOptions::full()
+        stability::StabilityOptions::full()
     };
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("cannot create {}", args.out.display()))?;
     let bar = indicatif::ProgressBar::new_spinner();
-    let measured = rows::rows(&opts, &|id| bar.set_message(format!("row {id}")));
+    let measured = stability::rows(&opts, &|id| bar.set_message(format!("row {id}")));
     bar.finish_and_clear();
-    rows::write_stability(&args.out, &measured)?;
+    stability::write_stability(&args.out, &measured)?;
     if args.json {
         for row in &measured {
             out!(
@@ -164,7 +164,7 @@ pub fn run_stability(args: &StabilityArgs) -> Result<()> {
             );
         }
     } else {
-        out!("{}", rows::markdown_table(&measured).trim_end());
+        out!("{}", stability::markdown_table(&measured).trim_end());
         out!(
             "wrote {} and the charts",
             args.out.join("stability.md").display()
@@ -172,7 +172,7 @@ pub fn run_stability(args: &StabilityArgs) -> Result<()> {
     }
     let failed: Vec<&str> = measured
         .iter()
-        .filter(|r| r.verdict == rows::Verdict::No)
+        .filter(|r| r.verdict == stability::Verdict::No)
         .map(|r| r.id)
         .collect();
     if !failed.is_empty() {
