@@ -1,4 +1,4 @@
-//! The benchmark scene of issue 7, generated rather than shipped: Whitted's picture with a
+//! The benchmark scene, generated rather than shipped: Whitted's picture with a
 //! finely subdivided mesh. A bumpy torus of about `N` triangles stands behind a mirror sphere
 //! and a glass sphere over a two-triangle floor, lit by two point lights; 640×480, 1 sample,
 //! depth 4 below the primary ray.
