@@ -197,67 +197,26 @@ fn material_from_mtl(
     warnings: &mut Vec<String>,
 ) -> Material {
     let d = Material::default();
-    let mut invalid = |key: &str, got: String, fallback: String| {
-        warnings.push(format!(
-            "{label}: material `{}` has an invalid `{key}` {got}; using {fallback}.",
-            short(&m.name)
-        ));
+    let mut values = Values {
+        m,
+        label,
+        warnings: &mut *warnings,
     };
-    let mut rgb = |value: Option<[f32; 3]>, key: &str, fallback: Vec3| match value {
-        None => fallback,
-        Some(a) => {
-            let v = Vec3::from_array(a);
-            if v.is_finite() && v.cmpge(Vec3::ZERO).all() {
-                v
-            } else {
-                invalid(key, format!("{a:?}"), format!("{fallback}"));
-                fallback
-            }
-        }
-    };
-    let ambient = rgb(m.ambient, "Ka", d.ambient);
-    let diffuse = rgb(m.diffuse, "Kd", d.diffuse);
-    let specular = rgb(m.specular, "Ks", d.specular);
-    let mut scalar = |value: Option<f32>, key: &str, ok: fn(f32) -> bool, fallback: f32| match value
-    {
-        Some(x) if x.is_finite() && ok(x) => Some(x),
-        Some(x) => {
-            let fb = fallback.to_string();
-            warnings.push(format!(
-                "{label}: material `{}` has an invalid `{key}` {x}; using {fb}.",
-                short(&m.name)
-            ));
-            None
-        }
-        None => None,
-    };
-    let shininess = scalar(m.shininess, "Ns", |x| x >= 0.0, d.shininess).unwrap_or(d.shininess);
+    let ambient = values.rgb(m.ambient, "Ka", d.ambient);
+    let diffuse = values.rgb(m.diffuse, "Kd", d.diffuse);
+    let specular = values.rgb(m.specular, "Ks", d.specular);
+    let shininess = values
+        .scalar(m.shininess, "Ns", |x| x >= 0.0, d.shininess)
+        .unwrap_or(d.shininess);
     // `Ns 0` with a `Ks` (MeshLab writes `Ns 0` and `Ks 1` meaning "no highlight"): an
     // exponent of 0 would add the whole `Ks` wherever the light falls and wash the model out.
     // The highlight is dropped; a mirror's reflectivity (`Ks`, below) is kept.
     let no_highlight = m.shininess.is_some() && shininess == 0.0 && specular != Vec3::ZERO;
-    let ior = scalar(m.optical_density, "Ni", |x| x > 0.0, d.ior).unwrap_or(d.ior);
-    let in_unit = |x: f32| (0.0..=1.0).contains(&x);
+    let ior = values
+        .scalar(m.optical_density, "Ni", |x| x > 0.0, d.ior)
+        .unwrap_or(d.ior);
     let glass = matches!(m.illumination_model, Some(4 | 6 | 7));
-    let mut tr_opaque = false;
-    let dissolve = scalar(m.dissolve, "d", in_unit, 1.0).or_else(|| {
-        let tr = m
-            .unknown_param
-            .get("Tr")
-            .and_then(|t| t.trim().parse::<f32>().ok());
-        // `Tr 1` without `d` on a material that is not glass: MeshLab and others write it
-        // meaning opaque (Tr as opacity); an invisible material is never what is meant.
-        scalar(tr, "Tr", in_unit, 0.0).map(|tr| {
-            tr_opaque = tr == 1.0 && !glass;
-            if tr_opaque { 1.0 } else { 1.0 - tr }
-        })
-    });
-    if tr_opaque {
-        warnings.push(format!(
-            "{label}: material `{}` has `Tr 1` (fully transparent) but is not glass; taken as opaque, as MeshLab means it.",
-            short(&m.name)
-        ));
-    }
+    let dissolve = values.dissolve(glass);
     if no_highlight {
         warnings.push(format!(
             "{label}: material `{}` has `Ns 0`, which would add all of `Ks` wherever light falls; shown without a highlight (`Ks 0`).",
@@ -281,6 +240,81 @@ fn material_from_mtl(
         ior,
         diffuse_map: None,
         ambient_map: None,
+    }
+}
+
+/// The values of one MTL material as they are read, with one warning for each invalid one.
+struct Values<'a> {
+    m: &'a tobj::Material,
+    label: &'a str,
+    warnings: &'a mut Vec<String>,
+}
+
+impl Values<'_> {
+    fn invalid(&mut self, key: &str, got: String, fallback: String) {
+        self.warnings.push(format!(
+            "{}: material `{}` has an invalid `{key}` {got}; using {fallback}.",
+            self.label,
+            short(&self.m.name)
+        ));
+    }
+
+    /// A colour, or `fallback` when it is absent or invalid (not finite, or negative).
+    fn rgb(&mut self, value: Option<[f32; 3]>, key: &str, fallback: Vec3) -> Vec3 {
+        let Some(a) = value else {
+            return fallback;
+        };
+        let v = Vec3::from_array(a);
+        if v.is_finite() && v.cmpge(Vec3::ZERO).all() {
+            v
+        } else {
+            self.invalid(key, format!("{a:?}"), format!("{fallback}"));
+            fallback
+        }
+    }
+
+    /// A finite number that passes `ok`, or `None` when it is absent or invalid (the warning
+    /// names `fallback`, what the caller uses instead).
+    fn scalar(
+        &mut self,
+        value: Option<f32>,
+        key: &str,
+        ok: fn(f32) -> bool,
+        fallback: f32,
+    ) -> Option<f32> {
+        match value {
+            Some(x) if x.is_finite() && ok(x) => Some(x),
+            Some(x) => {
+                self.invalid(key, x.to_string(), fallback.to_string());
+                None
+            }
+            None => None,
+        }
+    }
+
+    /// The opacity: `d`, else 1 − `Tr`, else `None`. `Tr 1` without `d` on a material that is
+    /// not glass (`glass`) is opaque, with a warning: MeshLab and others write it meaning opaque
+    /// (Tr as opacity); an invisible material is never what is meant.
+    fn dissolve(&mut self, glass: bool) -> Option<f32> {
+        let m = self.m;
+        let in_unit = |x: f32| (0.0..=1.0).contains(&x);
+        if let Some(d) = self.scalar(m.dissolve, "d", in_unit, 1.0) {
+            return Some(d);
+        }
+        let tr = m
+            .unknown_param
+            .get("Tr")
+            .and_then(|t| t.trim().parse::<f32>().ok());
+        let tr = self.scalar(tr, "Tr", in_unit, 0.0)?;
+        if tr == 1.0 && !glass {
+            self.warnings.push(format!(
+                "{}: material `{}` has `Tr 1` (fully transparent) but is not glass; taken as opaque, as MeshLab means it.",
+                self.label,
+                short(&m.name)
+            ));
+            return Some(1.0);
+        }
+        Some(1.0 - tr)
     }
 }
 

@@ -17,12 +17,12 @@ use super::keys::{
 };
 use super::names::unique_names;
 use super::reader::{Section, syntax_error};
-use super::sections::{choice, parse_camera, parse_material, parse_render};
+use super::sections::{choice, parse_camera, parse_light, parse_material, parse_render};
 use crate::scene::diag::{SceneError, Src, list_and, short, short_path, suggest};
 use crate::scene::obj::{self, MeshPlacement};
 use crate::scene::resolve::{ResolveBytesFn, ResolveFn, no_binary_files};
 use crate::scene::{
-    Light, MaterialId, NormalsMode, Object, ObjectId, ObjectSource, Scene, Sphere, Triangle, rules,
+    MaterialId, NormalsMode, Object, ObjectId, ObjectSource, Scene, Sphere, Triangle, rules,
 };
 
 /// Parses scene TOML, reading meshes and material libraries through `resolve` (textures are
@@ -115,24 +115,7 @@ impl SceneBuilder<'_> {
         let refs: Vec<&Section> = lights.iter().collect();
         let names = unique_names(&refs, "light", |i| Ok(format!("light {}", i + 1)))?;
         for (s, name) in lights.iter().zip(names) {
-            let follow_camera = s.boolean("follow_camera", false)?;
-            if follow_camera && let Some(v) = s.get("position") {
-                return Err(s.error(
-                    &v.span(),
-                    "position",
-                    "cannot be given with `follow_camera = true`: that light stands at the camera's eye",
-                ));
-            }
-            let light = Light {
-                name,
-                // Without a position, a light at the eye (where it stays only with
-                // `follow_camera`: see `Scene::place_lights`).
-                position: s.vec3("position", self.scene.camera.position)?,
-                color: s.color("color", Vec3::ONE)?,
-                radius: s.f32("radius", 0.0)?,
-                follow_camera,
-            };
-            rules::check_light(&light).map_err(|v| s.verdict(&v))?;
+            let light = parse_light(s, name, self.scene.camera.position)?;
             self.scene.lights.push(light);
         }
 

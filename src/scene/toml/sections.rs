@@ -1,12 +1,13 @@
-//! The values of the `[render]`, `[camera]` and `[[material]]` sections, with their defaults,
-//! each held to its rule; and the named choices (`shading`, `normals`).
+//! The values of the `[render]`, `[camera]`, `[[light]]` and `[[material]]` sections, with their
+//! defaults, each held to its rule; and the named choices (`shading`, `normals`).
 
+use glam::Vec3;
 use toml::de::DeValue;
 
 use super::reader::Section;
 use crate::choice::Choice;
 use crate::scene::diag::SceneError;
-use crate::scene::{Camera, Material, RenderParams, Shading, rules};
+use crate::scene::{Camera, Light, Material, RenderParams, Shading, rules};
 
 /// A named choice (`shading`, `normals`), or `None` when the key is absent.
 pub(super) fn choice<T: Choice>(s: &Section, key: &str) -> Result<Option<T>, SceneError> {
@@ -87,4 +88,26 @@ pub(super) fn parse_material(s: &Section, name: String) -> Result<Material, Scen
     };
     rules::check_material(&material).map_err(|v| s.verdict(&v))?;
     Ok(material)
+}
+
+/// A `[[light]]` named `name`; without a position it stands at `eye`, the camera's position
+/// (where it stays only with `follow_camera`: see `Scene::place_lights`).
+pub(super) fn parse_light(s: &Section, name: String, eye: Vec3) -> Result<Light, SceneError> {
+    let follow_camera = s.boolean("follow_camera", false)?;
+    if follow_camera && let Some(v) = s.get("position") {
+        return Err(s.error(
+            &v.span(),
+            "position",
+            "cannot be given with `follow_camera = true`: that light stands at the camera's eye",
+        ));
+    }
+    let light = Light {
+        name,
+        position: s.vec3("position", eye)?,
+        color: s.color("color", Vec3::ONE)?,
+        radius: s.f32("radius", 0.0)?,
+        follow_camera,
+    };
+    rules::check_light(&light).map_err(|v| s.verdict(&v))?;
+    Ok(light)
 }
