@@ -1,4 +1,4 @@
-//! Issues 7 and 15: raytree against a peer in the same run, the peer held at its best. The
+//! raytree against a peer in the same run, the peer held at its best. The
 //! peer is `benches/peer/embree_whitted.c`, a Whitted renderer over Debian's Embree 3
 //! (`apt-get install libembree-dev`), compiled here with the system C compiler (`$CC`, else
 //! `cc`) into a temp dir; without Embree the peer is skipped with a message and raytree runs
@@ -12,17 +12,17 @@
 //! ray only where N·L > 0 and the light meets some diffuse or specular colour); rays are
 //! counted by kind on both sides and the bench fails when one kind differs by more than 1 %.
 //!
-//! Peer configurations (`--peer-config`, a comma list; default `best,user-high,issue7`):
+//! Peer configurations (`--peer-config`, a comma list; default `best,user-high,user-medium`):
 //! `best` gives the spheres to Embree as its built-in sphere geometry, builds every BVH at
 //! `RTC_BUILD_QUALITY_HIGH` and sets flush-to-zero/denormals-are-zero on its tracing threads
-//! (Embree's advice); `user-high` is the same with the spheres as an Embree user geometry
-//! (whose callback is raytree's robust intersection), which measured faster than the built-in
-//! spheres on this scene; `issue7` is the configuration of issue 7 (user-geometry spheres,
-//! medium quality, denormals kept); `SPHERES:QUALITY[:ftz][:robust]` (e.g. `builtin:medium`,
+//! (Embree's advice); `user-high` is the same with the spheres as an Embree user geometry (whose
+//! callback is raytree's robust intersection), which measured faster than the built-in spheres on
+//! this scene; `user-medium` has user-geometry spheres with Embree's default build quality (medium)
+//! and denormals kept, for comparison; `SPHERES:QUALITY[:ftz][:robust]` (e.g. `builtin:medium`,
 //! `builtin:high:ftz:robust`) any other, `:robust` setting `RTC_SCENE_FLAG_ROBUST` (Embree's
-//! watertight mode; without it the scene flags are `RTC_SCENE_FLAG_NONE`, its fastest).
-//! The harness is compiled with `-O3 -march=native -ffp-contract=off` (no FMA contraction: its
-//! shading rounds as raytree's).
+//! watertight mode; without it the scene flags are `RTC_SCENE_FLAG_NONE`, its fastest). The harness
+//! is compiled with `-O3 -march=native -ffp-contract=off` (no FMA contraction: its shading rounds
+//! as raytree's).
 //!
 //! Each process builds once and renders K frames (`--frames`, default 5): the first frame is
 //! frame 1, the warm frame the median of frames 2..K. Each size starts with `--warmup` rounds
@@ -68,23 +68,23 @@ struct PeerConfig {
 }
 
 impl PeerConfig {
-    /// `best` (built-in spheres, high quality, FTZ/DAZ: the peer at its best as issue 15 names
-    /// it), `user-high` (the same with user-geometry spheres, which measure faster here),
-    /// `issue7` (user-geometry spheres, medium quality, denormals kept: the configuration of
-    /// issue 7), or `SPHERES:QUALITY` with `:ftz` after it for FTZ/DAZ and `:robust` for
-    /// Embree's watertight mode.
+    /// `best` (built-in spheres, high quality, FTZ/DAZ: the peer at its best as Embree's own
+    /// advice sets it up), `user-high` (the same with user-geometry spheres, which measure
+    /// faster here), `user-medium` (user-geometry spheres, medium quality, denormals kept), or
+    /// `SPHERES:QUALITY` with `:ftz` after it for FTZ/DAZ and `:robust` for Embree's watertight
+    /// mode.
     fn parse(text: &str) -> Self {
         let text = match text {
             "best" => "builtin:high:ftz",
             "user-high" => "user:high:ftz",
-            "issue7" => "user:medium",
+            "user-medium" => "user:medium",
             other => other,
         };
         let mut parts = text.split(':');
         let (spheres, quality) = (
             parts.next().unwrap_or_default(),
             parts.next().unwrap_or_else(|| {
-                panic!("--peer-config: best, issue7 or SPHERES:QUALITY[:ftz][:robust], not {text}")
+                panic!("--peer-config: best, user-high, user-medium or SPHERES:QUALITY[:ftz][:robust], not {text}")
             }),
         );
         let (mut ftz, mut robust) = (false, false);
@@ -160,7 +160,7 @@ fn parse_options() -> Options {
         keep: None,
         scaling: false,
         peer: true,
-        peer_configs: ["best", "user-high", "issue7"]
+        peer_configs: ["best", "user-high", "user-medium"]
             .map(PeerConfig::parse)
             .to_vec(),
         chart: None,
@@ -674,7 +674,7 @@ fn peer_comparison(o: &Options, root: &Path) {
         &[]
     };
     println!(
-        "peer bench (issue 15): {} threads, {} alternating rounds after {} discarded warm-up round(s) per size, {} frames per process (first = frame 1 after the build, warm = median of frames 2..{}), load average before: {}",
+        "peer bench: {} threads, {} alternating rounds after {} discarded warm-up round(s) per size, {} frames per process (first = frame 1 after the build, warm = median of frames 2..{}), load average before: {}",
         o.threads,
         o.runs,
         o.warmup,

@@ -1,8 +1,8 @@
-//! The lecture's "Ray Tracing Tree" figure (SPEC §5b) as data and as SVG: a tidy layout of a
-//! pixel's [`RayTree`] (rows by depth, leaves in order, parents centred over their children,
-//! subtrees never overlapping), its node and edge labels, the shadow-ray glyphs, the rays that
-//! were not traced, and one legend table. The viewer's diagram and `raytree tree --diagram`
-//! both draw this layout, in the one palette of [`crate::scene_view`].
+//! The lecture's "Ray Tracing Tree" figure (docs/design.md, "The ray tree as data") as data and as
+//! SVG: a tidy layout of a pixel's [`RayTree`] (rows by depth, leaves in order, parents centred
+//! over their children, subtrees never overlapping), its node and edge labels, the shadow-ray
+//! glyphs, the rays that were not traced, and one legend table. The viewer's diagram and `raytree
+//! tree --diagram` both draw this layout, in the one palette of [`crate::scene_view`].
 
 use std::fmt::Write as _;
 

@@ -47,7 +47,7 @@ enum Command {
     Bench(BenchArgs),
     #[cfg(feature = "lab")]
     /// Measure where the naive intersection, offset and refraction methods fail and that the
-    /// robust ones hold (the rows of STABILITY.md): stability.md and one chart per row.
+    /// robust ones hold (the rows of docs/stability.md): stability.md and one chart per row.
     Stability(StabilityArgs),
     /// List the built-in scenes.
     Scenes,

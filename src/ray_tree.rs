@@ -1,5 +1,5 @@
-//! The ray tracing tree of one pixel as data (SPEC §5b): the recorder that builds it from the
-//! same [`Tracer::trace`] the image uses, and its JSON form.
+//! The ray tracing tree of one pixel as data (docs/design.md, "The ray tree as data"): the recorder
+//! that builds it from the same [`Tracer::trace`] the image uses, and its JSON form.
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -76,7 +76,7 @@ pub struct ShadowRecord {
     #[serde(default)]
     pub contributes_nothing: bool,
     /// The shading normal faces the light but the geometric surface does not, and the smooth
-    /// surface does not reach above it (STABILITY N3, robust): the light adds nothing.
+    /// surface does not reach above it (docs/stability.md, row N3, robust): the light adds nothing.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub behind_surface: bool,
     pub n_dot_l: f32,
@@ -108,7 +108,7 @@ pub struct Node {
     /// `V`, unit vector from the hit towards the ray's origin.
     pub view: Option<Vec3>,
     /// The direction (reflected or refracted about a shading normal) crossed the geometric
-    /// plane of the surface it left and was mirrored back (STABILITY N2).
+    /// plane of the surface it left and was mirrored back (docs/stability.md, row N2).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub direction_corrected: bool,
     pub local: Option<LocalRecord>,

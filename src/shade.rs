@@ -1,5 +1,5 @@
-//! Local illumination (Phong and Blinn-Phong, SPEC §1) and the directions of the secondary rays:
-//! reflection `R = u − 2(u·N)N` and refraction by Snell's law
+//! Local illumination (Phong and Blinn-Phong, docs/design.md, "The model") and the directions of
+//! the secondary rays: reflection `R = u − 2(u·N)N` and refraction by Snell's law
 //! `T = (ηi/ηr)u − (cosθr − (ηi/ηr)cosθi)N` with total internal reflection (lecture:
 //! "Reflection and Refraction").
 

@@ -1,12 +1,13 @@
 //! `Accel`: none, grid and BVH must give the identical closest hit (same t, same primitive, same
 //! barycentrics; ties to the lower id) and the identical occlusion verdict for every ray, over
-//! random and degenerate scenes (STABILITY B1, B2, T1 "including through the BVH", T4).
+//! random and degenerate scenes (docs/stability.md, rows B2, T1 "including through the BVH",
+//! T4).
 
 use glam::Vec3;
 use raytree::accel::{AUTO_MIN_BVH_PRIMS, Accel, AccelKind, PrimHit, PrimSet, auto_kind};
 use raytree::experiments::meshes::octasphere;
-use raytree::rng::Pcg;
 use raytree::geometry::{Methods, Ray, SphereMethod, TriangleMethod};
+use raytree::rng::Pcg;
 
 const KINDS: [AccelKind; 3] = [AccelKind::None, AccelKind::Grid, AccelKind::Bvh];
 
@@ -337,7 +338,8 @@ fn dust_in_front_of_layers() {
     assert!(hits > 3000, "hits {hits}");
 }
 
-/// STABILITY B2: 1e5 identical triangles build quickly into shallow structures of bounded size.
+/// docs/stability.md, row B2: 1e5 identical triangles build quickly into shallow structures of
+/// bounded size.
 #[test]
 fn hundred_thousand_identical_triangles() {
     let tri = [
@@ -510,7 +512,7 @@ fn auto_resolves_by_size() {
 }
 
 /// Rays from outside at the vertices and edges of a closed mesh never pass through it, through
-/// any accelerator (STABILITY T1: "0 leaks, including through the BVH").
+/// any accelerator (docs/stability.md, row T1: "0 leaks, including through the BVH").
 #[test]
 fn closed_mesh_has_no_leaks_through_any_accelerator() {
     let mut rng = Pcg::new(8);
@@ -585,7 +587,7 @@ fn large_scene_built_with_the_fast_preset_agrees_with_the_grid() {
     assert!(hits > 1000, "too few hits to be a test: {hits}");
 }
 
-// ---- The accelerator made visible (issue 12): what one ray's traversal entered and tested. ----
+// ---- The accelerator made visible: what one ray's traversal entered and tested. ----
 
 /// Scenes for the visit tests: mixed random primitives, a closed mesh, a flat plane (the grid
 /// has one cell layer) and a large random soup (a deep tree).

@@ -81,7 +81,7 @@ fn renders_exr() {
     );
 }
 
-/// `--stats-json` (issue 7): every figure the peer bench reads, consistent with each other,
+/// `--stats-json`: every figure the peer bench reads, consistent with each other,
 /// and `--threads` holding for the accelerator build too.
 #[test]
 fn stats_json_has_consistent_figures() {
@@ -143,7 +143,7 @@ fn stats_json_has_consistent_figures() {
     );
 }
 
-/// `--frames K` (issue 15, the peer bench's first and warm frames): one load and build, K
+/// `--frames K` (the peer bench's first and warm frames): one load and build, K
 /// renders, each frame's render phase in the JSON, the statistics the first frame's, and the
 /// image the same as a single frame's; `--frames 0` is refused.
 #[test]

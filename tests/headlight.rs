@@ -1,5 +1,5 @@
-//! A light that follows the camera (SPEC §3b, `follow_camera = true`): one rule
-//! (`Scene::place_lights`) puts it at the render camera's eye, so `raytree render --eye`, the
+//! A light that follows the camera (`follow_camera = true`, docs/design.md, "Scene files"): one
+//! rule (`Scene::place_lights`) puts it at the render camera's eye, so `raytree render --eye`, the
 //! ray tree and the viewer all see it there; saved and loaded as written; held to its rules.
 
 use std::sync::Arc;

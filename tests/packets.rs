@@ -105,7 +105,7 @@ fn every_method_and_the_cutoff_are_bit_identical() {
     }
 }
 
-/// The issue-7 benchmark scene (a mesh, mirror and glass spheres, two lights), small.
+/// The peer bench's scene (a mesh, mirror and glass spheres, two lights), small.
 #[test]
 fn bench_scene_is_bit_identical() {
     let dir = tempfile::tempdir().expect("temp dir");

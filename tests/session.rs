@@ -3,11 +3,13 @@
 //! that panics, or a render thread that cannot be spawned, is reported without stopping the
 //! session.
 
-use std::sync::Arc;
+use std::cell::RefCell;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::mpsc::{Receiver, channel};
+use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, Instant};
 
-use raytree::render::session::{Pass, Session, SessionEvent};
+use raytree::render::session::{Pass, Session, SessionEvent, Step};
 use raytree::render::{Image, render};
 use raytree::scene::builtin::load_builtin;
 use raytree::trace::{TraceSettings, Tracer};
@@ -18,6 +20,67 @@ fn tracer(name: &str, w: u32, h: u32, max_depth: u32) -> Arc<Tracer> {
     s.render.height = h;
     s.render.max_depth = max_depth;
     Arc::new(Tracer::new(Arc::new(s), TraceSettings::default()))
+}
+
+/// The coordinators' steps as a test sees them: every (generation, step) the session's step
+/// hook reports, and a gate that holds each build at its start while it is closed.
+struct Steps {
+    reported: Receiver<(u64, Step)>,
+    /// Steps received but not yet waited for.
+    seen: RefCell<Vec<(u64, Step)>>,
+    /// Closed (`true`): builds wait at [`Step::Building`].
+    gate: Arc<(Mutex<bool>, Condvar)>,
+}
+
+impl Steps {
+    /// Installs the step hook on `session` (for its next starts), the gate open.
+    fn install(session: &mut Session) -> Steps {
+        let (sender, reported) = channel();
+        let sender = Mutex::new(sender);
+        let gate = Arc::new((Mutex::new(false), Condvar::new()));
+        let held = gate.clone();
+        session.set_step_hook(Some(Arc::new(move |generation, step| {
+            let _ = raytree::sync::lock(&sender).send((generation, step));
+            if step == Step::Building {
+                let (closed, opened) = &*held;
+                // A minute at most: a call that waited for its own build then fails its
+                // assertions instead of hanging.
+                let closed = raytree::sync::lock(closed);
+                let _ = opened.wait_timeout_while(closed, Duration::from_secs(60), |c| *c);
+            }
+        })));
+        Steps {
+            reported,
+            seen: RefCell::new(Vec::new()),
+            gate,
+        }
+    }
+
+    /// Closes (`true`) or opens the gate for builds.
+    fn hold(&self, closed: bool) {
+        let (gate, opened) = &*self.gate;
+        *raytree::sync::lock(gate) = closed;
+        opened.notify_all();
+    }
+
+    /// Waits, up to two minutes, until `generation` has reported `step`.
+    fn wait_for(&self, generation: u64, step: Step) {
+        let deadline = Instant::now() + Duration::from_secs(120);
+        while !self.seen.borrow().contains(&(generation, step)) {
+            let left = deadline.saturating_duration_since(Instant::now());
+            match self.reported.recv_timeout(left) {
+                Ok(reported) => self.seen.borrow_mut().push(reported),
+                Err(_) => panic!("generation {generation} never reported {step:?}"),
+            }
+        }
+    }
+}
+
+/// Nothing is waiting in `session`: no tracer to hand out, no event (checked once a
+/// generation has reported [`Step::Done`], after which it can send nothing).
+fn assert_nothing_waits(session: &Session, what: &str) {
+    assert!(session.take_built().is_none(), "a tracer {what}");
+    assert!(session.try_next().is_none(), "an event {what}");
 }
 
 /// Collects tiles into an image until the generation finishes; checks every event's
@@ -111,6 +174,7 @@ fn restart_mid_pass_never_mixes_generations() {
 fn panicking_worker_is_reported_and_the_next_start_renders() {
     let t = tracer("default", 96, 72, 5);
     let mut session = Session::new(2).expect("pool");
+    let steps = Steps::install(&mut session);
     let armed = Arc::new(AtomicBool::new(true));
     let calls = Arc::new(AtomicU32::new(0));
     {
@@ -153,12 +217,12 @@ fn panicking_worker_is_reported_and_the_next_start_renders() {
     );
     assert_eq!(passes, vec![Pass::Preview, Pass::Samples(1)]);
     // The failed generation stops: tiles already traced may still arrive, but no pass ends.
-    let quiet = Instant::now() + Duration::from_millis(300);
-    while Instant::now() < quiet {
-        match session.try_next() {
-            Some(SessionEvent::Tile(t)) => assert_eq!(t.generation, failed),
-            Some(ev) => panic!("after the failure: {ev:?}"),
-            None => std::thread::sleep(Duration::from_millis(2)),
+    // Once its coordinator is done, everything it sent is waiting.
+    steps.wait_for(failed, Step::Done);
+    while let Some(ev) = session.try_next() {
+        match ev {
+            SessionEvent::Tile(t) => assert_eq!(t.generation, failed),
+            ev => panic!("after the failure: {ev:?}"),
         }
     }
     // An edit restarts the render with the hook still installed (now harmless).
@@ -213,7 +277,7 @@ fn a_failed_thread_spawn_is_reported_and_the_next_start_renders() {
     assert!(img == batch, "the render after the failure differs");
 }
 
-/// A scene with a big mesh (its BVH build takes a good fraction of a second) at `w`×`h`.
+/// A scene with a big mesh (a real BVH build, a good fraction of a second) at `w`×`h`.
 fn big_scene(w: u32, h: u32) -> Arc<raytree::scene::Scene> {
     let dir = tempfile::tempdir().expect("temp dir");
     let path = raytree::scene::procedural::write_bench_scene(dir.path(), 300_000).expect("write");
@@ -223,17 +287,26 @@ fn big_scene(w: u32, h: u32) -> Arc<raytree::scene::Scene> {
     Arc::new(s)
 }
 
-/// `start_build` returns at once and builds on the coordinator: the tracer is handed out once,
-/// before the generation's first event, and the render equals the batch render of a tracer
-/// built on the caller's thread.
+/// `start_build` returns without waiting for the build, which runs on the coordinator: with the
+/// build held at its start, the call has returned and nothing is handed out; once let go, the
+/// tracer is handed out once, before the generation's first event, and the render equals the
+/// batch render of a tracer built on the caller's thread.
 #[test]
 fn a_build_off_the_caller_thread_is_handed_out_before_its_first_tile() {
     let scene = big_scene(48, 32);
     let mut session = Session::new(2).expect("pool");
-    let t = Instant::now();
+    let steps = Steps::install(&mut session);
+    steps.hold(true);
     let generation = session.start_build(scene.clone(), TraceSettings::default(), 1, None);
-    let returned = t.elapsed();
+    // Returned, and the build has started on the coordinator, where it waits.
+    steps.wait_for(generation, Step::Building);
     assert!(session.building_for().is_some(), "building is reported");
+    assert!(
+        session.take_built().is_none(),
+        "a tracer while its build is held: start_build waited for the build"
+    );
+    assert!(session.try_next().is_none(), "an event before the build");
+    steps.hold(false);
     let deadline = Instant::now() + Duration::from_secs(120);
     let built = loop {
         assert!(Instant::now() < deadline, "the build never ended");
@@ -246,8 +319,6 @@ fn a_build_off_the_caller_thread_is_handed_out_before_its_first_tile() {
         );
         std::thread::sleep(Duration::from_millis(2));
     };
-    // The build took longer than the call: the call did not wait for it.
-    assert!(built.build_secs > returned.as_secs_f64(), "{returned:?}");
     assert!(session.take_built().is_none(), "handed out once");
     assert!(session.building_for().is_none());
     assert!(Arc::ptr_eq(&built.scene, &scene));
@@ -260,16 +331,21 @@ fn a_build_off_the_caller_thread_is_handed_out_before_its_first_tile() {
     );
 }
 
-/// A second build (or a plain start, or a stop) while one is in flight supersedes it: the older
-/// tracer is never handed out and none of its events arrive; the newer one is.
+/// A second build (or a plain start, or a stop) while one is in flight (held at its start)
+/// supersedes it: the older tracer is never handed out and none of its events arrive; the
+/// newer one is.
 #[test]
 fn a_build_in_flight_is_superseded_and_its_result_never_appears() {
     let big = big_scene(48, 32);
     let small = tracer("default", 48, 32, 3);
     let mut session = Session::new(2).expect("pool");
+    let steps = Steps::install(&mut session);
+    steps.hold(true);
     let first = session.start_build(big.clone(), TraceSettings::default(), 1, None);
+    steps.wait_for(first, Step::Building);
     let second = session.start_build(small.scene.clone(), TraceSettings::default(), 1, None);
     assert!(second > first);
+    steps.hold(false);
     let deadline = Instant::now() + Duration::from_secs(120);
     let built = loop {
         assert!(Instant::now() < deadline, "the second build never ended");
@@ -283,26 +359,23 @@ fn a_build_in_flight_is_superseded_and_its_result_never_appears() {
         "the newer scene's tracer"
     );
     collect(&session, second, 48, 32);
-    // Let the superseded build run out: it hands nothing out and sends nothing that arrives.
-    let quiet = Instant::now() + Duration::from_secs(3);
-    while Instant::now() < quiet {
-        assert!(
-            session.take_built().is_none(),
-            "a superseded tracer appeared"
-        );
-        assert!(session.try_next().is_none(), "an event after the finish");
-        std::thread::sleep(Duration::from_millis(5));
-    }
+    // The superseded build has run out: it handed nothing out and sent nothing that arrives.
+    steps.wait_for(first, Step::Done);
+    assert_nothing_waits(&session, "from a superseded build");
     // A plain start and a stop supersede a build too.
-    session.start_build(big.clone(), TraceSettings::default(), 1, None);
+    steps.hold(true);
+    let third = session.start_build(big.clone(), TraceSettings::default(), 1, None);
+    steps.wait_for(third, Step::Building);
     let plain = session.start(small.clone(), 1, None);
+    steps.hold(false);
     collect(&session, plain, 48, 32);
-    session.start_build(big, TraceSettings::default(), 1, None);
+    steps.wait_for(third, Step::Done);
+    assert_nothing_waits(&session, "from a build superseded by a plain start");
+    steps.hold(true);
+    let fourth = session.start_build(big, TraceSettings::default(), 1, None);
+    steps.wait_for(fourth, Step::Building);
     session.stop();
-    let quiet = Instant::now() + Duration::from_secs(3);
-    while Instant::now() < quiet {
-        assert!(session.take_built().is_none(), "a stopped build appeared");
-        assert!(session.try_next().is_none(), "an event of a stopped build");
-        std::thread::sleep(Duration::from_millis(5));
-    }
+    steps.hold(false);
+    steps.wait_for(fourth, Step::Done);
+    assert_nothing_waits(&session, "from a stopped build");
 }

@@ -9,10 +9,10 @@ use std::sync::Arc;
 
 use raytree::accel::AccelKind;
 use raytree::experiments::metrics::differing_pixels;
-use raytree::rng::Pcg;
 use raytree::experiments::stability::*;
 use raytree::geometry::{Methods, OffsetMethod, SphereMethod, TriangleMethod};
 use raytree::render::{Image, render};
+use raytree::rng::Pcg;
 use raytree::scene::builtin::load_builtin;
 use raytree::trace::{TraceSettings, Tracer};
 

@@ -1,4 +1,4 @@
-//! `Tracer::visits_of` (issue 12, the accelerator made visible): replaying a ray-tree node's
+//! `Tracer::visits_of` (the accelerator made visible): replaying a ray-tree node's
 //! query gives the node's recorded hit, and its shadow rays the verdicts the tree shows.
 
 use std::sync::Arc;

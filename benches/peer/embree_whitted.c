@@ -1,16 +1,16 @@
-/* embree_whitted.c: the peer of raytree's peer benchmark (issues 7 and 15). A Whitted ray
+/* embree_whitted.c: the peer of raytree's peer benchmark (benches/peer.rs). A Whitted ray
  * tracer over Embree 3 (single rays: rtcIntersect1 for camera, reflected and refracted rays,
  * rtcOccluded1 for shadow rays) that renders the scene `benches/peer.rs` hands it with the same
  * camera, materials, recursion, shadow-ray rule and ray-origin offsets as raytree's
- * `src/trace.rs`, on N pthreads over 32x32 tiles taken from an atomic counter.
+ * `src/trace/`, on N pthreads over 32x32 tiles taken from an atomic counter.
  *
  * Usage: embree_whitted [--spheres builtin|user] [--quality low|medium|high] [--frames K]
  *                       [--ftz 0|1] [--robust 0|1] SCENE.bin THREADS [IMAGE.f32]
  *
  * --spheres builtin (the default) gives the spheres to Embree as its own sphere geometry
  *   (RTC_GEOMETRY_TYPE_SPHERE_POINT, a float4 centre and radius each): Embree's ray-sphere
- *   intersector, the fast path an Embree user takes. `user` is the configuration of issue 7: an
- *   Embree user geometry whose callback is raytree's robust (Ray Tracing Gems ch. 7) root pair.
+ *   intersector, the fast path an Embree user takes. `user` is an Embree user geometry whose
+ *   callback is raytree's robust (Ray Tracing Gems ch. 7) root pair.
  * --quality sets the scene's and every geometry's build quality (default high: the triangles'
  *   BVH with spatial splits, as an Embree user after render speed chooses).
  * --robust 1 sets RTC_SCENE_FLAG_ROBUST (Embree's watertight mode: no ray slips between two
@@ -155,7 +155,8 @@ static void load_scene(const char *path) {
 }
 
 /* ---- analytic spheres as an Embree user geometry (--spheres user) ----
- * The configuration of issue 7, kept as the bench's second row: a callback per sphere test.
+ * A callback per sphere test, with raytree's own intersection (rows `user-high` and
+ * `user-medium` of the bench).
  * Embree's built-in spheres (the default) solve t = projection -+ half-chord, whose near root
  * cancels for a ray that leaves a sphere; with raytree's error-bound origin offsets the bench
  * scene shows no re-hit (the same rays and pixels as raytree), which the bench checks. */
@@ -250,7 +251,7 @@ static double now_secs(void) {
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* ---- the Whitted trace, as raytree's src/trace.rs ---- */
+/* ---- the Whitted trace, as raytree's src/trace/mod.rs ---- */
 static RTCScene scene;
 enum { GEOM_TRIANGLES = 0, GEOM_SPHERES = 1 };
 

@@ -19,8 +19,8 @@ use glam::{IVec3, Vec3};
 
 use super::{Prim, Visitor, safe_inv, slab};
 
-/// Target cells per primitive (the `λ` in `res = cbrt(λ·N/V)·extent`). 4 is the usual middle
-/// of the 2…8 range; issue 5 measures it.
+/// Target cells per primitive (the `λ` in `res = cbrt(λ·N/V)·extent`): 4, the usual middle of
+/// the 2…8 range.
 pub const GRID_DENSITY: f32 = 4.0;
 
 /// Cells per axis at most (so at most `128³ ≈ 2.1e6` cells).

@@ -88,7 +88,7 @@ pub struct PrimHit {
 /// The uniform grid is never chosen. On the sweep's sphere (the grid's best case: one even
 /// surface, cells evenly filled) its cheaper build still wins a *single* frame from about 0.9M
 /// triangles (after the parallel BVH build: 1M 0.65 s against 0.68 s, 2M 0.73 s against
-/// 1.28 s). But on the issue-7 Whitted scene (a torus, mirror and glass spheres) the grid
+/// 1.28 s). But on the peer bench's Whitted scene (a torus, mirror and glass spheres) the grid
 /// renders about 10× slower and loses the first frame too (1M: 1.9 s against 0.93 s; 2M:
 /// 2.8 s against 1.8 s), and a viewer renders many frames per build, where the BVH is 2–10×
 /// faster each. `--accel grid` remains for the single frame of a huge even mesh.
@@ -596,7 +596,8 @@ impl Accel {
         self.skipped
     }
 
-    /// Depth of the BVH (root = 1), `None` for the other kinds (STABILITY B2 reports it).
+    /// Depth of the BVH (root = 1), `None` for the other kinds (reported in docs/stability.md,
+    /// row B2).
     pub fn bvh_depth(&self) -> Option<usize> {
         match &self.imp {
             Imp::Bvh(b) => Some(b.depth()),

@@ -1,6 +1,6 @@
-//! The accelerator made visible (issue 12, the lecture's "BVH" and "spatial subdivision"): what
-//! one query's traversal entered and tested, and the boxes of the structure level by level, for
-//! the views to draw.
+//! The accelerator made visible (the lecture's "BVH" and "spatial subdivision"): what one
+//! query's traversal entered and tested, and the boxes of the structure level by level, for the
+//! views to draw.
 //!
 //! A recording query runs the very traversal of [`Accel::closest_hit`] and [`Accel::occluded`]
 //! with a visitor that wraps theirs and notes each box entered ([`Visitor::enter`], a no-op for

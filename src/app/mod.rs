@@ -532,8 +532,7 @@ impl ViewerApp {
         }
         self.film.resize(w, h);
         self.scene = scene;
-        crate::sync::lock(&self.display)
-            .resize(w, h);
+        crate::sync::lock(&self.display).resize(w, h);
         // The tree follows the scene: re-trace the clicked pixel with the new settings.
         if let Some(tree) = &self.tree {
             let [x, y] = tree.pixel;
@@ -1399,9 +1398,7 @@ impl ViewerApp {
     pub(super) fn image_rect(&mut self, ctx: &egui::Context, avail: egui::Rect) -> egui::Rect {
         let (w, h) = self.render_size();
         let (rect, scale) = viewport::fit_image(avail, w, h, ctx.pixels_per_point());
-        crate::sync::lock(&self.display)
-            .params
-            .smooth = viewport::smooth_at(scale);
+        crate::sync::lock(&self.display).params.smooth = viewport::smooth_at(scale);
         rect
     }
 

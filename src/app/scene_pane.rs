@@ -174,8 +174,7 @@ impl SceneView {
         };
         let samples = tracer.scene.render.samples.clamp(1, SAMPLES);
         self.film.resize(w, h);
-        crate::sync::lock(&self.display)
-            .resize(w, h);
+        crate::sync::lock(&self.display).resize(w, h);
         self.finished = false;
         self.generation = self.session.start_view(tracer.clone(), view, samples);
     }

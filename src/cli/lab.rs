@@ -1,5 +1,5 @@
 //! `raytree bench` and `raytree stability` (feature `lab`): the speed-vs-accuracy and scaling
-//! sweeps, and the rows of STABILITY.md, with progress bars; files written, summaries printed.
+//! sweeps, and the rows of docs/stability.md, with progress bars; files written, summaries printed.
 
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;

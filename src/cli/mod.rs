@@ -54,7 +54,7 @@ pub struct SceneOverrides {
     #[arg(long, value_parser = ChoiceParser::<OffsetMethod>::default(),
           default_value = OffsetMethod::default().name())]
     offset: OffsetMethod,
-    /// Where shading and geometric normals disagree (STABILITY N1–N3).
+    /// Where shading and geometric normals disagree (docs/stability.md, rows N1–N3).
     #[arg(long, value_parser = ChoiceParser::<ShadingNormals>::default(),
           default_value = ShadingNormals::default().name())]
     shading_normals: ShadingNormals,

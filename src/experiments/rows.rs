@@ -8,11 +8,11 @@ use serde::Serialize;
 
 use super::chart::{Chart, Series, write_chart};
 use super::measure::value_name;
-use crate::rng::Pcg;
 use super::stability::*;
 use crate::accel::AccelKind;
 use crate::export::{ExportError, write_text};
 use crate::geometry::{OffsetMethod, ShadingNormals, SphereMethod, TriangleMethod};
+use crate::rng::Pcg;
 
 /// How a row's robust method meets its target.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

@@ -15,7 +15,6 @@ use glam::{DVec3, Vec3};
 use serde::Serialize;
 
 use super::meshes::{octasphere, triangles};
-use crate::rng::Pcg;
 use crate::accel::{Accel, AccelKind, PrimSet};
 use crate::geometry::sphere::sphere_roots_f64;
 use crate::geometry::triangle::triangle_hit_f64;
@@ -24,6 +23,7 @@ use crate::geometry::{
     intersect_triangle, next_float_up, offset_ray_origin, sphere_hit_point, triangle_hit_point,
 };
 use crate::render::render;
+use crate::rng::Pcg;
 use crate::scene::{
     Light, Material, MaterialId, MeshAttributes, Object, ObjectId, ObjectSource, Scene, Triangle,
 };

@@ -5,6 +5,7 @@
 pub mod region;
 pub mod session;
 pub mod stats;
+mod sums;
 
 use std::ops::Range;
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -21,6 +22,7 @@ use crate::trace::{
     NoRecord, PacketScratch, RayCounts, RayKind, SampleInfo, TraceSettings, Tracer,
 };
 pub use stats::{MemoryStats, RenderStats, RunReport, peak_memory_bytes};
+use sums::SumsBuffer;
 
 /// Side of a square tile in pixels.
 pub const TILE_SIZE: u32 = 32;
@@ -483,7 +485,7 @@ pub(crate) fn render_part_with(
     // render's when there was one. Taken inside the timed part, so a fresh buffer's page
     // faults count; either kind is zeroed tile by tile by the workers, in parallel (a fresh
     // one's pages are faulted in there, not by this thread before the first tile starts).
-    let mut sums = tracer.take_sums(total as usize);
+    let mut sums = SumsBuffer::take(tracer, total as usize);
     let mut parts: Vec<&mut [Vec3]> = Vec::with_capacity(tiles.len());
     let mut rest: &mut [Vec3] = sums.vec3s_mut(total as usize);
     for rect in &tiles {
@@ -535,7 +537,7 @@ pub(crate) fn render_part_with(
             }
         }
     }
-    tracer.keep_sums(sums);
+    sums.keep(tracer);
     let stats = RenderStats {
         width: region.width,
         height: region.height,

@@ -1,7 +1,7 @@
-//! The progressive render session behind the viewer (SPEC §4): rayon workers trace 32×32 tiles
-//! in passes — a coarse preview (one sample per 8×8 block, the block filled), every pixel at 1
-//! sample, then samples accumulated in doubling batches up to the target — nearest the focus
-//! point (image centre or cursor) first. Each start bumps a generation; workers drop stale work
+//! The progressive render session behind the viewer (docs/design.md, "The viewer"): rayon
+//! workers trace 32×32 tiles in passes — a coarse preview (one sample per 8×8 block, the block
+//! filled), every pixel at 1 sample, then samples accumulated in doubling batches up to the
+//! target — nearest the focus point (image centre or cursor) first. Each start bumps a generation; workers drop stale work
 //! at once; finished tiles go over a bounded channel tagged with their generation, so the UI
 //! can never mix passes of two generations. The UI only ever calls `try_recv`.
 //!
@@ -136,6 +136,23 @@ pub type TileHook = dyn Fn(Pass, Rect) + Send + Sync;
 /// [`SessionEvent::Failed`]. The viewer sets none.
 pub type SpawnHook = dyn Fn() -> std::io::Result<()> + Send + Sync;
 
+/// A step of a generation's coordinator thread, reported to the [`StepHook`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Step {
+    /// The tracer of a [`Session::start_build`] is about to be built; until the hook returns,
+    /// the build waits.
+    Building,
+    /// The coordinator is done: the generation sends nothing more, whether it finished, failed,
+    /// was superseded or was stopped.
+    Done,
+}
+
+/// Called on a generation's coordinator thread with the generation and each [`Step`]: the
+/// tests use it to hold a build until they have seen [`Session::start_build`] return, and to
+/// know when a failed, superseded or stopped generation can send nothing more. The viewer sets
+/// none.
+pub type StepHook = dyn Fn(u64, Step) + Send + Sync;
+
 /// Owns the worker pool and the channel; one per viewer.
 pub struct Session {
     generation: Arc<AtomicU64>,
@@ -148,6 +165,7 @@ pub struct Session {
     stale_dropped: Cell<u64>,
     tile_hook: Option<Arc<TileHook>>,
     spawn_hook: Option<Arc<SpawnHook>>,
+    step_hook: Option<Arc<StepHook>>,
     /// A start that could not spawn its thread: handed out by [`Self::try_next`], since no
     /// worker exists to send it.
     start_failure: Cell<Option<SessionEvent>>,
@@ -171,6 +189,7 @@ impl Session {
             stale_dropped: Cell::new(0),
             tile_hook: None,
             spawn_hook: None,
+            step_hook: None,
             start_failure: Cell::new(None),
             built: Arc::new(Mutex::new(None)),
             building: Cell::new(None),
@@ -185,6 +204,11 @@ impl Session {
     /// Sets (or with `None` removes) the [`SpawnHook`]; takes effect at the next start.
     pub fn set_spawn_hook(&mut self, hook: Option<Arc<SpawnHook>>) {
         self.spawn_hook = hook;
+    }
+
+    /// Sets (or with `None` removes) the [`StepHook`]; takes effect at the next start.
+    pub fn set_step_hook(&mut self, hook: Option<Arc<StepHook>>) {
+        self.step_hook = hook;
     }
 
     /// Changes the worker count (takes effect at the next start).
@@ -228,8 +252,8 @@ impl Session {
     }
 
     /// Like [`Self::start`], but first builds the tracer (its accelerator) of `scene` on the
-    /// coordinator thread, so the caller never waits for a build (SPEC §4: the window never
-    /// freezes). The tracer is handed out by [`Self::take_built`] once built, just before the
+    /// coordinator thread, so the caller never waits for a build (the window never freezes).
+    /// The tracer is handed out by [`Self::take_built`] once built, just before the
     /// generation's first tile. A later start or stop supersedes the build: its result is
     /// dropped, never handed out (the build itself runs to its end in the background, as
     /// obvhs's cannot be interrupted). A panic in the build is that generation's
@@ -283,55 +307,66 @@ impl Session {
         let sender = self.sender.clone();
         let stats = self.stats.clone();
         let tile_hook = self.tile_hook.clone();
+        let step_hook = self.step_hook.clone();
         let built = self.built.clone();
         let pool = self.pool.clone();
         // The coordinator runs on its own thread so the UI never waits; it builds the
         // accelerator if asked, only hands passes to the pool and stops as soon as the
         // generation moves on.
         let coordinator = move || {
-            let tracer = match source {
-                Source::Ready(tracer) => tracer,
-                Source::Build(scene, settings) => {
-                    match catch_unwind(AssertUnwindSafe(|| Tracer::new(scene, settings))) {
-                        Ok(tracer) => {
-                            let tracer = Arc::new(tracer);
-                            let mut slot = crate::sync::lock(&built);
-                            // Superseded while building: the result is dropped here.
-                            if current.load(Ordering::SeqCst) != generation {
-                                return;
-                            }
-                            *slot = Some((generation, tracer.clone()));
-                            tracer
-                        }
-                        Err(panic) => {
-                            let message = panic_message(panic.as_ref());
-                            let _ = sender.send(SessionEvent::Failed {
-                                generation,
-                                message: format!("building the accelerator failed: {message}"),
-                            });
-                            return;
-                        }
-                    }
+            let step = |step| {
+                if let Some(hook) = &step_hook {
+                    hook(generation, step);
                 }
             };
-            let view = view.unwrap_or_else(|| View {
-                camera: tracer.scene.camera.clone(),
-                width: tracer.scene.render.width,
-                height: tracer.scene.render.height,
-            });
-            let job = Job {
-                tracer,
-                view,
-                target: target.max(1),
-                focus,
-                generation,
-                current,
-                failed: AtomicBool::new(false),
-                sender,
-                stats,
-                tile_hook,
+            let generate = || {
+                let tracer = match source {
+                    Source::Ready(tracer) => tracer,
+                    Source::Build(scene, settings) => {
+                        step(Step::Building);
+                        match catch_unwind(AssertUnwindSafe(|| Tracer::new(scene, settings))) {
+                            Ok(tracer) => {
+                                let tracer = Arc::new(tracer);
+                                let mut slot = crate::sync::lock(&built);
+                                // Superseded while building: the result is dropped here.
+                                if current.load(Ordering::SeqCst) != generation {
+                                    return;
+                                }
+                                *slot = Some((generation, tracer.clone()));
+                                tracer
+                            }
+                            Err(panic) => {
+                                let message = panic_message(panic.as_ref());
+                                let _ = sender.send(SessionEvent::Failed {
+                                    generation,
+                                    message: format!("building the accelerator failed: {message}"),
+                                });
+                                return;
+                            }
+                        }
+                    }
+                };
+                let view = view.unwrap_or_else(|| View {
+                    camera: tracer.scene.camera.clone(),
+                    width: tracer.scene.render.width,
+                    height: tracer.scene.render.height,
+                });
+                let job = Job {
+                    tracer,
+                    view,
+                    target: target.max(1),
+                    focus,
+                    generation,
+                    current,
+                    failed: AtomicBool::new(false),
+                    sender,
+                    stats,
+                    tile_hook,
+                };
+                job.run();
             };
-            job.run();
+            generate();
+            step(Step::Done);
         };
         let spawned = match &self.spawn_hook {
             Some(hook) => hook(),

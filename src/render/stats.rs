@@ -91,7 +91,8 @@ pub fn peak_memory_bytes() -> Option<u64> {
 }
 
 /// What `raytree render` reports of one run: `--stats-json` writes it (fields in alphabetical
-/// order, as earlier versions wrote them), and the summary lines are its [`RunReport::lines`].
+/// order, one fixed order for the programs that read it), and the summary lines are its
+/// [`RunReport::lines`].
 #[derive(Clone, Debug, Serialize)]
 pub struct RunReport {
     /// Threads of rayon's global pool, which builds the accelerator.

@@ -10,9 +10,9 @@
 //! (the way Embree and Wald et al. 2008 collapse). The primitives are then copied in leaf
 //! order, each keeping its original id, so a leaf reads a contiguous run.
 //!
-//! Pathological input (STABILITY B2). PLOC pairs neighbours whose union is cheapest and breaks
-//! equal costs one way, so regular input (many identical boxes, boxes in a row, nested boxes
-//! with one centre) merges only one pair per pass: the tree becomes a chain and the build is
+//! Pathological input (docs/stability.md, row B2). PLOC pairs neighbours whose union is cheapest
+//! and breaks equal costs one way, so regular input (many identical boxes, boxes in a row, nested
+//! boxes with one centre) merges only one pair per pass: the tree becomes a chain and the build is
 //! quadratic (16k identical triangles: 9 s). We therefore
 //! - grow every box by a pseudo-random `< 2⁻¹²` of its size ([`jitter`]; still conservative)
 //!   so equal costs become distinct;
@@ -47,7 +47,7 @@ pub const MAX_BVH2_DEPTH: usize = 96;
 /// From this many primitives on the build uses obvhs's `fast_build` preset instead of
 /// `medium_build`.
 ///
-/// Measured on the issue-7 Whitted scene (`cargo bench --bench peer`'s torus, 4 samples a
+/// Measured on the peer bench's Whitted scene (`cargo bench --bench peer`'s torus, 4 samples a
 /// pixel, 2 threads, median of 5 interleaved runs; minimum render time in brackets):
 ///
 /// | triangles | medium: build / render | fast: build / render | very fast: build / render |
@@ -152,9 +152,9 @@ impl Bvh {
 pub const SPLIT_BUILD_MIN_PRIMS: usize = 500_000;
 
 /// The most primitives of one PLOC tree in the split build ([`SPLIT_BUILD_MIN_PRIMS`]): parts
-/// are halved until they fit, so 1M triangles are built as four trees of 250k (session 12;
-/// two halves of 500k until then, which peaked at 2.01 times the memory the tracer keeps once
-/// narrow nodes made the kept tree smaller).
+/// are halved until they fit, so 1M triangles are built as four trees of 250k: built as two
+/// halves of 500k, they peaked at 2.01 times the memory the tracer keeps afterwards (whose
+/// tree, with narrow nodes, is small).
 pub const SPLIT_PART_MAX_PRIMS: usize = 1 << 18;
 
 /// The pre-order binary tree of [`SPLIT_BUILD_MIN_PRIMS`]: while a part holds more than

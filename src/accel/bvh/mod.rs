@@ -11,13 +11,14 @@
 //! multiplications (two SSE tests without AVX2); the node is 256 bytes (four cache lines)
 //! against CWBVH's 80.
 //!
-//! Why eight children and not four (this tree was 4-wide until session 9): a ray's walk is a
-//! chain of dependent loads, one per level, and the 8-wide tree has about half the levels. On
-//! the 1.28M-triangle bench scene the camera- and shadow-ray frame went 0.038 → 0.033 s and the
-//! whole Whitted frame 0.072 → 0.068 s; on the glass scene and the kitchen model, where
-//! single reflected and refracted rays dominate, −4 % and −6 %; at 80k triangles ±0.
+//! Why eight children and not four: a ray's walk is a chain of dependent loads, one per level,
+//! and the 8-wide tree has about half the levels. Against a 4-wide tree, on the 1.28M-triangle
+//! bench scene the camera- and shadow-ray frame takes 0.033 s instead of 0.038 s and the whole
+//! Whitted frame 0.068 s instead of 0.072 s; on the glass scene and the kitchen model, where
+//! single reflected and refracted rays dominate, 4 % and 6 % less; at 80k triangles the same
+//! (the method and the figures: docs/performance.md).
 //!
-//! Why some nodes are narrow (since session 12): the collapse fills a node with the two
+//! Why some nodes are narrow: the collapse fills a node with the two
 //! children of its binary node and opens the largest inner child until there are eight, so
 //! near the leaves, where a small subtree's children are leaves, most nodes hold two to four
 //! children (on the 1.28M-triangle bench mesh 71 % of nodes, 42 % with just two). Such a node
