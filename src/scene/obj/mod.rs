@@ -4,14 +4,14 @@
 //! then Z, in degrees) and translation (docs/design.md, "Scene files"). A bare `.obj` opened as
 //! a whole scene is in [`super::first_look`].
 //!
-//! - [`request`]: what to load (the mesh, its placement); [`paths`]: the files it names;
-//! - [`read`]: OBJ text into tobj's models, through the parallel reader ([`parse`]) where it can,
-//!   and which faces give `vn`/`vt` at every corner ([`corners`]) where tobj reads;
-//! - [`memory`]: the memory budget, checked before anything is built;
-//! - [`mesh`]: the steps of adding a mesh to a scene; [`faces`]: one model's faces placed;
-//!   [`attributes`]: the mesh's normals (smooth ones from [`crate::geometry::normals`]) and
+//! - `request`: what to load (the mesh, its placement); `paths`: the files it names;
+//! - `read`: OBJ text into tobj's models, through the parallel reader ([`parse`]) where it can,
+//!   and which faces give `vn`/`vt` at every corner (`corners`) where tobj reads;
+//! - `memory`: the memory budget, checked before anything is built;
+//! - `mesh`: the steps of adding a mesh to a scene; `faces`: one model's faces placed;
+//!   `attributes`: the mesh's normals (smooth ones from [`crate::geometry::normals`]) and
 //!   texture coordinates;
-//! - [`mtl`]: MTL libraries and materials; [`maps`]: their textures.
+//! - `mtl`: MTL libraries and materials; `maps`: their textures.
 
 mod attributes;
 mod corners;

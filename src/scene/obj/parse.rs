@@ -1,6 +1,6 @@
 //! A parallel reader for the common part of OBJ (`v`, `vt`, `vn`, `f`, `l`, `o`, `g`, `usemtl`,
 //! `mtllib`, comments), giving exactly what `tobj` 4.0.5 gives with the options
-//! `triangulate: true, single_index: false` (the ones [`super::read`] gives tobj): the same models,
+//! `triangulate: true, single_index: false` (the ones the loader gives tobj): the same models,
 //! names, material ids, positions, normals, texture coordinates and the three index lists, in
 //! the same order, bit for bit. It is about ten times faster than `tobj` on big meshes, which
 //! spends its time hashing every face corner.

@@ -1,6 +1,6 @@
 //! Scene files (TOML): the sections and keys a file may have ([`keys`]), a strict reader that
-//! places every error at its file, line and column ([`reader`]), and the builder that makes a
-//! [`Scene`](crate::scene::Scene) of them ([`build`]). The format: docs/design.md, "Scene files".
+//! places every error at its file, line and column (`reader`), and the builder that makes a
+//! [`Scene`](crate::scene::Scene) of them (`build`). The format: docs/design.md, "Scene files".
 
 mod build;
 pub mod keys;
