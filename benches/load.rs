@@ -1,4 +1,4 @@
-//! OBJ loading, measured (never asserted): raytree's parallel reader (`scene::obj_parse`)
+//! OBJ loading, measured (never asserted): raytree's parallel reader (`scene::obj::parse`)
 //! against `tobj` in the same run, on the same text already in memory, and the whole bare-OBJ
 //! load (`load_scene_file`: read, parse, place, drop degenerate triangles, frame a camera).
 //! Two meshes of about `--triangles` triangles: the benchmark torus (`v` and `f a b c` only,
@@ -12,7 +12,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use raytree::scene::obj_parse;
+use raytree::scene::obj::parse;
 use raytree::scene::procedural::{bumpy_torus_obj, torus_grid};
 
 struct Options {
@@ -304,7 +304,7 @@ fn main() {
                 continue;
             }
             let (t, c) = (Instant::now(), cpu_seconds());
-            let a = obj_parse::parse(&text, |_| Ok(Default::default()))
+            let a = parse::parse(&text, |_| Ok(Default::default()))
                 .expect("the fast reader takes the benchmark mesh")
                 .expect("it loads");
             fast.push(t.elapsed().as_secs_f64());

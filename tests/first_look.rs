@@ -1,8 +1,8 @@
-//! A bare OBJ's first look (issue 14.4), measured on three models made here: a closed room with
-//! furniture (walls facing inwards, no MTL), the same room with a Blender-style MTL (`Ka 1`),
-//! and an outdoor model (the torus of assets/models, seen from outside). Each renders with a
-//! mean luminance in a readable band and few saturated pixels; the room's camera stands inside
-//! its bounds, the outdoor model's outside.
+//! A bare OBJ's first look, measured on three models made here: a closed room with furniture (walls
+//! facing inwards, no MTL), the same room with a Blender-style MTL (`Ka 1`), and an outdoor model
+//! (the torus of assets/models, seen from outside). Each renders with a mean luminance in a
+//! readable band and few saturated pixels; the room's camera stands inside its bounds, the outdoor
+//! model's outside.
 
 use std::ops::Range;
 use std::path::Path;
@@ -241,10 +241,10 @@ fn an_outdoor_model_is_framed_from_outside_and_readable() {
     assert_readable(&scene, "torus.obj", 0.03..0.6, 0.1);
 }
 
-// ---- Traits of real files (issue 14's "Done when"), each reproduced on a small generated
-// model: a room whose middle is furniture (Sweet Home 3D bedroom), walls without a ceiling
-// (a Blender kitchen), a box open on one side (the Cornell box), a z-up bust (a scanned
-// Nefertiti, a MeshLab bottle), MeshLab's `Tr 1`, and framing tight enough to read.
+// ---- Traits of real files, each reproduced on a small generated model: a room whose middle is
+// furniture (Sweet Home 3D bedroom), walls without a ceiling (a Blender kitchen), a box open on one
+// side (the Cornell box), a z-up bust (a scanned Nefertiti, a MeshLab bottle), MeshLab's `Tr 1`,
+// and framing tight enough to read.
 
 /// The 8 corners and 12 triangles of the box `lo..hi` appended to `out` (vertex numbers from
 /// `*base + 1`), facing inwards when `inward`; faces listed in `skip` (0 −x, 1 +x, 2 −y, 3 +y,
@@ -296,8 +296,8 @@ fn forward(scene: &Scene) -> Vec3 {
 
 #[test]
 fn a_room_whose_middle_is_a_bed_is_seen_from_inside_and_not_from_inside_the_bed() {
-    // The bounds' centre (0, 1.5, 0) is inside the (four-poster) bed: rays from there meet the bed's faces
-    // from behind, which the 14-ray test from the centre took for a statue.
+    // The bounds' centre (0, 1.5, 0) is inside the (four-poster) bed: rays from there meet the
+    // bed's faces from behind, which the 14-ray test from the centre took for a statue.
     let mut text = String::new();
     let mut base = 0;
     let (lo, hi) = (Vec3::new(-3.0, 0.0, -4.0), Vec3::new(3.0, 3.0, 4.0));

@@ -1,5 +1,5 @@
 //! Property-based fuzzing on stable Rust (proptest, seeded, deterministic) of the three ways
-//! input enters raytree (SPEC §9):
+//! input enters raytree (docs/reliability.md):
 //!
 //! - scene TOML: the built-in scenes and every fixture, mutated (bytes flipped, cut short,
 //!   numbers replaced by huge, tiny, NaN and infinite ones, values swapped between keys, lines
@@ -40,6 +40,7 @@ use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use raytree::scene::budget::MemoryLimit;
 use raytree::scene::builtin::{NAMES, scene_text};
 use raytree::scene::texture::decode_texture;
+use raytree::scene::toml::keys::{SECTIONS, SectionKeys};
 use raytree::scene::{load_scene_file, load_scene_str_with, load_scene_str_with_files};
 
 /// Cases per target in the short run.
@@ -208,58 +209,24 @@ const VALUES: &[&str] = &[
     "'''x'''",
 ];
 
-const KEYS: &[&str] = &[
-    "width",
-    "height",
-    "max_depth",
-    "samples",
-    "background",
-    "ambient_light",
-    "shading",
-    "position",
-    "look_at",
-    "up",
-    "fov_y",
-    "name",
-    "color",
-    "radius",
-    "ambient",
-    "diffuse",
-    "specular",
-    "shininess",
-    "reflectivity",
-    "transparency",
-    "ior",
-    "center",
-    "material",
-    "vertices",
-    "file",
-    "translate",
-    "rotate",
-    "scale",
-    "normals",
-    "crease_angle",
-    "radus",
-    "colour",
-    "x",
-    "\"quoted key\"",
-    "a.b",
-];
+/// Every key a scene file takes (the loader's own list, each key once), and some it does not.
+fn keys() -> Vec<&'static str> {
+    let mut keys: Vec<&'static str> = Vec::new();
+    for key in SECTIONS.iter().flat_map(|s| s.keys.iter().copied()) {
+        if !keys.contains(&key) {
+            keys.push(key);
+        }
+    }
+    keys.extend(["radus", "colour", "x", "\"quoted key\"", "a.b"]);
+    keys
+}
 
-const HEADERS: &[&str] = &[
-    "[render]",
-    "[camera]",
-    "[[light]]",
-    "[[material]]",
-    "[[sphere]]",
-    "[[triangle]]",
-    "[[mesh]]",
-    "[[render]]",
-    "[sphere]",
-    "[lights]",
-    "[",
-    "[[]]",
-];
+/// Every section header (the loader's own list), and some that are wrong.
+fn headers() -> Vec<String> {
+    let mut headers: Vec<String> = SECTIONS.iter().map(SectionKeys::header).collect();
+    headers.extend(["[[render]]", "[sphere]", "[lights]", "[", "[[]]"].map(String::from));
+    headers
+}
 
 #[derive(Clone, Debug)]
 enum Edit {
@@ -280,8 +247,8 @@ fn edit() -> impl Strategy<Value = Edit> {
         any::<i64>().prop_map(|i| i.to_string()),
     ];
     let line = prop_oneof![
-        4 => (proptest::sample::select(KEYS), any_value).prop_map(|(k, v)| format!("{k} = {v}")),
-        1 => proptest::sample::select(HEADERS).prop_map(str::to_string),
+        4 => (proptest::sample::select(keys()), any_value).prop_map(|(k, v)| format!("{k} = {v}")),
+        1 => proptest::sample::select(headers()),
         1 => "[ -~]{0,20}",
     ];
     prop_oneof![

@@ -1,5 +1,5 @@
 //! Public behaviour of `raytree::geometry`: the lecture's quiz, analytic sphere answers, and the
-//! stability rows S1, S2, S4, T1, T3, A1, A3 of `STABILITY.md` (each asserts where the naive
+//! stability rows S1, S2, S4, T1, T3, A1, A3 of docs/stability.md (each asserts where the naive
 //! method fails and that the robust one holds). Seeded, CPU-only, a second or two in release.
 
 use glam::Vec3;
@@ -150,7 +150,8 @@ fn s1_s2_robust_sphere_holds_far_away_and_lecture_fails() {
             c.max_point_err_ulp
         );
     }
-    // Lecture: fine nearby, broken from D/r = 1e4 on (STABILITY S1: >97% false hits there).
+    // Lecture: fine nearby, broken from D/r = 1e4 on (docs/stability.md, row S1: >97% false hits
+    // there).
     let c = sphere_cell(SphereMethod::Lecture, 3.0, N, &mut Pcg::new(7));
     assert_eq!((c.misses, c.false_hits), (0, 0), "lecture at D/r = 3");
     for d_over_r in [1e4, 1e5] {
@@ -230,7 +231,7 @@ fn t1_watertight_never_leaks_through_shared_edges() {
         }
     }
     eprintln!("T1 naive leaks [lecture, MT, -]: {naive_leaks:?} of {total}");
-    // The naive methods crack somewhere in the same sweep (STABILITY T1: 0.2–22%).
+    // The naive methods crack somewhere in the same sweep (docs/stability.md, row T1: 0.2–22%).
     assert!(
         naive_leaks[0] + naive_leaks[1] > 0,
         "expected lecture or Möller–Trumbore to leak; leaks {naive_leaks:?} of {total}"
@@ -304,8 +305,8 @@ fn a1_a3_error_bound_offset_never_self_intersects() {
             assert!(none(h), "triangle, {method:?}, scale {s}: {h:?}");
         }
     }
-    // The fixed 1e-4 is fine at scale 1 and shows acne from 1e3 on (STABILITY A1: 20% @1e3).
-    // On triangles the acne shows with Möller–Trumbore: the watertight test also rejects any
+    // The fixed 1e-4 is fine at scale 1 and shows acne from 1e3 on (docs/stability.md, row A1: 20%
+    // @1e3). On triangles the acne shows with Möller–Trumbore: the watertight test also rejects any
     // t within its own error bound of zero (pbrt-v4), which hides a too-small offset.
     let h = sphere_self_hits(OffsetMethod::Fixed, 1.0, 4.2, 2000, &mut rng);
     assert_eq!(h.acne, 0.0, "fixed offset at scale 1");
@@ -340,7 +341,8 @@ fn a1_contact_shadows_leak_only_with_large_offsets() {
             );
         }
     }
-    // Fixed 1e-4 jumps over a gap of 1e-6 at scale 1e-3 (STABILITY A1: 100% leak ≤ 1e-2).
+    // Fixed 1e-4 jumps over a gap of 1e-6 at scale 1e-3 (docs/stability.md, row A1: 100% leak ≤
+    // 1e-2).
     assert!(contact_leaks(OffsetMethod::Fixed, 1e-3, 1e-6, &mut rng));
     assert!(contact_leaks(
         OffsetMethod::NormalScaled,

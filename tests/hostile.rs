@@ -1,9 +1,9 @@
-//! Hostile input and faults (SPEC §9), as a user meets them: every file of the hostile corpus
-//! (`tests/fixtures/hostile`) gives one sentence naming the file, the place and the field, or
-//! loads with a warning; `raytree render` on each exits non-zero with exactly one stderr line
-//! and writes nothing; sizes are refused by their memory estimate before anything is
-//! allocated; recursion and trees stay bounded; a panicking worker is reported; failed writes
-//! leave no file behind.
+//! Hostile input and faults (docs/reliability.md), as a user meets them: every file of the hostile
+//! corpus (`tests/fixtures/hostile`) gives one sentence naming the file, the place and the field,
+//! or loads with a warning; `raytree render` on each exits non-zero with exactly one stderr line
+//! and writes nothing; sizes are refused by their memory estimate before anything is allocated;
+//! recursion and trees stay bounded; a panicking worker is reported; failed writes leave no file
+//! behind.
 //!
 //! Update the corpus snapshot after a deliberate change (look at it first):
 //! `INSTA_UPDATE=always cargo test --release --test hostile`

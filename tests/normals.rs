@@ -1,6 +1,7 @@
-//! Shading normals and textures from OBJ files (SPEC §3b): `vn` interpolated at the hit, the
-//! `[[mesh]]` keys `normals` and `crease_angle` (held to scene::rules, saved and loaded back),
-//! `vt` and `map_Kd` textures, and the sentences for broken `vn`, `vt` and texture files.
+//! Shading normals and textures from OBJ files (docs/design.md, "Scene files"): `vn` interpolated
+//! at the hit, the `[[mesh]]` keys `normals` and `crease_angle` (held to scene::rules, saved and
+//! loaded back), `vt` and `map_Kd` textures, and the sentences for broken `vn`, `vt` and texture
+//! files.
 
 use std::sync::Arc;
 

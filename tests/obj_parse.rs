@@ -1,4 +1,4 @@
-//! raytree's parallel OBJ reader (`scene::obj_parse`) gives exactly what tobj gives, on every
+//! raytree's parallel OBJ reader (`scene::obj::parse`) gives exactly what tobj gives, on every
 //! OBJ of the fixtures and assets, on hostile lines, on generated files big enough to be read in
 //! several chunks, and on what it must leave to tobj (it gives up rather than differ). The
 //! random OBJs of `tests/fuzz.rs` check the same property.
@@ -295,7 +295,9 @@ fn scenes_load_the_same_through_either_reader() {
         // With a negative index at the end, the whole file goes to tobj; the index adds one face.
         let slow_text = format!("{text}f -1 -2 -3\n");
         std::fs::write(&path, &slow_text).expect("write");
-        assert!(raytree::scene::obj_parse::parse(&slow_text, |_| Ok(Default::default())).is_none());
+        assert!(
+            raytree::scene::obj::parse::parse(&slow_text, |_| Ok(Default::default())).is_none()
+        );
         let slow = raytree::scene::load_scene_file(&path).expect("loads");
         assert!(fast.triangles.len() > 10_000);
         assert_eq!(
@@ -322,7 +324,7 @@ fn scenes_load_the_same_through_either_reader() {
 /// in one pass over chunks: the same counts as line by line, on a file read in several chunks.
 #[test]
 fn the_loader_pass_counts_what_the_budget_and_warnings_need() {
-    use raytree::scene::obj_parse::{Polylines, scan};
+    use raytree::scene::obj::parse::{Polylines, scan};
     let text = big_file(5).replacen("\nf ", "\nl 1 1\n\t usemtl  odd name \nf ", 40);
     let scanned = scan(&text, Polylines::Skip).expect("the fast reader takes it");
     let facts = scanned.facts().clone();
@@ -335,7 +337,7 @@ fn the_loader_pass_counts_what_the_budget_and_warnings_need() {
     let as_faces = scan(&text, Polylines::AsFaces).expect("takes it");
     assert_eq!(as_faces.facts().polylines, 0);
     assert_eq!(as_faces.facts().triangles, facts.triangles);
-    let corners = |s: raytree::scene::obj_parse::Scanned| -> usize {
+    let corners = |s: raytree::scene::obj::parse::Scanned| -> usize {
         let (models, _) = s
             .assemble(|_| Ok(Default::default()))
             .expect("assembles")
@@ -384,11 +386,11 @@ fn faces_with_mixed_corners_are_flagged_alike_on_either_path() {
     }
     let path = dir.path().join("m.obj");
     std::fs::write(&path, &text).expect("write");
-    assert!(raytree::scene::obj_parse::parse(&text, |_| Ok(Default::default())).is_some());
+    assert!(raytree::scene::obj::parse::parse(&text, |_| Ok(Default::default())).is_some());
     let fast = raytree::scene::load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
     // A negative index sends the whole file to tobj; its face adds one triangle, flat.
     let slow_text = format!("{text}f -1 -2 -3\n");
-    assert!(raytree::scene::obj_parse::parse(&slow_text, |_| Ok(Default::default())).is_none());
+    assert!(raytree::scene::obj::parse::parse(&slow_text, |_| Ok(Default::default())).is_none());
     std::fs::write(&path, &slow_text).expect("write");
     let slow = raytree::scene::load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
 

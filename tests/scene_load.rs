@@ -1,6 +1,6 @@
-//! Scene loading as the rest of raytree sees it (SPEC §3): defaults, the value forms, the
-//! errors and their places, meshes and their MTL materials, bare OBJ files, the built-in
-//! scenes and the TOML round trip.
+//! Scene loading as the rest of raytree sees it (docs/design.md, "Scene files"): defaults, the
+//! value forms, the errors and their places, meshes and their MTL materials, bare OBJ files, the
+//! built-in scenes and the TOML round trip.
 
 use std::path::Path;
 
@@ -471,7 +471,7 @@ fn bare_obj_is_framed_and_lit() {
     let path = Path::new("tests/fixtures/models/materials.obj");
     let scene = load_scene_file(path).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(scene.source.as_deref(), Some(path));
-    // A low ambient light, so that `Ka 1` does not wash the model out (issue 14.4).
+    // A low ambient light, so that `Ka 1` does not wash the model out.
     assert_eq!(
         scene.render,
         RenderParams {
@@ -497,8 +497,8 @@ fn bare_obj_is_framed_and_lit() {
         from_center.z > 0.0 && from_center.y > 0.0,
         "+z side, above: {from_center}"
     );
-    // The whole model is in view, and fills it (issue 14's first looks: the bounding
-    // sphere left long models a third of the image wide).
+    // The whole model is in view, and fills it (framed on the bounding sphere, a long model
+    // would be a third of the image wide).
     let forward = -from_center.normalize();
     let right = forward.cross(c.up).normalize();
     let up = right.cross(forward);

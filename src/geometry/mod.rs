@@ -1,8 +1,11 @@
 //! Rays, ray/primitive intersection methods and ray-origin offsets (lecture: "Ray/Surface
 //! Intersection"; robust variants from Ray Tracing Gems ch. 6–7, Woop–Benthin–Wald 2013 and
-//! pbrt-v4). Every method is selectable so the speed/accuracy sweeps can compare them.
+//! pbrt-v4). Every method is selectable so the speed/accuracy sweeps can compare them. Also the
+//! shading normals of triangles ([`shading`]) and the vertex normals of smooth meshes
+//! ([`normals`]).
 
 pub mod lanes;
+pub mod normals;
 pub mod offset;
 pub mod shading;
 pub mod sphere;
@@ -11,6 +14,7 @@ pub mod triangle;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+pub use normals::smooth_normals;
 pub use offset::{OffsetMethod, offset_ray_origin};
 pub use shading::{ShadingNormals, interpolate_normal, keep_side, terminator_origin};
 pub use sphere::{SphereMethod, intersect_sphere, sphere_hit_point};
@@ -42,7 +46,7 @@ pub struct Methods {
     pub sphere: SphereMethod,
     pub triangle: TriangleMethod,
     pub offset: OffsetMethod,
-    /// Where shading and geometric normals disagree (STABILITY N1–N3).
+    /// Where shading and geometric normals disagree (docs/stability.md, rows N1–N3).
     #[serde(default)]
     pub shading_normals: ShadingNormals,
 }

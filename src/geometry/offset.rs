@@ -2,13 +2,13 @@
 //! hit the surface it leaves (Ray Tracing Gems ch. 6; pbrt-v4 error bounds, "Robust Spawned
 //! Ray Origins").
 //!
-//! Where the naive offsets fail (STABILITY A1–A3): a fixed distance is below the spacing of
-//! `f32` values once coordinates reach about `1e3`, so the origin rounds back onto the surface
-//! and shadow rays hit it (acne); and it is larger than the whole scene at small scales, so
-//! shadow rays jump over nearby occluders (light leaks at contacts). Scaling by the magnitude
-//! of the point fixes the first but keeps a floor of 1. The error-bound offset moves the origin
-//! exactly as far as the hit point's computed error along the normal, then one `f32` step
-//! further, so it is outside the surface's uncertainty at every scale and no further.
+//! Where the naive offsets fail (docs/stability.md, rows A1–A3): a fixed distance is below the
+//! spacing of `f32` values once coordinates reach about `1e3`, so the origin rounds back onto the
+//! surface and shadow rays hit it (acne); and it is larger than the whole scene at small scales, so
+//! shadow rays jump over nearby occluders (light leaks at contacts). Scaling by the magnitude of
+//! the point fixes the first but keeps a floor of 1. The error-bound offset moves the origin
+//! exactly as far as the hit point's computed error along the normal, then one `f32` step further,
+//! so it is outside the surface's uncertainty at every scale and no further.
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 

@@ -1,4 +1,4 @@
-//! Shading normals on flat triangles (SPEC §3b, STABILITY N1–N3): the normal interpolated from
+//! Shading normals on flat triangles (docs/stability.md, rows N1–N3): the normal interpolated from
 //! vertex normals with the hit's barycentric coordinates, and the three places where it and the
 //! triangle's own (geometric) normal disagree.
 //!
@@ -20,7 +20,8 @@ use serde::{Deserialize, Serialize};
 
 use super::gamma;
 
-/// How shading normals are used where they disagree with the geometric normal (STABILITY N1–N3).
+/// How shading normals are used where they disagree with the geometric normal
+/// (docs/stability.md, rows N1–N3).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ShadingNormals {
@@ -43,7 +44,8 @@ crate::choice::choice!(ShadingNormals {
 /// the triangle's plane for a shadow ray from it to a light *behind* the plane to be trusted:
 /// `γ(64)`, about 9× the error of the `t` at which a grazing ray meets a neighbouring triangle
 /// (`≈ γ(7)·|P| / |N·L|` against the true `lift / |N·L|`). Below it, the light counts as behind
-/// the surface (STABILITY N3: a 0.5° grazing light otherwise leaked through a flat wall).
+/// the surface (docs/stability.md, row N3: a 0.5° grazing light otherwise leaked through a
+/// flat wall).
 pub const MIN_LIFT: f32 = 64.0 * f32::EPSILON * 0.5 / (1.0 - 64.0 * f32::EPSILON * 0.5);
 
 /// The unit normal interpolated from vertex normals `n` with barycentric weights `b`, or `None`
@@ -55,14 +57,14 @@ pub fn interpolate_normal(n: &[Vec3; 3], b: [f32; 3]) -> Option<Vec3> {
     (s != Vec3::ZERO).then_some(s)
 }
 
-/// Hanika (2021): the hit point `p` (barycentric weights `b` of triangle `v`) moved onto the
-/// smooth surface described by the unit vertex normals `n`, all turned to the side the ray came
-/// from, and `ng` the geometric normal on that side. Each vertex contributes `p` projected onto its tangent plane when `p` lies below that
-/// plane (and `p` itself otherwise), weighted by `b`. Returns the point and its absolute error
-/// bound per axis and whether it lies clearly above the triangle's plane (by at least
-/// [`MIN_LIFT`] of the coordinates' magnitude: a ray from it that crosses the plane at a
-/// grazing angle then meets the plane where `f32` can tell; below that it is as good as on the
-/// flat triangle). `None` when the point does not move outside (where the flat triangle
+/// Hanika (2021): the hit point `p` (barycentric weights `b` of triangle `v`) moved onto the smooth
+/// surface described by the unit vertex normals `n`, all turned to the side the ray came from, and
+/// `ng` the geometric normal on that side. Each vertex contributes `p` projected onto its tangent
+/// plane when `p` lies below that plane (and `p` itself otherwise), weighted by `b`. Returns the
+/// point and its absolute error bound per axis and whether it lies clearly above the triangle's
+/// plane (by at least [`MIN_LIFT`] of the coordinates' magnitude: a ray from it that crosses the
+/// plane at a grazing angle then meets the plane where `f32` can tell; below that it is as good as
+/// on the flat triangle). `None` when the point does not move outside (where the flat triangle
 /// already is the surface, or bulges above it), so the flat point is used.
 #[inline]
 pub fn terminator_origin(

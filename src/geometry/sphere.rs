@@ -3,13 +3,13 @@
 //! Improvements for Ray/Sphere Intersection"), plus the hit point with an error bound
 //! (pbrt-v4, "Bounding Intersection Point Error").
 //!
-//! Where the lecture's formula fails (STABILITY S1, S2): `(u·ΔP)² − |ΔP|² + r²` subtracts two
-//! numbers of size `D²` (D = distance from the ray origin to the centre) to find one of size
-//! `r²`, so once `D/r` passes about `1e3…1e4` in `f32` the discriminant is rounding noise: rays
-//! that miss are reported as hits and rays that hit are lost. The robust form takes the
+//! Where the lecture's formula fails (docs/stability.md, rows S1, S2): `(u·ΔP)² − |ΔP|² + r²`
+//! subtracts two numbers of size `D²` (D = distance from the ray origin to the centre) to find one
+//! of size `r²`, so once `D/r` passes about `1e3…1e4` in `f32` the discriminant is rounding noise:
+//! rays that miss are reported as hits and rays that hit are lost. The robust form takes the
 //! discriminant as `r² − |f + b·u|²` (Hearn–Baker: the squared distance from the centre to the
-//! ray's closest point, computed without cancellation) and picks the root pair without
-//! subtracting nearly equal numbers.
+//! ray's closest point, computed without cancellation) and picks the root pair without subtracting
+//! nearly equal numbers.
 use glam::{DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -147,8 +147,8 @@ pub fn sphere_hit_point(
         SphereMethod::Robust => {
             // Re-projection in f64: `P − C` of two f32 is exact there, and the only rounding
             // left is the final one to f32 (half an ulp per axis), so the point is within
-            // about one ulp of the sphere (STABILITY S2 target: 2 ulp). Once per shading
-            // point, not per intersection test, so the cost does not matter.
+            // about one ulp of the sphere (the target of docs/stability.md, row S2, is 2 ulp).
+            // Once per shading point, not per intersection test, so the cost does not matter.
             let c = DVec3::from(center);
             let v = DVec3::from(ray.at(t)) - c;
             let len = v.length();

@@ -6,13 +6,13 @@
 //! (vertex 0 has `1 − b1 − b2`). Each returns a `t` that does not depend on `t_min`/`t_max`
 //! except through the final range check, so accelerators that shrink `t_max` see the same hit.
 //!
-//! Where they fail (STABILITY T1, T3): the lecture's method and Möller–Trumbore decide "inside"
-//! per triangle with independently rounded quantities, so a ray through a shared edge or
-//! vertex can be outside both neighbours (a leak, a crack in the image). Möller–Trumbore also
-//! rejects `|det| <` [`MT_DET_EPSILON`], which is an absolute threshold on a quantity that scales
-//! with the square of the triangle's size: triangles with edges below about `1e-4` are missed
-//! altogether. The watertight test shears the triangle into a ray-aligned space where the three
-//! edge functions of a shared edge are computed from the same numbers in both triangles, so
+//! Where they fail (docs/stability.md, rows T1, T3): the lecture's method and Möller–Trumbore
+//! decide "inside" per triangle with independently rounded quantities, so a ray through a shared
+//! edge or vertex can be outside both neighbours (a leak, a crack in the image). Möller–Trumbore
+//! also rejects `|det| <` [`MT_DET_EPSILON`], which is an absolute threshold on a quantity that
+//! scales with the square of the triangle's size: triangles with edges below about `1e-4` are
+//! missed altogether. The watertight test shears the triangle into a ray-aligned space where the
+//! three edge functions of a shared edge are computed from the same numbers in both triangles, so
 //! their signs agree exactly and no ray slips between; it rejects only `det == 0`.
 use glam::{DVec3, Vec3, Vec3A, Vec3Swizzles, Vec4};
 use serde::{Deserialize, Serialize};
@@ -51,8 +51,9 @@ pub struct TriHit {
 /// implementations (the 1997 paper uses `1e-6`; `1e-8` is the usual `f32` choice).
 ///
 /// `det` has units of length² (for a unit direction), so this absolute threshold silently drops
-/// every triangle whose edges are shorter than about `1e-4` (STABILITY T3), and needle triangles
-/// seen edge-on. Kept on purpose: it is the method as taught and the sweeps show its failure.
+/// every triangle whose edges are shorter than about `1e-4` (docs/stability.md, row T3), and needle
+/// triangles seen edge-on. Kept on purpose: it is the method as taught and the sweeps show its
+/// failure.
 pub const MT_DET_EPSILON: f32 = 1e-8;
 
 /// Nearest hit in `(t_min, t_max)` of the ray with triangle `v` (both faces), if any.

@@ -1,10 +1,10 @@
-//! The memory budget (SPEC §9): sizes a file may ask for are checked against an estimate of the
-//! memory they need before anything of that size is allocated, so a hostile or mistyped scene
-//! gets a sentence instead of an out-of-memory kill. The loader (meshes), the batch render and
-//! the viewer's buffers all ask this one budget.
+//! The memory budget (docs/reliability.md): sizes a file may ask for are checked against an
+//! estimate of the memory they need before anything of that size is allocated, so a hostile or
+//! mistyped scene gets a sentence instead of an out-of-memory kill. The loader (meshes), the batch
+//! render and the viewer's buffers all ask this one budget.
 
-/// Peak bytes per pixel of `render::render` and an export: the tile sums of every tile held until the
-/// image is assembled (12), the image (12), and the encoder's copy (3 for PNG, about 12 for EXR
+/// Peak bytes per pixel of `render::render` and an export: the tile sums of every tile held until
+/// the image is assembled (12), the image (12), and the encoder's copy (3 for PNG, about 12 for EXR
 /// written to memory first), rounded up.
 pub const BATCH_BYTES_PER_PIXEL: u64 = 40;
 

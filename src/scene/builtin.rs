@@ -3,13 +3,13 @@
 //! embedded text instead of the disk. `default` is Whitted's classic picture (mirror and glass
 //! spheres over a checkerboard), `quiz` is the lecture's closing quiz, `glass` shows refraction
 //! and total internal reflection, `box` is a closed room with a mirror wall, `smooth` a smooth
-//! textured ball beside a faceted copy of itself (SPEC §3b). `acne` and `cracks`
-//! are made to show two failures of the naive methods (`--offset fixed`; `--triangle
+//! textured ball beside a faceted copy of itself (`normals = "smooth"` and a `map_Kd`). `acne`
+//! and `cracks` are made to show two failures of the naive methods (`--offset fixed`; `--triangle
 //! moller-trumbore` or `lecture`) that the defaults do not have.
 
 use super::Scene;
 use super::diag::{SceneError, list_and};
-use super::load::load_scene_str_with_files;
+use super::toml::load_scene_str_with_files;
 
 /// The built-in scenes, in the order a menu should show them.
 pub const NAMES: &[&str] = &[

@@ -1,6 +1,6 @@
-//! The camera, in one place: its data (SPEC §2), its frame for an image size, the primary ray
-//! of pixel (x, y) and sample s that the tiles and the ray tree both trace, framing of bounds,
-//! and the orbit / pan / zoom moves of the viewer.
+//! The camera, in one place: its data (docs/design.md, "Conventions"), its frame for an image size,
+//! the primary ray of pixel (x, y) and sample s that the tiles and the ray tree both trace, framing
+//! of bounds, and the orbit / pan / zoom moves of the viewer.
 //!
 //! Pixel (x, y), y = 0 at the top, looks through
 //! `((2(x+0.5)/W − 1)·a·tan(fov_y/2), (1 − 2(y+0.5)/H)·tan(fov_y/2), −1)` in camera space
@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use super::sampling::sample_offset;
 use crate::geometry::Ray;
 
-/// A pinhole camera; SPEC §2 gives the pixel-to-ray mapping.
+/// A pinhole camera; the module doc gives the pixel-to-ray mapping.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Camera {
     pub position: Vec3,
@@ -157,8 +157,8 @@ pub fn primary_ray(frame: &CameraFrame, x: u32, y: u32, sample: u32) -> Ray {
 pub const FRAME_MARGIN: f32 = 1.1;
 
 impl Camera {
-    /// This camera moved along the unit vector `direction` (from the target towards the eye) so that the
-    /// bounding sphere of `lo..hi` fills the vertical field of view with [`FRAME_MARGIN`],
+    /// This camera moved along the unit vector `direction` (from the target towards the eye) so
+    /// that the bounding sphere of `lo..hi` fills the vertical field of view with [`FRAME_MARGIN`],
     /// aimed at its centre; `up` and `fov_y_deg` are kept.
     pub fn framing(&self, lo: Vec3, hi: Vec3, direction: Vec3) -> Camera {
         let center = 0.5 * (lo + hi);

@@ -5,9 +5,9 @@
 use std::path::{Path, PathBuf};
 
 use super::diag::{SceneError, short_path};
-use super::load::load_scene_str_with_files;
 use super::rules::{MAX_MESH_FILE_BYTES, MAX_SCENE_FILE_BYTES};
 use super::texture::fs_bytes_resolver;
+use super::toml::load_scene_str_with_files;
 use super::{Scene, builtin, first_look};
 
 /// A scene file, OBJ, or built-in scene name, as given on the command line or to the viewer:

@@ -1,15 +1,16 @@
-//! The first look of a bare `.obj` (SPEC §3b): one object with its MTL materials, a low
-//! ambient light (Blender's `Ka 1` read as `Kd`), a key light and a headlight, and a camera
-//! framed on the bounds, or standing inside them when the model is a room.
+//! The first look of a bare `.obj` (docs/design.md, "Scene files"): one object with its MTL
+//! materials, a low ambient light (Blender's `Ka 1` read as `Kd`), a key light and a headlight, and
+//! a camera framed on the bounds, or standing inside them when the model is a room.
 
 use glam::Vec3;
 
 use super::diag::{SceneError, list_and, short};
 use super::obj::{MeshPlacement, MeshRequest, add_mesh, file_stem};
+use super::resolve::{ResolveBytesFn, ResolveFn};
 use super::rules::check_camera;
 use super::{
-    Camera, DEFAULT_CREASE_ANGLE_DEG, Light, NormalsMode, Object, ObjectId, ObjectSource,
-    ResolveBytesFn, ResolveFn, Scene, Triangle,
+    Camera, DEFAULT_CREASE_ANGLE_DEG, Light, NormalsMode, Object, ObjectId, ObjectSource, Scene,
+    Triangle,
 };
 
 /// A bare `.obj` as a scene: one object, its MTL materials, the default render settings, a
@@ -59,7 +60,7 @@ pub(crate) fn load_obj_scene(
             "{label}: the OBJ has no triangles to show (it has no faces, or only degenerate ones)."
         )));
     }
-    // A readable first look (issue 14.4): a low ambient light, so that Blender's `Ka 1` does
+    // A readable first look: a low ambient light, so that Blender's `Ka 1` does
     // not wash everything out, and such an ambient read as the diffuse colour.
     scene.render.ambient_light = Vec3::splat(BARE_OBJ_AMBIENT);
     let mut washed = Vec::new();
@@ -103,8 +104,8 @@ pub(crate) fn load_obj_scene(
             }
         ));
     }
-    // `Ns 0` with a `Ks` is read where every MTL material is ([`super::obj::material_from_mtl`]),
-    // for a bare OBJ and a scene's `[[mesh]]` alike.
+    // `Ns 0` with a `Ks` is read where every MTL material is (`material_from_mtl` in
+    // src/scene/obj/mtl.rs), for a bare OBJ and a scene's `[[mesh]]` alike.
     let (lo, hi) = scene.bounds().unwrap_or((Vec3::ZERO, Vec3::ZERO));
     let mut up = up_axis(&scene.triangles, lo, hi);
     if up == Vec3::Z {
@@ -426,8 +427,9 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
     }
 }
 
-/// The camera in front of the model (from `front`, raised by `elevation`: 0.3 is about 17°), aimed at the bounds'
-/// centre, as close as keeps every vertex inside the image with a 5 % margin on each side.
+/// The camera in front of the model (from `front`, raised by `elevation`: 0.3 is about 17°), aimed
+/// at the bounds' centre, as close as keeps every vertex inside the image with a 5 % margin on each
+/// side.
 fn frame_outside(
     triangles: &[Triangle],
     center: Vec3,

@@ -1,7 +1,9 @@
-//! Plain scene data with typed ids: camera, lights, Phong materials, spheres (analytic) and
-//! triangles (from `[[triangle]]` and meshes). Loading lives in [`load`] (strict TOML with file,
-//! line and column in every error), [`obj`] (OBJ/MTL through `tobj`) and [`builtin`] (scenes
-//! compiled into the binary). SPEC §3 is the contract for the file format.
+//! Plain scene data with typed ids: camera, lights, Phong materials, spheres (analytic),
+//! triangles (from `[[triangle]]` and meshes) with their meshes' normals and texture
+//! coordinates, and textures. Nothing here reads a file: scene files are read by [`toml`], OBJ
+//! meshes and their MTL materials by [`obj`], textures decoded by [`texture`], files found by
+//! [`files`] and [`resolve`]; [`builtin`] holds the scenes compiled into the binary and
+//! [`save`] writes a scene back as a file. The file format: docs/design.md, "Scene files".
 
 pub mod budget;
 pub mod builtin;
@@ -9,16 +11,14 @@ pub mod camera;
 pub mod diag;
 pub mod files;
 pub mod first_look;
-pub mod load;
 pub mod obj;
-mod obj_corners;
-pub mod obj_parse;
 pub mod procedural;
+pub mod resolve;
 pub mod rules;
 pub mod sampling;
 pub mod save;
 pub mod texture;
-pub mod toml_reader;
+pub mod toml;
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -26,24 +26,11 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
+pub use self::toml::{load_scene_str_with, load_scene_str_with_files};
 pub use builtin::load_builtin;
 pub use camera::{Camera, CameraFrame, primary_ray, primary_rays};
 pub use diag::SceneError;
 pub use files::{fs_resolver, load_scene_file, load_scene_str, open_scene_arg};
-pub use load::{load_scene_str_with, load_scene_str_with_files};
-
-/// Returns the text of a mesh or material library, given its path as written in the scene
-/// (relative to the scene file's folder), or the reason it cannot, as a short phrase. Built-in
-/// scenes resolve from strings compiled into the binary, files from the scene's folder.
-pub type ResolveFn<'a> = dyn Fn(&str) -> Result<String, String> + 'a;
-
-/// As [`ResolveFn`], for binary files (textures).
-pub type ResolveBytesFn<'a> = dyn Fn(&str) -> Result<Vec<u8>, String> + 'a;
-
-/// The binary resolver of scenes loaded without one: every texture is missing (a warning).
-pub fn no_binary_files(path: &str) -> Result<Vec<u8>, String> {
-    Err(format!("{path}: textures are not read for this scene"))
-}
 pub use save::scene_to_toml;
 
 /// Index into [`Scene::materials`].
@@ -54,7 +41,7 @@ pub struct MaterialId(pub u32);
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct ObjectId(pub u32);
 
-/// The local illumination model of SPEC §1.
+/// The local illumination model (docs/design.md, "The model").
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Shading {
@@ -110,7 +97,7 @@ pub struct Light {
     pub position: Vec3,
     pub color: Vec3,
     pub radius: f32,
-    /// A headlight (SPEC §3b, `follow_camera = true`): it stands at the render camera's eye
+    /// A headlight (`follow_camera = true`): it stands at the render camera's eye
     /// wherever the camera goes; [`Scene::place_lights`] sets its `position`. Always a point
     /// light (radius 0): a ball around the eye would swallow every camera ray.
     #[serde(default)]
@@ -219,7 +206,7 @@ impl Texture {
     }
 }
 
-/// Where a mesh's shading normals come from (SPEC §3b, `[[mesh]]` `normals`).
+/// Where a mesh's shading normals come from (`[[mesh]]` `normals`; docs/design.md, "Scene files").
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum NormalsMode {
@@ -368,10 +355,10 @@ impl Scene {
         MaterialId(self.materials.len() as u32 - 1)
     }
 
-    /// THE rule of lights that follow the camera (SPEC §3b): each stands at the render
-    /// camera's eye. Whatever sets the camera (the loader, `raytree render --eye`, a turntable
-    /// frame, the viewer before each render) calls this, so the image, its tiles, the ray trees
-    /// and the scene view all see the light at the same place. Idempotent; other lights stay.
+    /// THE rule of lights that follow the camera (`follow_camera = true`): each stands at the
+    /// render camera's eye. Whatever sets the camera (the loader, `raytree render --eye`, a
+    /// turntable frame, the viewer before each render) calls this, so the image, its tiles, the ray
+    /// trees and the scene view all see the light at the same place. Idempotent; other lights stay.
     pub fn place_lights(&mut self) {
         let eye = self.camera.position;
         for light in self.lights.iter_mut().filter(|l| l.follow_camera) {

@@ -1,7 +1,7 @@
-//! Writing a [`Scene`] back as a SPEC §3 scene file. Everything is written explicitly (every
-//! render and camera field, every light, material and object with its name), so the file loads
-//! back to an equal scene: meshes as their `[[mesh]]` entry (file and placement, not their
-//! triangles), `[[triangle]]` objects as triangles, and every material, including those that
+//! Writing a [`Scene`] back as a scene file (docs/design.md, "Scene files"). Everything is written
+//! explicitly (every render and camera field, every light, material and object with its name), so
+//! the file loads back to an equal scene: meshes as their `[[mesh]]` entry (file and placement, not
+//! their triangles), `[[triangle]]` objects as triangles, and every material, including those that
 //! came from an MTL (`<mesh>/<mtl name>`): a `[[material]]` of that name overrides the MTL on
 //! loading, so materials edited in the viewer survive a save.
 
@@ -15,7 +15,7 @@ use crate::choice::Choice;
 /// The scene as TOML. Mesh `file` paths are written as they were loaded (relative to the
 /// original scene file), so save next to it or adjust them.
 pub fn scene_to_toml(scene: &Scene) -> String {
-    let mut out = String::from("# raytree scene (SPEC §3)\n\n");
+    let mut out = String::from("# raytree scene (docs/design.md, \"Scene files\")\n\n");
     let r = &scene.render;
     out += "[render]\n";
     line(&mut out, "width", r.width);

@@ -1,6 +1,6 @@
-//! Image textures for MTL `map_Kd` and `map_Ka` (SPEC §3b): PNG and JPEG through the `image`
-//! crate, decoded once from sRGB to linear RGB, checked against the memory budget from the
-//! image's header before any texel is decoded. Sampling (bilinear, wrapping) is
+//! Image textures for MTL `map_Kd` and `map_Ka` (docs/design.md, "Scene files"): PNG and JPEG
+//! through the `image` crate, decoded once from sRGB to linear RGB, checked against the memory
+//! budget from the image's header before any texel is decoded. Sampling (bilinear, wrapping) is
 //! [`super::Texture::sample`].
 
 use std::io::Cursor;

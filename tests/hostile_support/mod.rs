@@ -1,6 +1,6 @@
 //! What the hostile-input tests (`tests/hostile.rs`, `tests/fuzz.rs`) check of every scene the
-//! loader accepts and every error it gives: the invariants of `Scene` (SPEC §3, §9) and the
-//! shape of an error (one line, naming the file).
+//! loader accepts and every error it gives: the invariants of `Scene` (docs/design.md, "Scene
+//! files"; docs/reliability.md) and the shape of an error (one line, naming the file).
 
 #![allow(dead_code)] // each test crate uses its own part
 
@@ -105,7 +105,8 @@ fn ensure(ok: bool, rule: &str) -> Result<(), String> {
 
 /// `message` with each "more than the memory limit of N (source)" spelled the same on every
 /// machine: the default limit is three quarters of the machine's memory, so its figure and its
-/// source vary (SPEC §9); what a test checks is the estimate and that the limit refused it.
+/// source vary (docs/reliability.md); what a test checks is the estimate and that the limit refused
+/// it.
 pub fn same_on_every_machine(message: &str) -> String {
     const LIMIT: &str = "more than the memory limit of ";
     let mut out = String::with_capacity(message.len());

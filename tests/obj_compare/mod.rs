@@ -112,8 +112,8 @@ pub fn without_polylines(text: &str) -> String {
 /// What the loader's single pass must count, counted line by line here: `v`, `vt`, `vn`,
 /// triangles of `f` (one for a face of fewer than three corners), `l` lines, and the names of
 /// `usemtl` followed by a space or tab.
-pub fn facts_by_lines(text: &str) -> raytree::scene::obj_parse::Facts {
-    let mut f = raytree::scene::obj_parse::Facts::default();
+pub fn facts_by_lines(text: &str) -> raytree::scene::obj::parse::Facts {
+    let mut f = raytree::scene::obj::parse::Facts::default();
     for line in text.lines() {
         let mut words = line.split_whitespace();
         match words.next() {
@@ -138,7 +138,7 @@ pub fn facts_by_lines(text: &str) -> raytree::scene::obj_parse::Facts {
 /// takes the text, its facts are the line-by-line counts and its models what tobj reads from
 /// the text with its polylines commented out. Returns whether it took the text.
 pub fn check_loader_pass(text: &str, mtl: &dyn Fn(&Path) -> tobj::MTLLoadResult) -> bool {
-    use raytree::scene::obj_parse::{Polylines, scan};
+    use raytree::scene::obj::parse::{Polylines, scan};
     let scanned = catch_unwind(AssertUnwindSafe(|| scan(text, Polylines::Skip)))
         .unwrap_or_else(|_| panic!("the fast reader's scan panicked on {text:?}"));
     let Some(scanned) = scanned else {
@@ -175,7 +175,7 @@ pub fn check_loader_pass(text: &str, mtl: &dyn Fn(&Path) -> tobj::MTLLoadResult)
 /// [`check`] for the reader as tobj reads (polylines as faces).
 pub fn check_tobj_pass(text: &str, mtl: &dyn Fn(&Path) -> tobj::MTLLoadResult) -> bool {
     let fast = catch_unwind(AssertUnwindSafe(|| {
-        raytree::scene::obj_parse::parse(text, mtl)
+        raytree::scene::obj::parse::parse(text, mtl)
     }))
     .unwrap_or_else(|_| panic!("the fast reader panicked on {text:?}"));
     let slow = catch_unwind(AssertUnwindSafe(|| {

@@ -1,26 +1,29 @@
-//! The scene builder (SPEC §3): the file format's sections and keys, their defaults, object and
-//! material names, meshes placed and loaded, in the order the file gives them. Values are read
-//! by [`super::toml_reader`] and held to [`super::rules`], so every error names the file, line,
-//! column and field; the hot loop never validates anything.
+//! The scene builder: a scene file's sections read in the order the file gives them, objects
+//! named and numbered, materials referred to by name, meshes placed and loaded. Values are read
+//! by [`super::reader`] and held to [`crate::scene::rules`], so every error names the file,
+//! line, column and field; the hot loop never validates anything.
 //!
 //! Mesh files are read through a resolver ([`ResolveFn`]) so that built-in scenes can take
 //! their OBJ and MTL text from strings compiled into the binary.
 
 use std::collections::HashMap;
-use std::ops::Range;
 
 use glam::Vec3;
 use toml::de::{DeTable, DeValue};
 
-use super::diag::{SceneError, Src, list_and, short, short_path, suggest};
-use super::obj::{self, MeshPlacement};
-use super::rules;
-use super::toml_reader::{Section, describe, syntax_error};
-use super::{
-    Camera, Light, Material, MaterialId, NormalsMode, Object, ObjectId, ObjectSource, RenderParams,
-    ResolveBytesFn, ResolveFn, Scene, Shading, Sphere, Triangle,
+use super::keys::{
+    CAMERA_KEYS, LIGHT_KEYS, MATERIAL_KEYS, MESH_KEYS, RENDER_KEYS, SPHERE_KEYS, TRIANGLE_KEYS,
+    check_sections,
 };
-use crate::choice::Choice;
+use super::names::unique_names;
+use super::reader::{Section, syntax_error};
+use super::sections::{choice, parse_camera, parse_light, parse_material, parse_render};
+use crate::scene::diag::{SceneError, Src, list_and, short, short_path, suggest};
+use crate::scene::obj::{self, MeshPlacement};
+use crate::scene::resolve::{ResolveBytesFn, ResolveFn, no_binary_files};
+use crate::scene::{
+    MaterialId, NormalsMode, Object, ObjectId, ObjectSource, Scene, Sphere, Triangle, rules,
+};
 
 /// Parses scene TOML, reading meshes and material libraries through `resolve` (textures are
 /// not read: each is a missing-texture warning).
@@ -29,7 +32,7 @@ pub fn load_scene_str_with(
     name: &str,
     resolve: &ResolveFn<'_>,
 ) -> Result<Scene, SceneError> {
-    load_scene_str_with_files(text, name, resolve, &super::no_binary_files)
+    load_scene_str_with_files(text, name, resolve, &no_binary_files)
 }
 
 /// Parses scene TOML, reading meshes and material libraries through `resolve` and textures
@@ -50,52 +53,6 @@ pub fn load_scene_str_with_files(
         user_materials: HashMap::new(),
     }
     .build(root.get_ref())
-}
-
-const SECTIONS: &[&str] = &[
-    "render", "camera", "light", "material", "sphere", "triangle", "mesh",
-];
-const RENDER_KEYS: &[&str] = &[
-    "width",
-    "height",
-    "max_depth",
-    "samples",
-    "background",
-    "ambient_light",
-    "shading",
-];
-const CAMERA_KEYS: &[&str] = &["position", "look_at", "up", "fov_y"];
-const LIGHT_KEYS: &[&str] = &["name", "position", "color", "radius", "follow_camera"];
-const MATERIAL_KEYS: &[&str] = &[
-    "name",
-    "ambient",
-    "diffuse",
-    "specular",
-    "shininess",
-    "reflectivity",
-    "transparency",
-    "ior",
-];
-const SPHERE_KEYS: &[&str] = &["name", "center", "radius", "material"];
-const TRIANGLE_KEYS: &[&str] = &["name", "vertices", "material"];
-const MESH_KEYS: &[&str] = &[
-    "name",
-    "file",
-    "material",
-    "translate",
-    "rotate",
-    "scale",
-    "normals",
-    "crease_angle",
-];
-
-/// `[section]` or `[[section]]`, as written in the format.
-fn section_syntax(name: &str) -> String {
-    if matches!(name, "render" | "camera") {
-        format!("[{name}]")
-    } else {
-        format!("[[{name}]]")
-    }
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -122,86 +79,6 @@ struct SceneBuilder<'a> {
     scene: Scene,
     /// The `[[material]]` entries by name (MTL materials are not referable by name).
     user_materials: HashMap<String, MaterialId>,
-}
-
-/// Every top-level key must be a known section of the right shape (`[render]` a table,
-/// `[[sphere]]` an array of tables).
-fn check_sections(src: &Src, root: &DeTable) -> Result<(), SceneError> {
-    for (key, value) in root.iter() {
-        let name = key.get_ref().as_ref();
-        if !SECTIONS.contains(&name) {
-            let home = [("render", RENDER_KEYS), ("camera", CAMERA_KEYS)]
-                .into_iter()
-                .find(|(_, keys)| keys.contains(&name));
-            let hint = match home {
-                Some((section, _)) => format!(" (it belongs under [{section}])"),
-                None => suggest(name, SECTIONS.iter().copied())
-                    .map(|s| format!(" (did you mean `{}`?)", section_syntax(s)))
-                    .unwrap_or_default(),
-            };
-            let what = match value.get_ref() {
-                DeValue::Table(_) | DeValue::Array(_) => "unknown section",
-                _ => "unknown top-level key",
-            };
-            let listed: Vec<String> = SECTIONS.iter().map(|s| section_syntax(s)).collect();
-            return Err(src.error(
-                &key.span(),
-                format!(
-                    "{what} `{}`{hint}; the sections are {}",
-                    short(name),
-                    list_and(&listed)
-                ),
-            ));
-        }
-        let wants_table = matches!(name, "render" | "camera");
-        let shape_ok = match value.get_ref() {
-            DeValue::Table(_) => wants_table,
-            DeValue::Array(_) => !wants_table,
-            _ => false,
-        };
-        if !shape_ok {
-            let shape = if wants_table {
-                "a table"
-            } else {
-                "an array of tables"
-            };
-            return Err(src.error(
-                &value.span(),
-                format!(
-                    "`{name}` must be written as {} ({shape}), got {}",
-                    section_syntax(name),
-                    describe(value.get_ref())
-                ),
-            ));
-        }
-    }
-    Ok(())
-}
-
-/// The names of `sections` (their `name` keys, unique), with `default(i)` for the others,
-/// stepping around the names given explicitly.
-fn unique_names(
-    sections: &[&Section],
-    kind: &str,
-    default: impl Fn(usize) -> Result<String, SceneError>,
-) -> Result<Vec<String>, SceneError> {
-    let mut names = Names::default();
-    let mut given = Vec::with_capacity(sections.len());
-    for s in sections {
-        let name = s.string("name")?;
-        if let Some((name, span)) = &name {
-            names.claim(s, name, span, kind)?;
-        }
-        given.push(name.map(|(name, _)| name));
-    }
-    given
-        .into_iter()
-        .enumerate()
-        .map(|(i, name)| match name {
-            Some(name) => Ok(name),
-            None => Ok(names.fresh(&default(i)?)),
-        })
-        .collect()
 }
 
 impl SceneBuilder<'_> {
@@ -238,24 +115,7 @@ impl SceneBuilder<'_> {
         let refs: Vec<&Section> = lights.iter().collect();
         let names = unique_names(&refs, "light", |i| Ok(format!("light {}", i + 1)))?;
         for (s, name) in lights.iter().zip(names) {
-            let follow_camera = s.boolean("follow_camera", false)?;
-            if follow_camera && let Some(v) = s.get("position") {
-                return Err(s.error(
-                    &v.span(),
-                    "position",
-                    "cannot be given with `follow_camera = true`: that light stands at the camera's eye",
-                ));
-            }
-            let light = Light {
-                name,
-                // Without a position, a light at the eye (where it stays only with
-                // `follow_camera`: see `Scene::place_lights`).
-                position: s.vec3("position", self.scene.camera.position)?,
-                color: s.color("color", Vec3::ONE)?,
-                radius: s.f32("radius", 0.0)?,
-                follow_camera,
-            };
-            rules::check_light(&light).map_err(|v| s.verdict(&v))?;
+            let light = parse_light(s, name, self.scene.camera.position)?;
             self.scene.lights.push(light);
         }
 
@@ -426,7 +286,7 @@ impl SceneBuilder<'_> {
         rules::check_placement(placement.translate, placement.rotate_deg, placement.scale)
             .map_err(|v| s.verdict(&v))?;
         let normals = choice::<NormalsMode>(s, "normals")?.unwrap_or_default();
-        let crease_angle_deg = s.f32("crease_angle", super::DEFAULT_CREASE_ANGLE_DEG)?;
+        let crease_angle_deg = s.f32("crease_angle", crate::scene::DEFAULT_CREASE_ANGLE_DEG)?;
         rules::check_mesh_normals(crease_angle_deg).map_err(|v| s.verdict(&v))?;
         let cannot =
             |problem: String| s.error(&file_span, "file", format!("cannot be loaded: {problem}"));
@@ -479,127 +339,4 @@ fn default_object_name(kind: Kind, s: &Section) -> Result<String, SceneError> {
         },
         _ => format!("{} {number}", kind.label()),
     })
-}
-
-/// Names given so far, so that duplicates are errors and default names stay unique.
-#[derive(Default)]
-struct Names {
-    taken: HashMap<String, String>,
-}
-
-impl Names {
-    /// An explicit name (`name` of section `s`): an error if an earlier one is the same.
-    fn claim(
-        &mut self,
-        s: &Section,
-        name: &str,
-        span: &Range<usize>,
-        kind: &str,
-    ) -> Result<(), SceneError> {
-        if let Some(first) = self.taken.get(name) {
-            return Err(s.error(
-                span,
-                "name",
-                format!(
-                    "repeats \"{}\", the name of {first}; {kind} names must be unique",
-                    short(name).escape_debug()
-                ),
-            ));
-        }
-        self.taken.insert(name.to_string(), s.what.clone());
-        Ok(())
-    }
-
-    /// `base`, or `base 2`, `base 3`, ... if taken.
-    fn fresh(&mut self, base: &str) -> String {
-        let mut name = base.to_string();
-        let mut n = 2;
-        while self.taken.contains_key(&name) {
-            name = format!("{base} {n}");
-            n += 1;
-        }
-        self.taken.insert(name.clone(), String::new());
-        name
-    }
-}
-
-/// A named choice (`shading`, `normals`), or `None` when the key is absent.
-fn choice<T: Choice>(s: &Section, key: &str) -> Result<Option<T>, SceneError> {
-    let Some(v) = s.get(key) else {
-        return Ok(None);
-    };
-    let named = match v.get_ref() {
-        DeValue::String(text) => T::from_name(text),
-        _ => None,
-    };
-    named.map(Some).ok_or_else(|| {
-        let names: Vec<String> = T::ALL.iter().map(|c| format!("\"{}\"", c.name())).collect();
-        s.type_error(key, v, &names.join(" or "))
-    })
-}
-
-fn parse_render(s: &Section) -> Result<RenderParams, SceneError> {
-    let d = RenderParams::default();
-    let shading = choice::<Shading>(s, "shading")?.unwrap_or(d.shading);
-    let render = RenderParams {
-        width: s.uint("width", d.width, &rules::IMAGE_SIZE)?,
-        height: s.uint("height", d.height, &rules::IMAGE_SIZE)?,
-        max_depth: s.uint("max_depth", d.max_depth, &rules::DEPTH)?,
-        samples: s.uint("samples", d.samples, &rules::SAMPLES)?,
-        background: s.color("background", d.background)?,
-        ambient_light: s.color("ambient_light", d.ambient_light)?,
-        shading,
-    };
-    rules::check_render(&render).map_err(|v| s.verdict(&v))?;
-    Ok(render)
-}
-
-fn parse_camera(s: &Section) -> Result<Camera, SceneError> {
-    let d = Camera::default();
-    let camera = Camera {
-        position: s.vec3("position", d.position)?,
-        look_at: s.vec3("look_at", d.look_at)?,
-        up: s.vec3("up", d.up)?,
-        fov_y_deg: s.f32("fov_y", d.fov_y_deg)?,
-    };
-    match rules::check_camera(&camera) {
-        Ok(()) => Ok(camera),
-        Err(v) if v.index.is_some() => Err(s.verdict(&v)),
-        // No frame: point at what was written, the field itself if present, else what it
-        // clashes with.
-        Err(v) => {
-            let order: &[&str] = match v.field {
-                "look_at" => &["look_at", "position"],
-                _ => &["up", "look_at", "position"],
-            };
-            let span = order
-                .iter()
-                .find_map(|k| s.get(k).map(|v| v.span()))
-                .unwrap_or_else(|| s.span.clone());
-            let phrase = if v.field == "up" && s.get("up").is_none() {
-                format!("(by default [0, 1, 0]) {}", v.phrase)
-            } else {
-                v.phrase
-            };
-            Err(s.error(&span, v.field, phrase))
-        }
-    }
-}
-
-fn parse_material(s: &Section, name: String) -> Result<Material, SceneError> {
-    let d = Material::default();
-    let material = Material {
-        name,
-        ambient: s.color("ambient", d.ambient)?,
-        diffuse: s.color("diffuse", d.diffuse)?,
-        specular: s.color("specular", d.specular)?,
-        shininess: s.f32("shininess", d.shininess)?,
-        reflectivity: s.color("reflectivity", d.reflectivity)?,
-        transparency: s.color("transparency", d.transparency)?,
-        ior: s.f32("ior", d.ior)?,
-        diffuse_map: None,
-        ambient_map: None,
-    };
-    rules::check_material(&material).map_err(|v| s.verdict(&v))?;
-    Ok(material)
 }

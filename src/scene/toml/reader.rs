@@ -6,7 +6,7 @@
 //! tree knows which section and field each value belongs to, so every error is one sentence
 //! `FILE:LINE:COLUMN: what field `key` ...` (serde's messages do not name the field of a wrong
 //! type, and `deny_unknown_fields` cannot suggest the key that was meant). What each field must
-//! be is not decided here but in [`super::rules`]; `Section::verdict` places its verdicts.
+//! be is not decided here but in [`crate::scene::rules`]; `Section::verdict` places its verdicts.
 
 use std::ops::{Range, RangeInclusive};
 
@@ -14,8 +14,8 @@ use glam::Vec3;
 use toml::Spanned;
 use toml::de::{DeTable, DeValue};
 
-use super::diag::{SceneError, Src, list_and, short, suggest};
-use super::rules::{self, Violation};
+use crate::scene::diag::{SceneError, Src, list_and, short, suggest};
+use crate::scene::rules::{self, Violation};
 
 pub(crate) fn syntax_error(src: &Src, e: &toml::de::Error) -> SceneError {
     let span = e.span().unwrap_or(0..0);

@@ -1,7 +1,8 @@
 //! Which faces of an OBJ give a normal (`vn`) and a texture coordinate (`vt`) at every corner
-//! (SPEC §3b: "the OBJ's `vn` where present, flat otherwise").
+//! (`normals = "file"`: the OBJ's `vn` where a face gives them, flat otherwise; docs/design.md,
+//! "Scene files").
 //!
-//! tobj 4.0.5 (and [`super::obj_parse`], which reads exactly as it does) fills a corner without
+//! tobj 4.0.5 (and [`super::parse`], which reads exactly as it does) fills a corner without
 //! `vn` or `vt` with the previous corner's index (the first normal for the first corner), and
 //! reads an index of 0, or a relative one that points one before the first, as "absent": a face
 //! without normals in a smooth file would be shaded with a neighbour's normal, and `f 1//0 ...`
@@ -9,8 +10,8 @@
 //! triangles, so that the loader shades such faces flat and refuses those indices as tobj
 //! refuses every other index out of range.
 //!
-//! The parallel reader ([`super::obj_parse`]) finds the same facts while it reads the faces
-//! ([`super::obj_parse::Scanned::take_face_corners`]) and never takes indices of 0 or relative
+//! The parallel reader ([`super::parse`]) finds the same facts while it reads the faces
+//! ([`super::parse::Scanned::take_face_corners`]) and never takes indices of 0 or relative
 //! ones, so this second pass only runs on files it leaves to tobj.
 
 /// A triangle's face gives a normal at every corner.
@@ -289,7 +290,7 @@ mod tests {
     /// polylines between them, for a file with both lists, one of them, or neither.
     #[test]
     fn the_fast_readers_pass_gives_the_same_faces() {
-        use super::super::obj_parse::{Polylines, scan};
+        use super::super::parse::{Polylines, scan};
         let faces = [
             "f 1/1/1 2/1/1 3/1/1\n",
             "f 1 2 3 4\n",

@@ -1,6 +1,6 @@
 //! A parallel reader for the common part of OBJ (`v`, `vt`, `vn`, `f`, `l`, `o`, `g`, `usemtl`,
 //! `mtllib`, comments), giving exactly what `tobj` 4.0.5 gives with the options
-//! `triangulate: true, single_index: false` (the ones [`super::obj`] uses): the same models,
+//! `triangulate: true, single_index: false` (the ones the loader gives tobj): the same models,
 //! names, material ids, positions, normals, texture coordinates and the three index lists, in
 //! the same order, bit for bit. It is about ten times faster than `tobj` on big meshes, which
 //! spends its time hashing every face corner.
@@ -14,7 +14,7 @@
 //!
 //! The same pass counts what the loader needs before it builds anything ([`Facts`]: vertices
 //! and triangles for the memory budget, `vn` and `vt` for the attributes' share, polylines, and
-//! the `usemtl` names for the unknown-material warning), so [`super::obj`] never scans the text
+//! the `usemtl` names for the unknown-material warning), so the mesh loader never scans the text
 //! again: [`scan`] reads the chunks, the loader checks the budget with the facts, and
 //! [`Scanned::assemble`] builds the models.
 //!
@@ -29,7 +29,7 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use super::obj_corners::{ALL_NORMALS, ALL_UVS, FaceCorners};
+use super::corners::{ALL_NORMALS, ALL_UVS, FaceCorners};
 
 /// An absent `vt` or `vn` in a face corner (`1//3`, `1`).
 const MISSING: u32 = u32::MAX;
@@ -203,7 +203,7 @@ impl Scanned {
     }
 
     /// Which faces of the `f` lines give `vt` and `vn` at every corner, and how many give them
-    /// at some corners only: what [`super::obj_corners::face_corners`] finds by reading the
+    /// at some corners only: what [`super::corners::face_corners`] finds by reading the
     /// text again, for a file with both lists (see [`FaceCorners::only`]). Taken out: a second
     /// call gives nothing. With [`Polylines::AsFaces`] the polylines' triangles are not in it.
     pub(crate) fn take_face_corners(&mut self) -> FaceCorners {
@@ -448,7 +448,7 @@ fn parse_line<'a>(
             let (corners, given) = face(words, &mut chunk.corners)?;
             let triangles = (chunk.corners.len() - before) / 3;
             chunk.face_triangles += triangles as u64;
-            // The same facts as [`super::obj_corners`] finds by reading the line again.
+            // The same facts as [`super::corners`] finds by reading the line again.
             let all = |list: usize| given[list] == corners;
             let flags = (u8::from(all(0)) * ALL_UVS) | (u8::from(all(1)) * ALL_NORMALS);
             for (partial, given) in chunk.partial.iter_mut().zip(given) {

@@ -1,0 +1,212 @@
+//! Placing one model's faces: each face's corners transformed to the scene, the degenerate and
+//! the too distant marked to be dropped (at load time, so the tracer never meets them), and
+//! the indices of the normals and texture coordinates each face gives.
+
+use glam::{Mat3, Vec2, Vec3};
+use rayon::prelude::*;
+
+use super::corners::{ALL_NORMALS, ALL_UVS};
+use crate::scene::rules::{MAX_COORDINATE, is_visible_triangle};
+use crate::scene::{MaterialId, NO_INDEX, ObjectId, Triangle};
+
+/// One model's faces, to be placed in parallel: the model, the placement, and the mesh's
+/// normals and texture coordinates so far with the index of this model's first (when its faces
+/// give them).
+pub(super) struct Faces<'a> {
+    pub mesh: &'a tobj::Mesh,
+    pub linear: Mat3,
+    pub translate: Vec3,
+    pub mirrors: bool,
+    pub normals: Option<(&'a [Vec3], u32)>,
+    pub uvs: Option<(&'a [Vec2], u32)>,
+}
+
+/// The material of a placed triangle until its model's material is known.
+const PLACED: MaterialId = MaterialId(u32::MAX);
+/// The material of a triangle to drop: zero area or not finite.
+const DEGENERATE: MaterialId = MaterialId(u32::MAX - 1);
+/// The material of a triangle to drop: beyond the scene-size limit.
+const TOO_FAR: MaterialId = MaterialId(u32::MAX - 2);
+
+impl Faces<'_> {
+    /// Face `k` placed: its corners transformed (two swapped when the placement mirrors),
+    /// marked [`PLACED`], [`DEGENERATE`] or [`TOO_FAR`] in place of its material.
+    fn triangle(&self, k: usize, object: ObjectId) -> Triangle {
+        let mesh = self.mesh;
+        let corner = |index: u32| {
+            let i = index as usize * 3;
+            mesh.positions
+                .get(i..i + 3)
+                .map_or(Vec3::NAN, |p| Vec3::new(p[0], p[1], p[2]))
+        };
+        let face = &mesh.indices[3 * k..3 * k + 3];
+        let mut v = [face[0], face[1], face[2]].map(|i| self.linear * corner(i) + self.translate);
+        if self.mirrors {
+            v.swap(1, 2);
+        }
+        let material = if !is_visible_triangle(&v) {
+            DEGENERATE
+        } else if v.iter().any(|p| p.abs().max_element() > MAX_COORDINATE) {
+            TOO_FAR
+        } else {
+            PLACED
+        };
+        Triangle {
+            vertices: v,
+            material,
+            object,
+        }
+    }
+
+    /// The mesh's normal or texture-coordinate indices of face `k` (swapped as its corners),
+    /// from `(the model's index list, the model's first in the mesh's list, how many the model
+    /// has)`; [`NO_INDEX`]`× 3` when one is out of range or names a value that is not `usable`.
+    fn corner_ids(
+        &self,
+        k: usize,
+        (indices, base, count): (&[u32], u32, u32),
+        usable: &(impl Fn(u32) -> bool + Sync),
+    ) -> [u32; 3] {
+        let Some(idx) = indices.get(3 * k..3 * k + 3) else {
+            return [NO_INDEX; 3];
+        };
+        let mut idx = [idx[0], idx[1], idx[2]];
+        if !idx.iter().all(|&i| i < count && usable(base + i)) {
+            return [NO_INDEX; 3];
+        }
+        if self.mirrors {
+            idx.swap(1, 2);
+        }
+        idx.map(|i| base + i)
+    }
+    /// Places the model's `count` faces in parallel, straight into `triangles` (the dropped
+    /// ones marked, to be taken out by [`keep_placed`]): no per-thread lists, whose memory the
+    /// allocator would keep after the load.
+    pub(super) fn place(&self, triangles: &mut Vec<Triangle>, count: usize, object: ObjectId) {
+        triangles.par_extend((0..count).into_par_iter().map(|k| self.triangle(k, object)));
+    }
+
+    /// The normal indices of the model's `count` faces (`NO_INDEX × 3` for a face that does not
+    /// give `vn` at every corner, or gives an unusable one), or none when the model has none.
+    pub(super) fn normal_ids(&self, count: usize, given: &Given) -> Vec<[u32; 3]> {
+        let Some((normals, base)) = self.normals else {
+            return Vec::new();
+        };
+        let usable = |i: u32| {
+            let n = normals[i as usize];
+            n.is_finite() && n != Vec3::ZERO
+        };
+        let list = (
+            &self.mesh.normal_indices[..],
+            base,
+            normals.len() as u32 - base,
+        );
+        self.all_corner_ids(count, given, ALL_NORMALS, list, &usable)
+    }
+
+    /// As [`Faces::normal_ids`], for the texture coordinates (`vt`).
+    pub(super) fn uv_ids(&self, count: usize, given: &Given) -> Vec<[u32; 3]> {
+        let Some((uvs, base)) = self.uvs else {
+            return Vec::new();
+        };
+        let usable = |i: u32| uvs[i as usize].is_finite();
+        let list = (
+            &self.mesh.texcoord_indices[..],
+            base,
+            uvs.len() as u32 - base,
+        );
+        self.all_corner_ids(count, given, ALL_UVS, list, &usable)
+    }
+
+    /// [`Faces::corner_ids`] of each of the `count` faces that `given` says give `bit` at every
+    /// corner, `NO_INDEX × 3` for the others.
+    fn all_corner_ids(
+        &self,
+        count: usize,
+        given: &Given,
+        bit: u8,
+        list: (&[u32], u32, u32),
+        usable: &(impl Fn(u32) -> bool + Sync),
+    ) -> Vec<[u32; 3]> {
+        (0..count)
+            .into_par_iter()
+            .map(|k| match given.all(k, bit) {
+                true => self.corner_ids(k, list, usable),
+                false => [NO_INDEX; 3],
+            })
+            .collect()
+    }
+}
+
+/// Which of a model's faces give `vn` (`vt`) at every corner: the mesh's flags by triangle in
+/// tobj's order (empty when every face does), from the model's first triangle on.
+pub(super) struct Given<'a> {
+    pub flags: &'a [u8],
+    pub first: usize,
+}
+
+impl Given<'_> {
+    /// Face `k` of the model gives every corner what `bit` ([`ALL_NORMALS`], [`ALL_UVS`]) says.
+    fn all(&self, k: usize, bit: u8) -> bool {
+        self.flags.get(self.first + k).is_none_or(|f| f & bit != 0)
+    }
+
+    /// Faces that give an index at every corner, but one out of range or unusable (a face that
+    /// does not give them all is shaded flat, or untextured, and counted apart).
+    pub(super) fn unusable(&self, ids: &[[u32; 3]], bit: u8) -> usize {
+        ids.par_iter()
+            .enumerate()
+            .filter(|&(k, i)| i[0] == NO_INDEX && self.all(k, bit))
+            .count()
+    }
+}
+
+/// How many of `placed` were marked [`DEGENERATE`] and how many [`TOO_FAR`].
+pub(super) fn dropped(placed: &[Triangle]) -> (usize, usize) {
+    let fates = |fate: MaterialId| placed.par_iter().filter(|t| t.material == fate).count();
+    (fates(DEGENERATE), fates(TOO_FAR))
+}
+
+/// Keeps the triangles from `start` on marked [`PLACED`], in order, with their normal and
+/// texture-coordinate indices (`ids`, each empty or one per triangle from `start`).
+pub(super) fn keep_placed(
+    triangles: &mut Vec<Triangle>,
+    start: usize,
+    ids: [&mut Vec<[u32; 3]>; 2],
+) {
+    let count = triangles.len() - start;
+    let [normal_ids, uv_ids] = ids;
+    let mut w = 0;
+    for k in 0..count {
+        if triangles[start + k].material == PLACED {
+            triangles[start + w] = triangles[start + k];
+            for ids in [&mut *normal_ids, &mut *uv_ids] {
+                if !ids.is_empty() {
+                    ids[w] = ids[k];
+                }
+            }
+            w += 1;
+        }
+    }
+    triangles.truncate(start + w);
+    normal_ids.truncate(w);
+    uv_ids.truncate(w);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn degenerate_triangles_are_invisible() {
+        let ok = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        assert!(is_visible_triangle(&ok));
+        assert!(!is_visible_triangle(&[Vec3::ZERO, Vec3::X, Vec3::X * 2.0]));
+        assert!(!is_visible_triangle(&[Vec3::ZERO, Vec3::X, Vec3::NAN]));
+        assert!(!is_visible_triangle(&[
+            Vec3::ZERO,
+            Vec3::X * 3e38,
+            Vec3::Y * 3e38
+        ]));
+    }
+}

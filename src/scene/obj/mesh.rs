@@ -1,0 +1,293 @@
+//! One OBJ mesh added to a scene, step by step: its text read and checked against the memory
+//! budget, its material libraries read, then each model's faces placed, its attributes and
+//! material found, and the degenerate faces dropped; last the mesh's normals, texture
+//! coordinates and warnings.
+
+use std::sync::Arc;
+
+use glam::{Mat3, Vec2, Vec3};
+use rayon::prelude::*;
+
+use super::attributes::{Corners, finish_attributes};
+use super::corners::{self, FaceCorners};
+use super::faces::{Faces, Given, dropped, keep_placed};
+use super::memory::check_memory;
+use super::mtl::{Libraries, mtl_material, warn_unknown_usemtl};
+use super::parse::Facts;
+use super::read::{ObjProblem, read_models, scan};
+use super::request::MeshRequest;
+use crate::scene::{MaterialId, MeshAttributes, NormalsMode, Scene};
+
+/// Adds the OBJ's triangles (placed, degenerate ones dropped) and the MTL materials they use
+/// to `scene`; returns how many triangles were added.
+pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, ObjProblem> {
+    let (scanned, fast_corners, facts) = scan(req.text)?;
+    check_memory(scene, req.text.len(), &facts, req.normals)?;
+    let libraries = Libraries::new(req);
+    let (models, mtl_materials, fast) =
+        read_models(req.text, scanned, |path| libraries.load(path))?;
+    let face_corners = face_corners(req.text, &models, fast, fast_corners)?;
+    let (mut warnings, mtl_texts) = libraries.finish();
+    warn_about_reading(req, &facts, &mtl_materials, &mut warnings);
+
+    let mut build = MeshBuild::new(scene, req, &models, &face_corners, &mtl_materials, warnings);
+    for model in &models {
+        build.add_model(scene, &model.mesh, &mtl_texts);
+    }
+    Ok(build.finish(scene, &face_corners))
+}
+
+/// Which faces give `vn`/`vt` at every corner (tobj fills the others from a neighbour): the
+/// fast reader's pass found them; a file read by tobj is read again for them.
+fn face_corners(
+    text: &str,
+    models: &[tobj::Model],
+    fast: bool,
+    fast_corners: Option<FaceCorners>,
+) -> Result<FaceCorners, ObjProblem> {
+    let (uvs_in_file, normals_in_file) = models.iter().fold((false, false), |(t, n), m| {
+        (
+            t || !m.mesh.texcoords.is_empty(),
+            n || !m.mesh.normals.is_empty(),
+        )
+    });
+    Ok(match (uvs_in_file || normals_in_file, fast_corners) {
+        (false, _) => Default::default(),
+        (true, Some(found)) if fast => found.only(uvs_in_file, normals_in_file),
+        (true, _) => corners::face_corners(text, uvs_in_file, normals_in_file).map_err(
+            |(line, reason)| ObjProblem {
+                line: Some(line),
+                reason: reason.into(),
+            },
+        )?,
+    })
+}
+
+/// The warnings about what was read: the polylines ignored, and, when nothing else went wrong
+/// so far, the `usemtl` names no library defines.
+fn warn_about_reading(
+    req: &MeshRequest,
+    facts: &Facts,
+    mtl_materials: &[tobj::Material],
+    warnings: &mut Vec<String>,
+) {
+    let polylines = facts.polylines;
+    if polylines > 0 {
+        let s = if polylines == 1 { "" } else { "s" };
+        warnings.push(format!(
+            "{}: ignored {polylines} polyline{s} (`l`): a line has no surface to show.",
+            req.label
+        ));
+    }
+    if req.material_override.is_none() && warnings.is_empty() {
+        warn_unknown_usemtl(req.label, facts, mtl_materials, warnings);
+    }
+}
+
+/// A mesh while its models are added, one after another.
+struct MeshBuild<'a> {
+    req: &'a MeshRequest<'a>,
+    mtl_materials: &'a [tobj::Material],
+    /// The scene material of each MTL material, made when first used.
+    mtl_ids: Vec<Option<MaterialId>>,
+    linear: Mat3,
+    /// Normals go through the inverse transpose, which keeps them perpendicular to the placed
+    /// surface (and on its outside when a mirroring scale swaps the corners).
+    normal_matrix: Mat3,
+    mirrors: bool,
+    file_normals: bool,
+    /// Which faces give every corner's `vn` (`vt`): flags by triangle in tobj's order, or
+    /// none when every face does.
+    explicit: &'a [u8],
+    /// Triangles of the models so far, as tobj read them (kept or not).
+    triangle_read: usize,
+    first_triangle: usize,
+    /// Triangles kept so far.
+    added: usize,
+    /// Triangles dropped so far: of zero area or not finite, and beyond the scene-size limit.
+    dropped: usize,
+    too_far: usize,
+    attrs: MeshAttributes,
+    corners: Corners,
+    warnings: Vec<String>,
+}
+
+impl<'a> MeshBuild<'a> {
+    fn new(
+        scene: &mut Scene,
+        req: &'a MeshRequest<'a>,
+        models: &[tobj::Model],
+        face_corners: &'a FaceCorners,
+        mtl_materials: &'a [tobj::Material],
+        warnings: Vec<String>,
+    ) -> Self {
+        let linear = req.placement.linear();
+        let first_triangle = scene.triangles.len();
+        let triangles_read: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+        let explicit: &[u8] = match face_corners.triangles.len() == triangles_read {
+            true => &face_corners.triangles,
+            false => &[],
+        };
+        Arc::make_mut(&mut scene.triangles).reserve(triangles_read);
+        Self {
+            req,
+            mtl_materials,
+            mtl_ids: vec![None; mtl_materials.len()],
+            linear,
+            normal_matrix: linear.inverse().transpose(),
+            mirrors: req.placement.mirrors(),
+            file_normals: req.normals == NormalsMode::File,
+            explicit,
+            triangle_read: 0,
+            first_triangle,
+            added: 0,
+            dropped: 0,
+            too_far: 0,
+            attrs: MeshAttributes {
+                first_triangle: first_triangle as u32,
+                ..MeshAttributes::default()
+            },
+            corners: Corners::default(),
+            warnings,
+        }
+    }
+
+    /// Adds one model's faces: placed, with their normal and texture-coordinate indices and
+    /// their material, the degenerate and too distant ones dropped.
+    fn add_model(&mut self, scene: &mut Scene, mesh: &tobj::Mesh, mtl_texts: &[(String, String)]) {
+        let (normal_base, uv_base) = self.read_attributes(mesh);
+        let faces = Faces {
+            mesh,
+            linear: self.linear,
+            translate: self.req.placement.translate,
+            mirrors: self.mirrors,
+            normals: normal_base.map(|base| (&self.attrs.normals[..], base)),
+            uvs: uv_base.map(|base| (&self.attrs.uvs[..], base)),
+        };
+        let count = mesh.indices.len() / 3;
+        let given = Given {
+            flags: self.explicit,
+            first: self.triangle_read,
+        };
+        let start = scene.triangles.len();
+        faces.place(Arc::make_mut(&mut scene.triangles), count, self.req.object);
+        let mut normal_ids = faces.normal_ids(count, &given);
+        let mut uv_ids = faces.uv_ids(count, &given);
+        self.corners.bad_normals += given.unusable(&normal_ids, corners::ALL_NORMALS);
+        self.corners.bad_uvs += given.unusable(&uv_ids, corners::ALL_UVS);
+        self.triangle_read += count;
+        let (degenerate, far) = dropped(&scene.triangles[start..]);
+        self.dropped += degenerate;
+        self.too_far += far;
+        let kept = count - degenerate - far;
+        // Materials are added on first use, so a scene lists only what it shows.
+        let material = (kept > 0).then(|| self.material(scene, mesh, mtl_texts));
+        if kept < count {
+            // Rare: keep the placed ones, in order, with their corner indices.
+            let triangles = Arc::make_mut(&mut scene.triangles);
+            keep_placed(triangles, start, [&mut normal_ids, &mut uv_ids]);
+        }
+        if let Some(material) = material {
+            Arc::make_mut(&mut scene.triangles)[start..]
+                .par_iter_mut()
+                .for_each(|t| t.material = material);
+        }
+        self.corners.append(self.added, normal_ids, uv_ids);
+        self.added += kept;
+    }
+
+    /// Adds the model's normals (placed) and texture coordinates to the mesh's, when its faces
+    /// give them; returns the index of the model's first of each. Per-face normal and texture
+    /// indices exist only when every face gives them.
+    fn read_attributes(&mut self, mesh: &tobj::Mesh) -> (Option<u32>, Option<u32>) {
+        let attrs = &mut self.attrs;
+        let normal_base = attrs.normals.len() as u32;
+        let has_normals = self.file_normals
+            && !mesh.normals.is_empty()
+            && mesh.normal_indices.len() == mesh.indices.len();
+        if has_normals {
+            let normal_matrix = self.normal_matrix;
+            attrs.normals.par_extend(
+                mesh.normals
+                    .par_chunks_exact(3)
+                    .map(|n| (normal_matrix * Vec3::new(n[0], n[1], n[2])).normalize_or_zero()),
+            );
+        }
+        let uv_base = attrs.uvs.len() as u32;
+        let has_uvs =
+            !mesh.texcoords.is_empty() && mesh.texcoord_indices.len() == mesh.indices.len();
+        if has_uvs {
+            attrs.uvs.par_extend(
+                mesh.texcoords
+                    .par_chunks_exact(2)
+                    .map(|t| Vec2::new(t[0], t[1])),
+            );
+        }
+        (
+            has_normals.then_some(normal_base),
+            has_uvs.then_some(uv_base),
+        )
+    }
+
+    /// The material of a model's faces: the override, its MTL material (made on first use), or
+    /// the scene's default.
+    fn material(
+        &mut self,
+        scene: &mut Scene,
+        mesh: &tobj::Mesh,
+        mtl_texts: &[(String, String)],
+    ) -> MaterialId {
+        let mtl_materials = self.mtl_materials;
+        match (self.req.material_override, mesh.material_id) {
+            (Some(id), _) => id,
+            (None, Some(i)) if i < mtl_materials.len() => {
+                *self.mtl_ids[i].get_or_insert_with(|| {
+                    mtl_material(
+                        scene,
+                        self.req,
+                        &mtl_materials[i],
+                        mtl_texts,
+                        &mut self.warnings,
+                    )
+                })
+            }
+            (None, _) => scene.default_material(),
+        }
+    }
+
+    /// Ends the mesh: the triangle list trimmed, the attributes kept, the warnings about dropped
+    /// triangles given; returns how many triangles the mesh added.
+    fn finish(mut self, scene: &mut Scene, face_corners: &FaceCorners) -> usize {
+        let req = self.req;
+        let added = self.added;
+        if added < scene.triangles.capacity() / 2 {
+            Arc::make_mut(&mut scene.triangles).shrink_to_fit();
+        }
+        let textured = scene.triangles[self.first_triangle..].iter().any(|t| {
+            scene.material(t.material).diffuse_map.is_some()
+                || scene.material(t.material).ambient_map.is_some()
+        });
+        let mut corners = self.corners;
+        corners.partial_normals = face_corners.partial_normals * usize::from(self.file_normals);
+        corners.partial_uvs = face_corners.partial_uvs;
+        let warnings = &mut self.warnings;
+        finish_attributes(scene, req, self.attrs, corners, textured, warnings);
+        let (dropped, too_far) = (self.dropped, self.too_far);
+        if dropped > 0 {
+            let s = if dropped == 1 { "" } else { "s" };
+            warnings.push(format!(
+                "{}: dropped {dropped} degenerate triangle{s} (zero area or non-finite vertices).",
+                req.label
+            ));
+        }
+        if too_far > 0 {
+            let s = if too_far == 1 { "" } else { "s" };
+            warnings.push(format!(
+                "{}: dropped {too_far} triangle{s} placed beyond ±1e15, raytree's limit on scene size.",
+                req.label
+            ));
+        }
+        scene.warnings.extend(self.warnings);
+        added
+    }
+}

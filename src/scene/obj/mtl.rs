@@ -1,0 +1,347 @@
+//! MTL materials: the libraries an OBJ names, read for tobj; each material mapped to a Phong
+//! material named `<object>/<mtl name>` (a `[[material]]` of that name overrides its colours) with
+//! its textures; and the warnings about invalid values and `usemtl` names no library defines.
+
+use std::borrow::Cow;
+use std::cell::RefCell;
+use std::path::Path;
+
+use glam::Vec3;
+
+use super::maps::load_texture;
+use super::parse::Facts;
+use super::paths::sibling;
+use super::request::MeshRequest;
+use crate::scene::diag::{list_and, short, short_path};
+use crate::scene::{Material, MaterialId, Scene};
+
+/// The material libraries (`mtllib`) of one OBJ as tobj asks for them: each read next to the
+/// OBJ and made readable for tobj ([`mtl_for_tobj`]), with a warning for each that cannot be,
+/// and the text of each that can, so that a texture's warning can name its line. A mesh with a
+/// material override reads none.
+pub(super) struct Libraries<'r> {
+    req: &'r MeshRequest<'r>,
+    warnings: RefCell<Vec<String>>,
+    texts: RefCell<Vec<(String, String)>>,
+}
+
+impl<'r> Libraries<'r> {
+    pub(super) fn new(req: &'r MeshRequest<'r>) -> Self {
+        Self {
+            req,
+            warnings: RefCell::new(Vec::new()),
+            texts: RefCell::new(Vec::new()),
+        }
+    }
+
+    /// The library `path` (as the OBJ names it) read, for tobj.
+    pub(super) fn load(&self, path: &Path) -> tobj::MTLLoadResult {
+        let req = self.req;
+        if req.material_override.is_some() {
+            return Ok(Default::default());
+        }
+        let name = short_path(&path.to_string_lossy());
+        let text = (req.resolve)(&sibling(req.key, &path.to_string_lossy())).map_err(|reason| {
+            self.warnings.borrow_mut().push(format!(
+                "{}: cannot read the material library `{name}` ({reason}); its faces use the default material.",
+                req.label
+            ));
+            tobj::LoadError::OpenFileFailed
+        })?;
+        self.texts.borrow_mut().push((name.clone(), text.clone()));
+        let text = mtl_for_tobj(&text).map_err(|(line, reason)| {
+            self.warnings.borrow_mut().push(format!(
+                "{}: cannot read the material library `{name}` (line {line}: {reason}); its faces use the default material.",
+                req.label
+            ));
+            tobj::LoadError::MaterialParseError
+        })?;
+        tobj::load_mtl_buf(&mut text.as_bytes()).inspect_err(|e| {
+            self.warnings.borrow_mut().push(format!(
+                "{}: cannot read the material library `{name}` ({e}); its faces use the default material.",
+                req.label
+            ));
+        })
+    }
+
+    /// The warnings about the libraries, and the text of each library read (its name, its
+    /// text).
+    pub(super) fn finish(self) -> (Vec<String>, Vec<(String, String)>) {
+        (self.warnings.into_inner(), self.texts.into_inner())
+    }
+}
+
+/// MTL text as `tobj` can take it, or the line and the reason it cannot. The MTL format lets
+/// `Ka`, `Kd`, `Ks` and `Ke` give one number for all three channels (`Kd 0.8`); tobj 4.0.5
+/// panics on that (and on zero or two numbers), so one number is spelled out three times here
+/// and zero or two are refused with their line.
+fn mtl_for_tobj(text: &str) -> Result<Cow<'_, str>, (usize, String)> {
+    let mut fixed: Option<String> = None;
+    for (i, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() else {
+            if let Some(out) = fixed.as_mut() {
+                out.push_str(line);
+                out.push('\n');
+            }
+            continue;
+        };
+        let values: Vec<&str> = words.collect();
+        let parses = values.iter().all(|v| v.parse::<f32>().is_ok());
+        match values.len() {
+            1 | 2 if !parses => {} // tobj reports the bad number as an error
+            0 | 2 => {
+                return Err((
+                    i + 1,
+                    format!(
+                        "`{key}` needs one number or three (r g b), got {}",
+                        values.len()
+                    ),
+                ));
+            }
+            1 => {
+                let out = fixed.get_or_insert_with(|| {
+                    let mut head = String::with_capacity(text.len() + 64);
+                    for earlier in text.lines().take(i) {
+                        head.push_str(earlier);
+                        head.push('\n');
+                    }
+                    head
+                });
+                let v = values[0];
+                out.push_str(&format!("{key} {v} {v} {v}\n"));
+                continue;
+            }
+            _ => {}
+        }
+        if let Some(out) = fixed.as_mut() {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    Ok(fixed.map_or(Cow::Borrowed(text), Cow::Owned))
+}
+
+/// `usemtl` names ([`Facts::usemtl`]) that no loaded library defines: tobj silently gives
+/// those faces no material.
+pub(super) fn warn_unknown_usemtl(
+    label: &str,
+    facts: &Facts,
+    known: &[tobj::Material],
+    warnings: &mut Vec<String>,
+) {
+    let unknown: Vec<&str> = facts
+        .usemtl
+        .iter()
+        .map(String::as_str)
+        .filter(|name| !known.iter().any(|m| m.name == *name))
+        .collect();
+    if !unknown.is_empty() {
+        // A handful of names, so that the warning stays one readable sentence.
+        let mut names: Vec<String> = unknown
+            .iter()
+            .take(5)
+            .map(|n| format!("`{}`", short(n)))
+            .collect();
+        if unknown.len() > 5 {
+            names.push(format!("{} more", unknown.len() - 5));
+        }
+        warnings.push(format!(
+            "{label}: `usemtl` names materials that no material library defines ({}); their faces use the default material.",
+            list_and(&names)
+        ));
+    }
+}
+
+/// The scene material for an MTL material: `<object>/<mtl name>`, reusing a scene material of
+/// that name if the scene file defines one (so edited materials survive a save and reload).
+pub(super) fn mtl_material(
+    scene: &mut Scene,
+    req: &MeshRequest,
+    m: &tobj::Material,
+    mtl_texts: &[(String, String)],
+    warnings: &mut Vec<String>,
+) -> MaterialId {
+    let name = format!("{}/{}", req.object_name, m.name);
+    let id = match scene.materials.iter().position(|x| x.name == name) {
+        Some(i) => MaterialId(i as u32),
+        None => {
+            let material = material_from_mtl(m, name, req.label, warnings);
+            scene.materials.push(material);
+            MaterialId(scene.materials.len() as u32 - 1)
+        }
+    };
+    // Textures come from the MTL even when a `[[material]]` of this name overrides its
+    // colours (a scene file has no texture keys, so a saved scene keeps its textures).
+    let mut texture = |key: &str, file: &Option<String>| {
+        let file = file.as_deref()?;
+        load_texture(scene, req, &m.name, key, file, mtl_texts, warnings)
+    };
+    let diffuse = texture("map_Kd", &m.diffuse_texture);
+    let ambient = texture("map_Ka", &m.ambient_texture);
+    let material = &mut scene.materials[id.0 as usize];
+    material.diffuse_map = material.diffuse_map.or(diffuse);
+    material.ambient_map = material.ambient_map.or(ambient);
+    id
+}
+
+/// Maps an MTL material to the Phong material: Ka→ambient, Kd→diffuse, Ks→specular,
+/// Ns→shininess, Ni→ior, transparency = 1 − d (or Tr); `illum` 3 and 5 (ray-traced
+/// reflection) set reflectivity = Ks; 4, 6 and 7 (glass) set reflectivity = Ks and
+/// transparency = 1 − d, or 0.9 without `d`. Missing or invalid values fall back to
+/// [`Material::default`] (invalid ones with a warning).
+fn material_from_mtl(
+    m: &tobj::Material,
+    name: String,
+    label: &str,
+    warnings: &mut Vec<String>,
+) -> Material {
+    let d = Material::default();
+    let mut values = Values {
+        m,
+        label,
+        warnings: &mut *warnings,
+    };
+    let ambient = values.rgb(m.ambient, "Ka", d.ambient);
+    let diffuse = values.rgb(m.diffuse, "Kd", d.diffuse);
+    let specular = values.rgb(m.specular, "Ks", d.specular);
+    let shininess = values
+        .scalar(m.shininess, "Ns", |x| x >= 0.0, d.shininess)
+        .unwrap_or(d.shininess);
+    // `Ns 0` with a `Ks` (MeshLab writes `Ns 0` and `Ks 1` meaning "no highlight"): an
+    // exponent of 0 would add the whole `Ks` wherever the light falls and wash the model out.
+    // The highlight is dropped; a mirror's reflectivity (`Ks`, below) is kept.
+    let no_highlight = m.shininess.is_some() && shininess == 0.0 && specular != Vec3::ZERO;
+    let ior = values
+        .scalar(m.optical_density, "Ni", |x| x > 0.0, d.ior)
+        .unwrap_or(d.ior);
+    let glass = matches!(m.illumination_model, Some(4 | 6 | 7));
+    let dissolve = values.dissolve(glass);
+    if no_highlight {
+        warnings.push(format!(
+            "{label}: material `{}` has `Ns 0`, which would add all of `Ks` wherever light falls; shown without a highlight (`Ks 0`).",
+            short(&m.name)
+        ));
+    }
+    let mirror = glass || matches!(m.illumination_model, Some(3 | 5));
+    let transparency = match dissolve {
+        Some(dissolve) => 1.0 - dissolve,
+        None if glass => 0.9,
+        None => 0.0,
+    };
+    Material {
+        name,
+        ambient,
+        diffuse,
+        specular: if no_highlight { Vec3::ZERO } else { specular },
+        shininess,
+        reflectivity: if mirror { specular } else { Vec3::ZERO },
+        transparency: Vec3::splat(transparency),
+        ior,
+        diffuse_map: None,
+        ambient_map: None,
+    }
+}
+
+/// The values of one MTL material as they are read, with one warning for each invalid one.
+struct Values<'a> {
+    m: &'a tobj::Material,
+    label: &'a str,
+    warnings: &'a mut Vec<String>,
+}
+
+impl Values<'_> {
+    fn invalid(&mut self, key: &str, got: String, fallback: String) {
+        self.warnings.push(format!(
+            "{}: material `{}` has an invalid `{key}` {got}; using {fallback}.",
+            self.label,
+            short(&self.m.name)
+        ));
+    }
+
+    /// A colour, or `fallback` when it is absent or invalid (not finite, or negative).
+    fn rgb(&mut self, value: Option<[f32; 3]>, key: &str, fallback: Vec3) -> Vec3 {
+        let Some(a) = value else {
+            return fallback;
+        };
+        let v = Vec3::from_array(a);
+        if v.is_finite() && v.cmpge(Vec3::ZERO).all() {
+            v
+        } else {
+            self.invalid(key, format!("{a:?}"), format!("{fallback}"));
+            fallback
+        }
+    }
+
+    /// A finite number that passes `ok`, or `None` when it is absent or invalid (the warning
+    /// names `fallback`, what the caller uses instead).
+    fn scalar(
+        &mut self,
+        value: Option<f32>,
+        key: &str,
+        ok: fn(f32) -> bool,
+        fallback: f32,
+    ) -> Option<f32> {
+        match value {
+            Some(x) if x.is_finite() && ok(x) => Some(x),
+            Some(x) => {
+                self.invalid(key, x.to_string(), fallback.to_string());
+                None
+            }
+            None => None,
+        }
+    }
+
+    /// The opacity: `d`, else 1 − `Tr`, else `None`. `Tr 1` without `d` on a material that is
+    /// not glass (`glass`) is opaque, with a warning: MeshLab and others write it meaning opaque
+    /// (Tr as opacity); an invisible material is never what is meant.
+    fn dissolve(&mut self, glass: bool) -> Option<f32> {
+        let m = self.m;
+        let in_unit = |x: f32| (0.0..=1.0).contains(&x);
+        if let Some(d) = self.scalar(m.dissolve, "d", in_unit, 1.0) {
+            return Some(d);
+        }
+        let tr = m
+            .unknown_param
+            .get("Tr")
+            .and_then(|t| t.trim().parse::<f32>().ok());
+        let tr = self.scalar(tr, "Tr", in_unit, 0.0)?;
+        if tr == 1.0 && !glass {
+            self.warnings.push(format!(
+                "{}: material `{}` has `Tr 1` (fully transparent) but is not glass; taken as opaque, as MeshLab means it.",
+                self.label,
+                short(&m.name)
+            ));
+            return Some(1.0);
+        }
+        Some(1.0 - tr)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::read::quietly;
+    use super::*;
+
+    #[test]
+    fn mtl_colours_of_one_number_are_spelled_out_and_two_are_refused() {
+        let text = "newmtl a\nKd 0.8\nKs 1 2 3\n";
+        assert_eq!(
+            mtl_for_tobj(text).expect("one number is valid MTL"),
+            "newmtl a\nKd 0.8 0.8 0.8\nKs 1 2 3\n"
+        );
+        assert!(matches!(mtl_for_tobj("Ka 1 2 3\n"), Ok(Cow::Borrowed(_))));
+        let e = mtl_for_tobj("newmtl a\n\nKa 1 2\n").expect_err("two numbers");
+        assert_eq!(
+            e,
+            (3, "`Ka` needs one number or three (r g b), got 2".into())
+        );
+        assert!(mtl_for_tobj("Ke\n").is_err());
+        // Not numbers: tobj's own error, not ours.
+        assert!(mtl_for_tobj("Kd x y\n").is_ok());
+        // tobj itself panics on these; through `mtl_for_tobj` it never sees them.
+        for bad in ["newmtl a\nKd 1 2\n", "newmtl a\nKs\n"] {
+            assert!(quietly(|| tobj::load_mtl_buf(&mut bad.as_bytes())).is_err());
+        }
+    }
+}

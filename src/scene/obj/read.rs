@@ -1,0 +1,259 @@
+//! Reading OBJ text into tobj's models: the parallel reader ([`super::parse`]) where it can,
+//! tobj itself for the rest, with panics caught and polylines left out; what the text holds,
+//! counted before it is read; and the line a file stops loading at, for its error.
+
+use std::borrow::Cow;
+use std::cell::{Cell, RefCell};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::Path;
+use std::sync::Once;
+
+use super::corners::FaceCorners;
+use super::parse::{self, Facts, Polylines, Scanned};
+
+/// Why an OBJ could not be read: the `tobj` reason and, when found, the line.
+#[derive(Debug)]
+pub(crate) struct ObjProblem {
+    pub line: Option<usize>,
+    pub reason: String,
+}
+
+impl ObjProblem {
+    /// `:17: reason` or `: reason`, to follow a file name.
+    pub fn with_line(&self) -> String {
+        match self.line {
+            Some(line) => format!(":{line}: {}", self.reason),
+            None => format!(": {}", self.reason),
+        }
+    }
+}
+
+/// One pass of the parallel reader over `text`: the pass (`None` when it leaves the text to
+/// tobj), which faces give `vn`/`vt` at every corner as it saw them, and the [`Facts`] the budget
+/// and the warnings need (counted line by line for a text left to tobj).
+pub(super) fn scan(
+    text: &str,
+) -> Result<(Option<Scanned>, Option<FaceCorners>, Facts), ObjProblem> {
+    let mut scanned = quietly(|| parse::scan(text, Polylines::Skip)).map_err(|()| ObjProblem {
+        line: None,
+        reason: "the OBJ reader failed on this file".into(),
+    })?;
+    let fast_corners = scanned.as_mut().map(Scanned::take_face_corners);
+    let facts = match &scanned {
+        Some(s) => s.facts().clone(),
+        None => slow_facts(text),
+    };
+    Ok((scanned, fast_corners, facts))
+}
+
+/// The models and MTL materials of OBJ text, read as [`load_obj`] reads it, and whether the fast
+/// reader read them; a file that cannot be read is a problem with its line when one is found.
+pub(super) fn read_models(
+    text: &str,
+    scanned: Option<Scanned>,
+    load_mtl: impl Fn(&Path) -> tobj::MTLLoadResult,
+) -> Result<(Vec<tobj::Model>, Vec<tobj::Material>, bool), ObjProblem> {
+    match load_obj(text, scanned, load_mtl) {
+        Ok((Ok((models, materials)), fast)) => Ok((models, materials.unwrap_or_default(), fast)),
+        Ok((Err(e), _)) => Err(ObjProblem {
+            line: error_line(text),
+            reason: e.to_string(),
+        }),
+        Err(reason) => Err(ObjProblem { line: None, reason }),
+    }
+}
+
+fn load_options() -> tobj::LoadOptions {
+    tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ..Default::default()
+    }
+}
+
+thread_local! {
+    /// Set while [`quietly`] runs: the panic hook then prints nothing.
+    static QUIET: Cell<bool> = const { Cell::new(false) };
+}
+
+/// Runs `f` with panics caught and not printed. `tobj` is third-party code fed hostile files; a
+/// panic in it must become one error sentence, not a crash or a second line on stderr
+/// (docs/reliability.md). The panic hook is wrapped once, and stays silent only on this thread and
+/// only while `f` runs, so every other panic is reported as before.
+pub(super) fn quietly<T>(f: impl FnOnce() -> T) -> Result<T, ()> {
+    static HOOK: Once = Once::new();
+    HOOK.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !QUIET.with(Cell::get) {
+                previous(info);
+            }
+        }));
+    });
+    let was = QUIET.with(|q| q.replace(true));
+    let outcome = catch_unwind(AssertUnwindSafe(f));
+    QUIET.with(|q| q.set(was));
+    outcome.map_err(|_| ())
+}
+
+/// Reads OBJ text: the models of the parallel reader's pass `scanned` (the same result as `tobj`,
+/// faster), or `tobj` itself on the text without its polylines when that reader left it to tobj;
+/// with panics caught, since hostile files must never take the program down (docs/reliability.md).
+/// Each `mtllib` reaches `load_mtl` once, even when the fast reader gives up after it: tobj then
+/// gets the recorded results. The flag says whether the models are the fast reader's.
+pub(super) fn load_obj(
+    text: &str,
+    scanned: Option<Scanned>,
+    load_mtl: impl Fn(&Path) -> tobj::MTLLoadResult,
+) -> Result<(tobj::LoadResult, bool), String> {
+    let failed = |()| "the OBJ reader failed on this file".to_string();
+    let recorded = RefCell::new(std::collections::VecDeque::new());
+    if let Some(scanned) = scanned {
+        let fast = quietly(|| {
+            scanned.assemble(|path: &Path| {
+                let result = load_mtl(path);
+                recorded
+                    .borrow_mut()
+                    .push_back((path.to_path_buf(), result.clone()));
+                result
+            })
+        })
+        .map_err(failed)?;
+        if let Some(loaded) = fast {
+            return Ok((loaded, true));
+        }
+    }
+    let replay = |path: &Path| {
+        let mut recorded = recorded.borrow_mut();
+        match recorded.front() {
+            Some((p, _)) if p == path => match recorded.pop_front() {
+                Some((_, result)) => result,
+                None => load_mtl(path),
+            },
+            _ => load_mtl(path),
+        }
+    };
+    let (text, _) = without_polylines(text);
+    quietly(|| tobj::load_obj_buf(&mut text.as_bytes(), &load_options(), replay))
+        .map(|loaded| (loaded, false))
+        .map_err(failed)
+}
+
+/// Reads OBJ text without polylines, as the mesh loader reads it (the error search's reader).
+fn read_plain(text: &str) -> Result<tobj::LoadResult, String> {
+    let scanned = quietly(|| parse::scan(text, Polylines::Skip))
+        .map_err(|()| "the OBJ reader failed on this file".to_string())?;
+    load_obj(text, scanned, |_| Ok(Default::default())).map(|(loaded, _)| loaded)
+}
+
+/// True for a polyline (`l`) statement.
+fn is_polyline(line: &str) -> bool {
+    line.split_whitespace().next() == Some("l")
+}
+
+/// OBJ text without its polylines, and how many there were. A polyline has no surface to
+/// trace, but tobj reads `l` like `f`, so `l 1 2 3` would be drawn as a triangle; each one
+/// becomes an empty comment, so line numbers in messages stay right.
+pub(super) fn without_polylines(text: &str) -> (Cow<'_, str>, usize) {
+    if !text.lines().any(is_polyline) {
+        return (Cow::Borrowed(text), 0);
+    }
+    let mut out = String::with_capacity(text.len());
+    let mut count = 0;
+    for line in text.lines() {
+        if is_polyline(line) {
+            out.push('#');
+            count += 1;
+        } else {
+            out.push_str(line);
+        }
+        out.push('\n');
+    }
+    (Cow::Owned(out), count)
+}
+
+/// Vertices (`v`) and triangles (after triangulation; a 1- or 2-corner face counts as one
+/// degenerate triangle, as tobj makes it) of OBJ text, counted without parsing numbers.
+pub(super) fn obj_counts(text: &str) -> (u64, u64) {
+    let (mut vertices, mut triangles) = (0u64, 0u64);
+    for line in text.lines() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => vertices += 1,
+            Some("f") => triangles += (words.count() as u64).saturating_sub(2).max(1),
+            _ => {}
+        }
+    }
+    (vertices, triangles)
+}
+
+/// The [`Facts`] of OBJ text that the parallel reader leaves to tobj, counted line by line as
+/// that reader counts them (polylines skipped).
+pub(super) fn slow_facts(text: &str) -> Facts {
+    let (vertices, triangles) = obj_counts(text);
+    let mut facts = Facts {
+        vertices,
+        triangles,
+        ..Facts::default()
+    };
+    for line in text.lines() {
+        match line.split_whitespace().next() {
+            Some("vn") => facts.normals += 1,
+            Some("vt") => facts.texcoords += 1,
+            Some("l") => facts.polylines += 1,
+            _ => {}
+        }
+        if let Some(rest) = line.trim_start().strip_prefix("usemtl")
+            && rest.starts_with([' ', '\t'])
+            && !rest.trim().is_empty()
+        {
+            facts.usemtl.insert(rest.trim().to_string());
+        }
+    }
+    facts
+}
+
+/// The first line at which the OBJ stops loading, found by bisecting prefixes (tobj's errors
+/// carry no position; this runs only on the error path).
+fn error_line(text: &str) -> Option<usize> {
+    let ends: Vec<usize> = text
+        .match_indices('\n')
+        .map(|(i, _)| i + 1)
+        .chain((!text.ends_with('\n')).then_some(text.len()))
+        .collect();
+    let fails = |lines: usize| {
+        let prefix = &text[..ends[lines - 1]];
+        !matches!(read_plain(prefix), Ok(Ok(_)))
+    };
+    let (mut lo, mut hi) = (1, ends.len());
+    if hi == 0 || !fails(hi) {
+        return None;
+    }
+    while lo < hi {
+        let mid = (lo + hi) / 2;
+        if fails(mid) {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    Some(lo)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn error_lines_are_found() {
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 x\nf 1 2 3\n";
+        assert_eq!(error_line(text), Some(4));
+    }
+
+    #[test]
+    fn panics_in_quietly_are_caught_and_others_still_reported() {
+        assert_eq!(quietly(|| 7), Ok(7));
+        assert_eq!(quietly(|| -> i32 { panic!("hostile") }), Err(()));
+        assert!(!QUIET.with(Cell::get), "the flag is reset after the panic");
+    }
+}
