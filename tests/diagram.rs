@@ -86,16 +86,16 @@ fn tree_of(root: Node) -> RayTree {
     }
 }
 
-/// SplitMix64: a tree from a seed.
-struct Mix(u64);
+/// Seeded numbers for the random trees: each call gives a number below `n` (at least 1).
+struct Mix(raytree::rng::Pcg);
 
 impl Mix {
+    fn new(seed: u64) -> Self {
+        Mix(raytree::rng::Pcg::new(seed))
+    }
+
     fn next(&mut self, n: u64) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        (z ^ (z >> 31)) % n.max(1)
+        self.0.below(n.max(1) as usize) as u64
     }
 }
 
@@ -250,7 +250,7 @@ fn generated_trees_lay_out_tidily() {
     runner
         .run(&strategy, |(seed, max_depth, wide, generation)| {
             let tree = tree_of(random_node(
-                &mut Mix(seed),
+                &mut Mix::new(seed),
                 RayKind::Primary,
                 0,
                 max_depth,

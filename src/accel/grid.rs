@@ -375,13 +375,7 @@ mod tests {
     /// force sees: this is where the starting cell's rounding matters.
     #[test]
     fn rays_starting_on_cell_planes_match_brute_force() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut rnd = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rnd = crate::rng::uniform(0x2545_f491_4f6c_dd1d);
         let mut prims = Vec::new();
         for id in 0..400u32 {
             let c = Vec3::new(rnd(), rnd(), rnd()) * 4.0 - 2.0;

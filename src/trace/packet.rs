@@ -81,7 +81,7 @@ impl Tracer {
     /// closest hits are one packet query, the shadow rays of the hits towards each light
     /// another; reflected and refracted rays are traced one by one. Every colour and fact is
     /// the one [`Tracer::trace`] of the ray alone gives, bit for bit: the same intersection
-    /// answers (see [`Accel::closest_hits`]) go through the same shading code.
+    /// answers (see [`crate::accel::Accel::closest_hits`]) go through the same shading code.
     #[inline(always)]
     pub fn trace_packet<const K: usize>(
         &self,

@@ -1004,9 +1004,9 @@ mod tests {
     /// `transpose8` moves bit `(i, j)` to `(j, i)`.
     #[test]
     fn bit_matrix_transpose() {
-        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        let mut rng = crate::rng::Pcg::new(0x9E37_79B9_7F4A_7C15);
         for _ in 0..200 {
-            x = x.rotate_left(13) ^ (x >> 7) ^ 0x2545_F491_4F6C_DD1D;
+            let x = u64::from(rng.next_u32()) << 32 | u64::from(rng.next_u32());
             let t = transpose8(x);
             for i in 0..8 {
                 for j in 0..8 {

@@ -304,11 +304,10 @@ mod tests {
             "\tf  1//1 \x0b 2//1\x0c3//1\n",
         ];
         let mut text = String::from("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvn 0 0 1\n");
-        let mut seed = 7u32;
+        let mut rng = crate::rng::Pcg::new(7);
         // More than 1 MiB: the reader cuts it into several chunks.
         while text.len() < 3 << 20 {
-            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            text += faces[(seed >> 16) as usize % faces.len()];
+            text += faces[rng.below(faces.len())];
         }
         let found = scan(&text, Polylines::Skip)
             .expect("the fast reader takes it")
