@@ -83,7 +83,7 @@ fn main() {
         let (mut by_wall, mut by_cpu) = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0));
         let mut frames = 0;
         let mut installed_after = None;
-        while app.opening().is_some() || app.samples_done() == 0 {
+        while app.files.opening().is_some() || app.samples_done() == 0 {
             let (c0, w0) = schedstat();
             let f = Instant::now();
             app.poll_session();
@@ -97,7 +97,7 @@ fn main() {
             if frame.1 > by_cpu.1 {
                 by_cpu = frame;
             }
-            if installed_after.is_none() && app.opening().is_none() {
+            if installed_after.is_none() && app.files.opening().is_none() {
                 installed_after = Some(t.elapsed().as_secs_f64());
             }
             frames += 1;
@@ -123,7 +123,7 @@ fn main() {
         );
         println!("  longest frame by wall time: {}", ms(by_wall));
         println!("  longest frame by CPU time:  {}", ms(by_cpu));
-        if let Some(o) = app.last_open {
+        if let Some(o) = app.files.last_open {
             println!(
                 "  background: read {:.2} s, parse {:.2} s, copy + build {:.2} s ({} triangles)",
                 o.read_secs, o.parse_secs, o.build_secs, o.triangles

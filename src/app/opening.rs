@@ -83,9 +83,7 @@ impl OpenProgress {
     }
 
     fn stage_secs(&self) -> f64 {
-        crate::sync::lock(&self.stage_since)
-            .elapsed()
-            .as_secs_f64()
+        crate::sync::lock(&self.stage_since).elapsed().as_secs_f64()
     }
 }
 
