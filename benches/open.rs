@@ -2,8 +2,8 @@
 //! benchmark torus as a bare OBJ while the UI loop runs (poll + apply, a 16 ms sleep between
 //! frames, as a window would). Per frame: the wall time and the UI thread's own CPU time and
 //! run-queue wait (`/proc/thread-self/schedstat`), so a frame stretched by a loaded machine is
-//! told apart from one that worked. Beside it, in the same run, what the UI thread used to do
-//! on open: the whole load (`load_scene_file`) and the scene view's copy of the scene.
+//! told apart from one that worked. Beside it, in the same run, what opening on the UI thread
+//! would cost: the whole load (`load_scene_file`) and the scene view's copy of the scene.
 //!
 //! Run: `cargo bench --bench open -- --triangles 1000000 --runs 3 --threads 2`
 

@@ -1,10 +1,9 @@
-//! Faults in the viewer (SPEC §9): bursts of edits (hundreds a second) never deadlock and never
-//! leave a stale tile (after the burst, the converged film equals the batch render of the final
+//! Faults in the viewer (docs/reliability.md): bursts of edits never deadlock and never leave a
+//! stale tile (after the burst, the converged film equals the batch render of the final
 //! scene); a new scene opened mid-render replaces the old one cleanly, a bad one leaves it
 //! rendering; the window survives being 0×0. The logic runs headless
-//! (`ViewerApp::headless`); the window cases drive the real app through egui_kittest on the
-//! wgpu software adapter, like `tests/viewer.rs` (same environment: `XDG_RUNTIME_DIR=/tmp
-//! WGPU_BACKEND=vulkan` where needed).
+//! (`ViewerApp::headless`); the window cases drive the real app through the harness of
+//! `tests/common/viewer.rs`.
 
 #[path = "common/viewer.rs"]
 mod viewer;

@@ -1,9 +1,9 @@
-//! Opening a file never freezes the viewer (issue 14.5): the read, the parse and the build run
+//! Opening a file never freezes the viewer: the read, the parse and the build run
 //! in the background while the previous scene stays up and usable; a second open cancels the
 //! first, which never installs; the progress only goes up and stays below 100 % until the new
 //! scene is in; a headlight follows the camera without a rebuild. Headless
 //! (`ViewerApp::headless`), the open held at a stage boundary by the open hook; the window
-//! case drives the real app through egui_kittest (`WGPU_BACKEND=vulkan XDG_RUNTIME_DIR=...`).
+//! case drives the real app through the harness of `tests/common/viewer.rs`.
 
 #[path = "common/viewer.rs"]
 mod viewer;

@@ -17,6 +17,7 @@ mod input;
 mod legend;
 pub mod messages;
 pub mod modes;
+mod open_scene;
 pub mod opening;
 mod paint3d;
 mod panels;
@@ -30,20 +31,18 @@ pub mod tree_view;
 pub mod undo;
 pub mod viewport;
 pub mod watch;
+mod window;
 pub mod workspace;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-
-use eframe::egui;
 
 use crate::accel::Accel;
 use crate::render::session::SessionEvent;
 use crate::render::{Image, RenderSettings};
 use crate::scene::{self, Scene};
 use crate::trace::{TraceSettings, Tracer};
-use dialog::BrowseFor;
 use messages::Messages;
 pub use render_view::PANE_SIZE_DEBOUNCE;
 use render_view::{Reach, RenderView};
@@ -52,6 +51,7 @@ use selection::TreeSelection;
 pub use selection::{MAX_TREES, remap_pixel};
 use undo::WorkingCopy;
 use viewport::GpuDisplay;
+pub use window::run;
 pub use workspace::{Prefs, SETTINGS_MIN_WIDTH, VIEWER_SAMPLES, Workspace};
 
 /// Everything a panel can ask for; applied once at the end of the frame.
@@ -103,52 +103,6 @@ pub struct ViewerApp {
     /// The preferences, the settings panel, the file dialog and the windows.
     pub workspace: Workspace,
     pending: Vec<Command>,
-}
-
-/// Opens the window and runs the viewer until it is closed.
-pub fn run(scene_arg: Option<&str>) -> anyhow::Result<()> {
-    // A file is opened in the background once the window is up (a big mesh takes seconds to
-    // read and build): the window shows the default scene and the open's progress meanwhile.
-    // Built-in scene names and missing files are answered at once.
-    let mut background = None;
-    let (scene, label) = match scene_arg {
-        Some(arg) if Path::new(arg).is_file() => {
-            background = Some(PathBuf::from(arg));
-            (
-                scene::builtin::load_builtin("default")?,
-                "default".to_string(),
-            )
-        }
-        Some(arg) => (scene::open_scene_arg(arg)?, arg.to_string()),
-        None => (
-            scene::builtin::load_builtin("default")?,
-            "default".to_string(),
-        ),
-    };
-    let options = eframe::NativeOptions {
-        renderer: eframe::Renderer::Wgpu,
-        viewport: egui::ViewportBuilder::default()
-            .with_title("raytree")
-            .with_inner_size([1400.0, 900.0])
-            .with_drag_and_drop(true),
-        ..Default::default()
-    };
-    eframe::run_native(
-        "raytree",
-        options,
-        Box::new(move |cc| {
-            let mut app = ViewerApp::new(cc, scene, label).map_err(|e| -> Box<dyn std::error::Error + Send + Sync> { e.into() })?;
-            if let Some(path) = background {
-                app.command(Command::OpenFile(path));
-            }
-            Ok(Box::new(app))
-        }),
-    )
-    .map_err(|e| {
-        anyhow::anyhow!(
-            "cannot open the viewer window ({e}); without a display or graphics adapter, use `raytree render SCENE -o out.png`"
-        )
-    })
 }
 
 impl ViewerApp {
@@ -236,9 +190,8 @@ impl ViewerApp {
     /// Sets the viewer's sample target and whether the render follows the pane's size, and
     /// renders again with them.
     pub fn set_view(&mut self, viewer_samples: u32, pane_size: bool) {
-        set_view(
+        self.render.set_view(
             &mut self.workspace.prefs,
-            &mut self.render,
             &mut self.pending,
             viewer_samples,
             pane_size,
@@ -365,91 +318,6 @@ impl ViewerApp {
             }
             None => false,
         }
-    }
-
-    /// True while a saved change waits for its reload (the UI keeps polling).
-    pub fn reload_pending(&self) -> bool {
-        self.files.reload_pending()
-    }
-
-    /// Opens `path` (or reloads it after a save, `reload`) in the background: read, parse and
-    /// build off the UI thread, the scene shown staying up until the new one is ready. Cancels
-    /// an open already under way (its result is never installed). A reload of the same
-    /// geometry keeps the camera (as moved in the viewer), the trees and the accelerator.
-    fn start_open(&mut self, path: PathBuf, reload: bool) {
-        let request = opening::Request {
-            path,
-            settings: self.working.settings.trace,
-            pane: self.render.pane(&self.workspace.prefs),
-            max_side: self.render.max_side,
-            reload: reload.then(|| {
-                (
-                    self.render.tracer.clone(),
-                    self.working.scene.camera.clone(),
-                )
-            }),
-            hook: None,
-        };
-        self.files
-            .start(request, &self.working.scene, &mut self.messages);
-    }
-
-    /// Takes the result of the background open, when it is ready.
-    fn poll_open(&mut self) {
-        let Some((job, outcome)) = self.files.take_finished() else {
-            return;
-        };
-        match outcome {
-            opening::Outcome::Opened(opened) => self.install_opened(&job.path, job.reload, *opened),
-            // The message names the file, place and field; the old scene stays.
-            opening::Outcome::Failed(e) if job.reload => self.messages.error(format!(
-                "{e} (after a save; the last good scene stays until the file loads again)"
-            )),
-            opening::Outcome::Failed(e) => {
-                self.messages.error(e);
-                // The scene shown is watched again.
-                self.files.watch(&self.working.scene, &mut self.messages);
-            }
-        }
-    }
-
-    /// Makes an opened (or reloaded) scene the one shown and rendered.
-    fn install_opened(&mut self, path: &Path, reload: bool, opened: opening::Opened) {
-        let opening::Opened {
-            edit,
-            tracer,
-            fit,
-            same_geometry,
-            timings,
-        } = opened;
-        let reloaded = format!("reloaded {} after a save", path.display());
-        if same_geometry {
-            for w in &edit.warnings {
-                self.messages.notice(w.clone());
-            }
-            // The camera as it is now (it may have moved while the file was read), the
-            // accelerator shown kept: rendered as any edit is.
-            let camera = self.working.scene.camera.clone();
-            self.working.scene = edit;
-            self.working.scene.camera = camera;
-            self.messages.notice(reloaded);
-            self.files.learn(timings);
-            self.files.watch(&self.working.scene, &mut self.messages);
-            self.restart(false, Reach::RenderAndSceneView);
-            return;
-        }
-        self.replace_scene(edit, path.display().to_string());
-        if reload {
-            self.messages.notice(reloaded);
-        }
-        if let Some(message) = fit.message {
-            self.messages.error(message);
-        }
-        self.render.scene_size = fit.scene;
-        self.files.learn(timings);
-        self.files.watch(&self.working.scene, &mut self.messages);
-        self.render.pending_build = None;
-        self.start_generation(tracer, Reach::RenderAndSceneView);
     }
 
     /// Takes the tiles that arrived, within a time budget so the UI stays responsive.
@@ -583,233 +451,5 @@ impl ViewerApp {
             };
             self.restart(rebuild, reach);
         }
-    }
-
-    /// Makes `s` the working copy, named `label`: nothing of the old scene stays picked, the
-    /// scene view frames the new one, and the history starts over.
-    fn replace_scene(&mut self, s: Scene, label: String) {
-        for w in &s.warnings {
-            self.messages.notice(w.clone());
-        }
-        self.working.scene = s;
-        self.working.history = undo::History::default();
-        self.files.label = label;
-        self.selection.clear();
-        self.scene_view.unframe();
-    }
-}
-
-/// Sets the viewer's sample target and whether the render follows the pane's size, and asks
-/// for a render with them.
-fn set_view(
-    prefs: &mut Prefs,
-    render: &mut RenderView,
-    pending: &mut Vec<Command>,
-    viewer_samples: u32,
-    pane_size: bool,
-) {
-    prefs.viewer_samples = viewer_samples.clamp(1, scene::rules::MAX_SAMPLES);
-    prefs.pane_size = pane_size;
-    if !pane_size {
-        render.unfollow_pane();
-    }
-    pending.push(Command::Restart);
-}
-
-impl eframe::App for ViewerApp {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
-        let ctx = ui.ctx().clone();
-        self.poll_session();
-        self.render.poll_export(&mut self.messages);
-        input::shortcuts(
-            &ctx,
-            &mut self.workspace,
-            &mut self.working,
-            &mut self.pending,
-        );
-        let toggle = egui::KeyboardShortcut::new(egui::Modifiers::COMMAND, egui::Key::B);
-        if ctx.input_mut(|i| i.consume_shortcut(&toggle)) {
-            self.workspace.toggle_settings_panel(&mut self.messages);
-        }
-        panels::top_bar(
-            ui,
-            &mut self.workspace,
-            &mut self.working,
-            &self.files,
-            &mut self.messages,
-            &mut self.pending,
-        );
-        let finished = self.is_finished();
-        let target = self.viewer_target();
-        panels::status_bar(
-            ui,
-            &self.render,
-            &mut self.files,
-            &self.selection,
-            target,
-            finished,
-        );
-        // Hover is transient: the views set it again while the pointer stays on a node.
-        self.selection.tree_state.hovered = None;
-        scene_pane::advance_playback(&mut self.scene_view, &mut self.selection, &ctx);
-        self.workspace
-            .settle_settings_panel(ctx.content_rect().width(), &mut self.messages);
-        if !self.workspace.prefs.settings_panel {
-            // A slim strip keeps the hidden settings one click away.
-            egui::Panel::left("settings strip")
-                .resizable(false)
-                .exact_size(30.0)
-                .show(ui, |ui| {
-                    if ui
-                        .button("»")
-                        .on_hover_text("show the settings (Ctrl+B)")
-                        .clicked()
-                    {
-                        self.workspace.toggle_settings_panel(&mut self.messages);
-                    }
-                });
-        } else {
-            egui::Panel::left("settings")
-                .resizable(true)
-                .default_size(290.0)
-                .show(ui, |ui| {
-                    ui.with_layout(egui::Layout::right_to_left(egui::Align::Min), |ui| {
-                        if ui
-                            .small_button("« hide")
-                            .on_hover_text("hide the settings (Ctrl+B); the render gets the room")
-                            .clicked()
-                        {
-                            self.workspace.toggle_settings_panel(&mut self.messages);
-                        }
-                    });
-                    // Scrolled both ways: wide content (an opened material) scrolls instead of
-                    // widening the panel, which would move and resize the render.
-                    egui::ScrollArea::both().show(ui, |ui| {
-                        panels::side_panel(
-                            ui,
-                            &mut self.working,
-                            &mut self.workspace.prefs,
-                            &mut self.render,
-                            &self.selection,
-                            &mut self.pending,
-                        )
-                    });
-                });
-        }
-        // The panes fill the central panel edge to edge.
-        let frame = egui::Frame::central_panel(ui.style()).inner_margin(0);
-        egui::CentralPanel::default()
-            .frame(frame)
-            .show(ui, |ui| workspace::show(self, ui, pane_ui));
-        if let Some(command) = self.workspace.show_browser(&ctx) {
-            self.pending.push(command);
-        }
-        panels::help_window(&ctx, &mut self.workspace.show_help);
-        let has_tree = self.selection.tree.is_some();
-        panels::export_window(&ctx, &mut self.workspace, has_tree, &self.files.file_stem());
-        let working = &mut self.working;
-        let sweep = &mut self.workspace.sweep;
-        if sweep.open
-            && let Some(point) = sweep.show(&ctx, &working.scene, &working.settings.trace)
-        {
-            // A clicked point: its settings become the viewer's; say what changed.
-            if let Some(text) = sweep.applied.clone() {
-                self.messages.notice(text);
-            }
-            working.scene.render.max_depth = point.max_depth;
-            working.scene.render.samples = point.samples;
-            working.settings.trace = point.trace;
-            self.pending.push(Command::Rebuild);
-        }
-        self.messages.show(&ctx);
-        self.apply();
-        self.working.track(&ctx);
-        self.render.follow_display_prefs(&self.workspace.prefs);
-        if !self.is_finished() || !self.scene_view.is_finished() || self.render.export_job.is_some()
-        {
-            ctx.request_repaint();
-        } else if self.files.is_watched() {
-            // Idle: wake up now and then to see whether the scene was saved.
-            ctx.request_repaint_after(watch::DEBOUNCE);
-        }
-    }
-
-    fn save(&mut self, storage: &mut dyn eframe::Storage) {
-        eframe::set_value(storage, eframe::APP_KEY, &self.workspace.prefs);
-    }
-}
-
-/// What each pane of the workspace shows.
-fn pane_ui(app: &mut ViewerApp, ui: &mut egui::Ui, pane: workspace::Pane) {
-    use workspace::Pane;
-    match pane {
-        Pane::Render => input::render_pane(
-            ui,
-            &mut app.render,
-            &mut app.selection,
-            &mut app.working.scene.camera,
-            &app.workspace.prefs,
-            &app.scene_view.filter,
-            &mut app.pending,
-        ),
-        Pane::SceneView => scene_pane::scene_view_ui(
-            ui,
-            &mut app.scene_view,
-            &app.render.tracer,
-            &mut app.selection,
-            &mut app.working.scene,
-            &app.workspace.prefs,
-            &mut app.pending,
-        ),
-        Pane::Diagram => match app.selection.tree.clone() {
-            Some(tree) => {
-                if tree_view::diagram(ui, &tree, &mut app.selection.tree_state) {
-                    let name = format!("tree-{}-{}.svg", tree.pixel[0], tree.pixel[1]);
-                    app.workspace.browse(BrowseFor::ExportDiagram, &name);
-                }
-            }
-            None => {
-                ui.weak("click a pixel in the render view for its ray tree");
-            }
-        },
-        Pane::TreeList => {
-            if app.selection.tree.is_some() {
-                panels::tree_panel(
-                    ui,
-                    &mut app.selection,
-                    &mut app.workspace,
-                    &app.render.tracer,
-                );
-            } else {
-                ui.weak(
-                    "click a pixel in the render view for its ray tree; shift-click adds more pixels",
-                );
-            }
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn preferences_saved_before_layout_versions_get_the_new_layout() {
-        let old: Prefs = serde_json::from_str(r#"{"exposure": 2.0}"#).expect("old prefs");
-        assert_eq!(old.layout_version, 0);
-        assert_eq!(old.exposure, 2.0);
-        assert_eq!(old.viewer_samples, VIEWER_SAMPLES);
-        assert!(old.pane_size);
-        let now = Prefs::default();
-        assert_eq!(now.layout_version, workspace::LAYOUT_VERSION);
-        assert_eq!(old.checked().layout_version, workspace::LAYOUT_VERSION);
-    }
-
-    #[test]
-    fn the_tonemap_is_saved_as_the_number_the_shader_reads() {
-        let prefs: Prefs = serde_json::from_str(r#"{"tonemap": 2}"#).expect("prefs");
-        assert_eq!(prefs.tonemap, viewport::Tonemap::Aces);
-        let json = serde_json::to_value(&prefs).expect("serialises");
-        assert_eq!(json["tonemap"], 2);
     }
 }

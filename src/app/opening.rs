@@ -1,11 +1,11 @@
-//! Opening a scene file off the UI thread (issue 14.5, SPEC §4: the window never freezes). One
-//! background job reads the file (in chunks, with the bytes counted), parses it (meshes,
-//! materials, attributes, the first look of a bare OBJ), makes the viewer's copy at the render
-//! size and builds the accelerator (on rayon's global pool, beside the render's workers); the
-//! UI keeps drawing the previous scene and takes the result when it is ready
-//! ([`OpenJob::try_take`]). A newer open, an accelerator change or a
-//! reload cancels the job: its flag is checked at every stage boundary (and between chunks
-//! of the read), and a cancelled job never sends a result.
+//! Opening a scene file off the UI thread, so the window never freezes (docs/design.md, "The
+//! viewer"). One background job reads the file (in chunks, with the bytes counted), parses it
+//! (meshes, materials, attributes, the first look of a bare OBJ), makes the viewer's copy at
+//! the render size and builds the accelerator (on rayon's global pool, beside the render's
+//! workers); the UI keeps drawing the previous scene and takes the result when it is ready
+//! ([`OpenJob::try_take`]). A newer open, an accelerator change or a reload cancels the job:
+//! its flag is checked at every stage boundary (and between chunks of the read), and a
+//! cancelled job never sends a result.
 //!
 //! Progress is stage-weighted (see [`OpenJob::percent`] and the README): the read is counted in
 //! bytes; the parse and the build, which report nothing, are timed against estimates from the

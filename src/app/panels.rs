@@ -340,7 +340,7 @@ fn view_settings(
         )
         .changed();
     if changed_target || changed_pane {
-        super::set_view(prefs, render, pending, target, pane);
+        render.set_view(prefs, pending, target, pane);
     }
 }
 

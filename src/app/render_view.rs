@@ -8,11 +8,11 @@ use std::time::{Duration, Instant};
 
 use eframe::egui;
 
-use super::Prefs;
 use super::film::Film;
 use super::messages::{Message, Messages};
 use super::modes::ImageMode;
 use super::viewport::{self, DisplayState, Pixels, SharedDisplay};
+use super::{Command, Prefs};
 use crate::accel::Accel;
 use crate::render::Image;
 use crate::render::session::{Pass, Session};
@@ -185,9 +185,21 @@ impl RenderView {
         self.pane.seen.map(|(px, _)| px).filter(|_| prefs.pane_size)
     }
 
-    /// The render stops following the pane.
-    pub fn unfollow_pane(&mut self) {
-        self.pane.follows = None;
+    /// Sets the viewer's sample target and whether the render follows the pane's size in
+    /// `prefs`, and asks for a render with them.
+    pub fn set_view(
+        &mut self,
+        prefs: &mut Prefs,
+        pending: &mut Vec<Command>,
+        viewer_samples: u32,
+        pane_size: bool,
+    ) {
+        prefs.viewer_samples = viewer_samples.clamp(1, scene::rules::MAX_SAMPLES);
+        prefs.pane_size = pane_size;
+        if !pane_size {
+            self.pane.follows = None;
+        }
+        pending.push(Command::Restart);
     }
 
     /// Starts a generation of `tracer`, whose accelerator is built.

@@ -731,7 +731,7 @@ mod tests {
 
     /// A flat floor with a few objects, seen from above at an angle: every corner lies inside
     /// the view with the margin, one of them on its edge (the fit is tight), and the camera is
-    /// closer than the bounding sphere's framing (which the pane used before) puts it.
+    /// closer than framing the bounding sphere would put it.
     #[test]
     fn corner_fit_frames_a_flat_box_tightly() {
         let (lo, hi) = (Vec3::new(-12.0, 0.0, -12.0), Vec3::new(12.0, 2.0, 12.0));

@@ -368,6 +368,26 @@ mod tests {
     use super::*;
 
     #[test]
+    fn preferences_saved_before_layout_versions_get_the_new_layout() {
+        let old: Prefs = serde_json::from_str(r#"{"exposure": 2.0}"#).expect("old prefs");
+        assert_eq!(old.layout_version, 0);
+        assert_eq!(old.exposure, 2.0);
+        assert_eq!(old.viewer_samples, VIEWER_SAMPLES);
+        assert!(old.pane_size);
+        let now = Prefs::default();
+        assert_eq!(now.layout_version, LAYOUT_VERSION);
+        assert_eq!(old.checked().layout_version, LAYOUT_VERSION);
+    }
+
+    #[test]
+    fn the_tonemap_is_saved_as_the_number_the_shader_reads() {
+        let prefs: Prefs = serde_json::from_str(r#"{"tonemap": 2}"#).expect("prefs");
+        assert_eq!(prefs.tonemap, Tonemap::Aces);
+        let json = serde_json::to_value(&prefs).expect("serialises");
+        assert_eq!(json["tonemap"], 2);
+    }
+
+    #[test]
     fn the_default_layout_is_usable_and_survives_a_round_trip() {
         let layout = default_layout();
         assert!(usable(&layout));
