@@ -767,7 +767,7 @@ fn render_at_pane_size_follows_the_window_and_export_keeps_the_scene_size() {
     let out = dir.path().join("shot.png");
     export_via(&mut h, "Render (PNG or EXR)", &out);
     let deadline = Instant::now() + Duration::from_secs(60);
-    while h.state().render.export_job.is_some() {
+    while h.state().render.exporting() {
         assert!(Instant::now() < deadline, "the export did not finish");
         h.step();
         std::thread::sleep(Duration::from_millis(20));

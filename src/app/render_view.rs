@@ -46,15 +46,15 @@ impl Reach {
 /// Progress of the current generation, as the UI saw it.
 #[derive(Clone, Debug, Default)]
 pub struct Progress {
-    pub started: Option<Instant>,
+    pub(super) started: Option<Instant>,
     /// Samples per pixel of the last complete pass (0: only the preview, or nothing yet).
-    pub samples_done: u32,
-    pub preview_done: bool,
-    pub finished_secs: Option<f64>,
+    pub(super) samples_done: u32,
+    pub(super) preview_done: bool,
+    pub(super) finished_secs: Option<f64>,
     /// What the status bar says of the pass under way: "preview", "4 samples", "stopped".
-    pub pass_label: String,
+    pub(super) pass_label: String,
     /// The largest build percentage shown, so it never goes back.
-    pub build_percent: f64,
+    pub(super) build_percent: f64,
 }
 
 impl Progress {
@@ -102,26 +102,26 @@ struct PaneSize {
 /// The render view's state.
 pub struct RenderView {
     /// The tracer of the current generation; its scene is the one rendered.
-    pub tracer: Arc<Tracer>,
-    pub session: Session,
+    pub(super) tracer: Arc<Tracer>,
+    pub(super) session: Session,
     generation: u64,
     /// A build asked of the session and not yet installed, and which views its generation
     /// restarts; while it is, the current tracer's accelerator does not fit the working copy,
     /// so every restart builds (a stop in the middle of a build drops it).
-    pub pending_build: Option<Reach>,
-    pub progress: Progress,
+    pub(super) pending_build: Option<Reach>,
+    pub(super) progress: Progress,
     /// The film as the latest tiles left it: linear colour and sample-0 facts per pixel.
-    pub film: Film,
-    pub display: SharedDisplay,
+    pub(super) film: Film,
+    pub(super) display: SharedDisplay,
     pane: PaneSize,
     /// The scene's own width and height (the working copy's, kept when an edit is refused).
-    pub scene_size: (u32, u32),
+    pub(super) scene_size: (u32, u32),
     /// The largest texture side the GPU allows: the render is never larger on screen.
-    pub max_side: u32,
+    pub(super) max_side: u32,
     /// The image mode the display was last painted in.
     painted_mode: ImageMode,
     /// An export rendering at the scene's size in the background: its message when done.
-    pub export_job: Option<Receiver<Message>>,
+    pub(super) export_job: Option<Receiver<Message>>,
 }
 
 impl RenderView {
@@ -328,6 +328,11 @@ impl RenderView {
             self.refresh_display(prefs);
         }
         self.painted_mode = prefs.mode;
+    }
+
+    /// Whether an export is rendering in the background.
+    pub fn exporting(&self) -> bool {
+        self.export_job.is_some()
     }
 
     /// Takes the message of a finished background export.

@@ -108,10 +108,10 @@ pub struct Workspace {
     settings_settled: bool,
     /// How the tree's panes were last set (`None`: not yet, or the layout was reset).
     tree_panes: Option<TreePanes>,
-    pub browser: Option<FileBrowser>,
-    pub show_help: bool,
+    pub(super) browser: Option<FileBrowser>,
+    pub(super) show_help: bool,
     /// The Ctrl+S window: which picture to export.
-    pub export_choice: bool,
+    pub(super) export_choice: bool,
     /// The "Speed vs accuracy" window and its background sweep.
     pub sweep: SweepWindow,
 }
