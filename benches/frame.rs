@@ -70,7 +70,7 @@ fn main() {
         .with_size([1600.0, 1000.0])
         .renderer(renderer)
         .build_eframe(|cc| {
-            // The scene's size and sample count, as before the viewer's own target.
+            // The scene's size and sample count, not the viewer's own target (quick to settle).
             let samples = scene.render.samples;
             let mut app = ViewerApp::new(cc, scene, "kitchen".into()).expect("the viewer");
             app.set_view(samples, false);

@@ -45,7 +45,7 @@ pub struct Prefs {
     /// Render at the render pane's pixel size (the scene's width and height are kept for
     /// export and saving); off: render at the scene's size.
     pub pane_size: bool,
-    /// Whether the settings panel on the left is shown (F9).
+    /// Whether the settings panel on the left is shown (Ctrl+B).
     pub settings_panel: bool,
 }
 
