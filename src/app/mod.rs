@@ -46,6 +46,7 @@ use crate::trace::{TraceSettings, Tracer};
 use messages::Messages;
 pub use render_view::PANE_SIZE_DEBOUNCE;
 use render_view::{Reach, RenderView};
+use saving::Drawn;
 use scene_files::SceneFiles;
 use selection::TreeSelection;
 pub use selection::{MAX_TREES, remap_pixel};
@@ -407,8 +408,8 @@ impl ViewerApp {
                 },
                 Command::SaveScene(path) => self.save_scene(&path),
                 Command::Export(path) => self.export(&path),
-                Command::ExportOverlay(path) => self.export_drawn(&path, false),
-                Command::ExportSceneView(path) => self.export_drawn(&path, true),
+                Command::ExportOverlay(path) => self.export_drawn(&path, Drawn::Overlay),
+                Command::ExportSceneView(path) => self.export_drawn(&path, Drawn::SceneView),
                 Command::ExportTree(path) => self.export_tree(&path),
                 Command::ExportDiagram(path) => self.export_diagram(&path),
                 Command::PickMore(x, y) => {

@@ -12,6 +12,15 @@ use crate::ray_tree::RayTree;
 use crate::scene;
 use crate::trace::Tracer;
 
+/// A picture drawn with the trees.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Drawn {
+    /// The render with the trees drawn over it, as in the render view.
+    Overlay,
+    /// The scene view's camera at the scene's size.
+    SceneView,
+}
+
 impl ViewerApp {
     /// Writes the working copy as a scene file.
     pub(super) fn save_scene(&mut self, path: &Path) {
@@ -134,9 +143,8 @@ impl ViewerApp {
         }
     }
 
-    /// Writes the render with the trees drawn over it (`scene_view`: false) or the scene view
-    /// at the scene's size (true) as a stamped PNG, drawn by the headless scene view's rules.
-    pub(super) fn export_drawn(&mut self, path: &Path, scene_view: bool) {
+    /// Writes `picture` as a stamped PNG, drawn by the headless scene view's rules.
+    pub(super) fn export_drawn(&mut self, path: &Path, picture: Drawn) {
         let Some(tree) = self.selection.tree.clone() else {
             self.messages
                 .error("no ray tree to draw: click a pixel first");
@@ -147,7 +155,7 @@ impl ViewerApp {
             ..self.scene_view.filter.clone()
         };
         let scene = self.render.scene().clone();
-        let drawn = if scene_view {
+        let drawn = if picture == Drawn::SceneView {
             let (w, h) = self.render.scene_size;
             crate::scene_view::headless::scene_view_image(
                 &scene,
