@@ -326,7 +326,7 @@ impl ViewerApp {
         if self.files.saved()
             && let Some(path) = self.working.scene.source.clone()
         {
-            self.start_open(path, true);
+            self.start_open(path, opening::OpenKind::Reload);
         }
         self.poll_open();
         // A tracer built off the UI thread comes before its generation's first tile.
@@ -394,7 +394,7 @@ impl ViewerApp {
                     rebuild = true;
                 }
                 // Read, parsed and built in the background ([`opening`]).
-                Command::OpenFile(path) => self.start_open(path, false),
+                Command::OpenFile(path) => self.start_open(path, opening::OpenKind::Open),
                 Command::OpenBuiltin(name) => match scene::builtin::load_builtin(&name) {
                     Ok(s) => {
                         // Built-in scenes are tiny: opened at once, superseding any open.
@@ -441,8 +441,8 @@ impl ViewerApp {
             && let Some(job) = self.files.job()
             && job.accel != self.working.settings.trace.accel
         {
-            let (path, reload) = (job.path.clone(), job.reload);
-            self.start_open(path, reload);
+            let (path, kind) = (job.path.clone(), job.kind);
+            self.start_open(path, kind);
         }
         if restart {
             let reach = if camera_only {

@@ -4,8 +4,9 @@
 
 use std::path::{Path, PathBuf};
 
+use super::opening::{self, OpenKind};
 use super::render_view::Reach;
-use super::{ViewerApp, opening, undo};
+use super::{ViewerApp, undo};
 use crate::scene::Scene;
 
 impl ViewerApp {
@@ -14,17 +15,17 @@ impl ViewerApp {
         self.files.reload_pending()
     }
 
-    /// Opens `path` (or reloads it after a save, `reload`) in the background: read, parse and
+    /// Opens `path` (or reloads it after a save) in the background: read, parse and
     /// build off the UI thread, the scene shown staying up until the new one is ready. Cancels
     /// an open already under way (its result is never installed). A reload of the same
     /// geometry keeps the camera (as moved in the viewer), the trees and the accelerator.
-    pub(super) fn start_open(&mut self, path: PathBuf, reload: bool) {
+    pub(super) fn start_open(&mut self, path: PathBuf, kind: OpenKind) {
         let request = opening::Request {
             path,
             settings: self.working.settings.trace,
             pane: self.render.pane(&self.workspace.prefs),
             max_side: self.render.max_side,
-            reload: reload.then(|| {
+            reload: (kind == OpenKind::Reload).then(|| {
                 (
                     self.render.tracer.clone(),
                     self.working.scene.camera.clone(),
@@ -42,11 +43,11 @@ impl ViewerApp {
             return;
         };
         match outcome {
-            opening::Outcome::Opened(opened) => self.install_opened(&job.path, job.reload, *opened),
+            opening::Outcome::Opened(opened) => self.install_opened(&job.path, job.kind, *opened),
             // The message names the file, place and field; the old scene stays.
-            opening::Outcome::Failed(e) if job.reload => self.messages.error(format!(
-                "{e} (after a save; the last good scene stays until the file loads again)"
-            )),
+            opening::Outcome::Failed(e) if job.kind == OpenKind::Reload => self.messages.error(
+                format!("{e} (after a save; the last good scene stays until the file loads again)"),
+            ),
             opening::Outcome::Failed(e) => {
                 self.messages.error(e);
                 // The scene shown is watched again.
@@ -56,7 +57,7 @@ impl ViewerApp {
     }
 
     /// Makes an opened (or reloaded) scene the one shown and rendered.
-    fn install_opened(&mut self, path: &Path, reload: bool, opened: opening::Opened) {
+    fn install_opened(&mut self, path: &Path, kind: OpenKind, opened: opening::Opened) {
         let opening::Opened {
             edit,
             tracer,
@@ -81,7 +82,7 @@ impl ViewerApp {
             return;
         }
         self.replace_scene(edit, path.display().to_string());
-        if reload {
+        if kind == OpenKind::Reload {
             self.messages.notice(reloaded);
         }
         if let Some(message) = fit.message {

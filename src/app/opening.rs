@@ -234,11 +234,20 @@ pub enum Outcome {
     Failed(String),
 }
 
+/// Why a file is opened.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OpenKind {
+    /// Another scene, asked for by the user.
+    Open,
+    /// The scene shown, again, after a save.
+    Reload,
+}
+
 /// An open under way.
 pub struct OpenJob {
     pub path: PathBuf,
     /// Whether it reloads the open scene after a save.
-    pub reload: bool,
+    pub kind: OpenKind,
     /// The accelerator it builds.
     pub accel: crate::accel::AccelKind,
     cancel: Arc<AtomicBool>,
@@ -259,7 +268,11 @@ impl OpenJob {
         let (sender, receiver) = channel();
         let job = Self {
             path: request.path.clone(),
-            reload: request.reload.is_some(),
+            kind: if request.reload.is_some() {
+                OpenKind::Reload
+            } else {
+                OpenKind::Open
+            },
             accel: request.settings.accel,
             cancel: cancel.clone(),
             progress: progress.clone(),
