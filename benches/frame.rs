@@ -70,11 +70,11 @@ fn main() {
         .with_size([1600.0, 1000.0])
         .renderer(renderer)
         .build_eframe(|cc| {
-            // The scene's size and sample count, as before the viewer's own target.
+            // The scene's size and sample count, not the viewer's own target (quick to settle).
             let samples = scene.render.samples;
             let mut app = ViewerApp::new(cc, scene, "kitchen".into()).expect("the viewer");
             app.set_view(samples, false);
-            app.set_settings_panel(true);
+            app.workspace.set_settings_panel(true);
             app
         });
     settle(&mut h);
@@ -87,8 +87,8 @@ fn main() {
         [w * 7 / 8, h_px * 7 / 8],
     ));
     h.step();
-    let trees = h.state().trees().count();
-    let nodes: usize = h.state().trees().map(|t| t.nodes).sum();
+    let trees = h.state().selection.trees().count();
+    let nodes: usize = h.state().selection.trees().map(|t| t.nodes).sum();
     // The selected ray's visits are on by default; add every box of one BVH level.
     let levels = h.state().accel().levels();
     let last = levels.saturating_sub(1);

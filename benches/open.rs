@@ -2,8 +2,8 @@
 //! benchmark torus as a bare OBJ while the UI loop runs (poll + apply, a 16 ms sleep between
 //! frames, as a window would). Per frame: the wall time and the UI thread's own CPU time and
 //! run-queue wait (`/proc/thread-self/schedstat`), so a frame stretched by a loaded machine is
-//! told apart from one that worked. Beside it, in the same run, what the UI thread used to do
-//! on open: the whole load (`load_scene_file`) and the scene view's copy of the scene.
+//! told apart from one that worked. Beside it, in the same run, what opening on the UI thread
+//! would cost: the whole load (`load_scene_file`) and the scene view's copy of the scene.
 //!
 //! Run: `cargo bench --bench open -- --triangles 1000000 --runs 3 --threads 2`
 
@@ -83,7 +83,7 @@ fn main() {
         let (mut by_wall, mut by_cpu) = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0));
         let mut frames = 0;
         let mut installed_after = None;
-        while app.opening().is_some() || app.samples_done() == 0 {
+        while app.files.opening().is_some() || app.samples_done() == 0 {
             let (c0, w0) = schedstat();
             let f = Instant::now();
             app.poll_session();
@@ -97,7 +97,7 @@ fn main() {
             if frame.1 > by_cpu.1 {
                 by_cpu = frame;
             }
-            if installed_after.is_none() && app.opening().is_none() {
+            if installed_after.is_none() && app.files.opening().is_none() {
                 installed_after = Some(t.elapsed().as_secs_f64());
             }
             frames += 1;
@@ -123,7 +123,7 @@ fn main() {
         );
         println!("  longest frame by wall time: {}", ms(by_wall));
         println!("  longest frame by CPU time:  {}", ms(by_cpu));
-        if let Some(o) = app.last_open {
+        if let Some(o) = app.files.last_open {
             println!(
                 "  background: read {:.2} s, parse {:.2} s, copy + build {:.2} s ({} triangles)",
                 o.read_secs, o.parse_secs, o.build_secs, o.triangles

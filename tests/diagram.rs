@@ -396,34 +396,23 @@ fn the_cli_writes_the_diagram() {
     assert!(texts.iter().any(|t| t == "glass sphere"), "{texts:?}");
 }
 
+/// The viewer test harness (tests/common/viewer.rs).
+#[cfg(feature = "viewer")]
+#[path = "common/viewer.rs"]
+mod harness;
+
 /// The viewer's diagram pane, through egui_kittest (see tests/viewer.rs).
 #[cfg(feature = "viewer")]
 mod viewer {
-    use std::time::{Duration, Instant};
-
     use eframe::egui;
-    use egui_kittest::Harness;
     use egui_kittest::kittest::Queryable;
-    use raytree::app::ViewerApp;
-    use raytree::scene::builtin::load_builtin;
+
+    use super::harness::{settle_render, sized, window};
 
     #[test]
     fn the_glass_spheres_tree_fits_its_pane_zooms_and_pans() {
-        let mut scene = load_builtin("default").expect("built-in scene");
-        scene.render.width = 160;
-        scene.render.height = 120;
-        let mut h = Harness::builder()
-            .with_size([1600.0, 1000.0])
-            .renderer(egui_kittest::wgpu::WgpuTestRenderer::new())
-            .build_eframe(|cc| {
-                ViewerApp::new(cc, scene, "test".into()).expect("the viewer starts")
-            });
-        let deadline = Instant::now() + Duration::from_secs(120);
-        while !h.state().is_finished() {
-            assert!(Instant::now() < deadline, "the render did not finish");
-            h.step();
-            std::thread::sleep(Duration::from_millis(2));
-        }
+        let mut h = window(sized("default", 160, 120, None), [1600.0, 1000.0]);
+        settle_render(&mut h, "the render did not finish");
         h.step();
         // Pixel (75, 62) of the 160×120 image is on the glass sphere: a 13-node tree.
         let image = h.get_by_label("render viewport").rect();
@@ -441,7 +430,12 @@ mod viewer {
         for _ in 0..4 {
             h.step();
         }
-        let tree = h.state().tree.clone().expect("a tree after the click");
+        let tree = h
+            .state()
+            .selection
+            .tree
+            .clone()
+            .expect("a tree after the click");
         assert!(
             tree.nodes >= 9,
             "the glass sphere's tree: {} nodes",

@@ -7,67 +7,22 @@
 //! Update the snapshot after a deliberate change (look at it first):
 //! `UPDATE_SNAPSHOTS=1 cargo test --release --test viewer`
 
-use std::panic::AssertUnwindSafe;
+#[path = "common/viewer.rs"]
+mod viewer;
+
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use eframe::egui;
 use egui::accesskit::Role;
-use egui_kittest::Harness;
 use egui_kittest::kittest::NodeT as _;
 use egui_kittest::kittest::Queryable;
-use raytree::app::ViewerApp;
+use raytree::app::messages::Message;
 use raytree::render::render;
 use raytree::scene::Scene;
-use raytree::scene::builtin::load_builtin;
 use raytree::trace::{TraceSettings, Tracer};
-
-fn small(name: &str) -> Scene {
-    let mut s = load_builtin(name).expect("built-in scene");
-    s.render.width = 160;
-    s.render.height = 120;
-    s
-}
-
-/// The viewer at 1280×800 rendering the scene at its own size to its own sample count (so
-/// its image equals the batch render's), the settings shown.
-fn harness(scene: Scene) -> Harness<'static, ViewerApp> {
-    let samples = scene.render.samples;
-    let mut h = window(scene, [1280.0, 800.0]);
-    h.state_mut().set_view(samples, false);
-    h.state_mut().set_settings_panel(true);
-    h.step();
-    h
-}
-
-/// The viewer in a `size` window, as a new user gets it: the viewer's sample target, the
-/// render at the pane's size, the settings panel as the window's width has it.
-fn window(scene: Scene, size: [f32; 2]) -> Harness<'static, ViewerApp> {
-    let renderer =
-        std::panic::catch_unwind(AssertUnwindSafe(egui_kittest::wgpu::WgpuTestRenderer::new))
-            .unwrap_or_else(|_| {
-                panic!(
-                    "no wgpu adapter for the viewer tests: install Mesa's software Vulkan \
-             (apt-get install mesa-vulkan-drivers libvulkan1), as scripts/install-deps.sh does"
-                )
-            });
-    Harness::builder()
-        .with_size(size)
-        .renderer(renderer)
-        .build_eframe(|cc| ViewerApp::new(cc, scene, "test".into()).expect("the viewer starts"))
-}
-
-/// Steps frames until the progressive renders (render view and scene view) reach their target.
-fn settle(h: &mut Harness<'static, ViewerApp>) {
-    let deadline = Instant::now() + Duration::from_secs(120);
-    while !h.state().is_finished() || !h.state().scene_view.is_finished() {
-        assert!(Instant::now() < deadline, "the render did not finish");
-        h.step();
-        std::thread::sleep(Duration::from_millis(2));
-    }
-    h.step();
-}
+use viewer::{Window, harness, settle, small, window};
 
 fn batch(scene: &Scene) -> raytree::render::Image {
     let tracer = Tracer::new(Arc::new(scene.clone()), TraceSettings::default());
@@ -129,7 +84,7 @@ fn dropping_a_bad_scene_shows_its_error_and_keeps_the_old_scene() {
     h.step();
     // Read and parsed in the background: the error comes when that open ends.
     let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
-    while h.state().opening().is_some() || h.state().messages.is_empty() {
+    while h.state().files.opening().is_some() || h.state().messages.is_empty() {
         assert!(std::time::Instant::now() < deadline, "the open never ended");
         h.step();
     }
@@ -138,20 +93,20 @@ fn dropping_a_bad_scene_shows_its_error_and_keeps_the_old_scene() {
         .state()
         .messages
         .last()
-        .map(|m| m.1.clone())
+        .map(|m| m.text.clone())
         .unwrap_or_default();
     assert!(
         message.contains("broken.toml:2:") && message.contains("radius"),
         "{message}"
     );
     // The message is on screen as a toast, and the quiz scene is still the one shown.
-    assert!(h.state().toasts_shown() >= 1);
+    assert!(h.state().messages.toasts_shown() >= 1);
     assert_eq!(h.state().scene().triangles.len(), triangles);
     assert!(h.state().scene().spheres.is_empty());
 }
 
 /// Ctrl+S, the picture `choice` in the Export window, then `out` in the file dialog.
-fn export_via(h: &mut Harness<'static, ViewerApp>, choice: &str, out: &std::path::Path) {
+fn export_via(h: &mut Window, choice: &str, out: &std::path::Path) {
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
     // A new window lays itself out in its first frame and takes clicks from the second.
     h.step();
@@ -223,7 +178,7 @@ fn ctrl_s_offers_the_render_with_rays_and_the_scene_view() {
     h.step();
     let at = pixel_pos(&h, GLASS.0, GLASS.1);
     click(&mut h, at, egui::Modifiers::NONE);
-    assert!(h.state().tree.is_some());
+    assert!(h.state().selection.tree.is_some());
     let (plain, rays, view) = (
         dir.path().join("plain.png"),
         dir.path().join("rays.png"),
@@ -257,7 +212,7 @@ fn ctrl_s_offers_the_render_with_rays_and_the_scene_view() {
 }
 
 /// Where pixel (`x`, `y`) of the render is on screen.
-fn pixel_pos(h: &Harness<'static, ViewerApp>, x: u32, y: u32) -> egui::Pos2 {
+fn pixel_pos(h: &Window, x: u32, y: u32) -> egui::Pos2 {
     let image = h.get_by_label("render viewport").rect();
     let (w, hh) = (
         h.state().scene().render.width as f32,
@@ -269,7 +224,7 @@ fn pixel_pos(h: &Harness<'static, ViewerApp>, x: u32, y: u32) -> egui::Pos2 {
     )
 }
 
-fn click(h: &mut Harness<'static, ViewerApp>, pos: egui::Pos2, modifiers: egui::Modifiers) {
+fn click(h: &mut Window, pos: egui::Pos2, modifiers: egui::Modifiers) {
     drag(h, pos, egui::Vec2::ZERO, modifiers);
 }
 
@@ -286,7 +241,7 @@ fn the_glass_pixel_is_on_the_glass_sphere() {
 }
 
 /// Line shapes painted inside `rect` in the last frame.
-fn lines_in(h: &Harness<'static, ViewerApp>, rect: egui::Rect) -> usize {
+fn lines_in(h: &Window, rect: egui::Rect) -> usize {
     h.output()
         .shapes
         .iter()
@@ -305,7 +260,12 @@ fn clicking_a_pixel_shows_its_ray_tree_in_every_view() {
     let lines_before = lines_in(&h, scene_view);
     let at = pixel_pos(&h, GLASS.0, GLASS.1);
     click(&mut h, at, egui::Modifiers::NONE);
-    let tree = h.state().tree.clone().expect("a tree after the click");
+    let tree = h
+        .state()
+        .selection
+        .tree
+        .clone()
+        .expect("a tree after the click");
     assert_eq!(tree.pixel, [GLASS.0, GLASS.1]);
     assert!(tree.nodes > 3, "the glass sphere's tree has children");
     let [x, y] = tree.pixel;
@@ -344,7 +304,7 @@ fn clicking_a_pixel_shows_its_ray_tree_in_every_view() {
     h.step();
     h.step();
     assert_eq!(
-        h.state().tree_state.selected.as_deref(),
+        h.state().selection.tree_state.selected.as_deref(),
         Some(&[0usize][..])
     );
     settle(&mut h);
@@ -353,12 +313,7 @@ fn clicking_a_pixel_shows_its_ray_tree_in_every_view() {
 }
 
 /// Drags from `from` by `by` with the primary button, `modifiers` held (by zero: a click).
-fn drag(
-    h: &mut Harness<'static, ViewerApp>,
-    from: egui::Pos2,
-    by: egui::Vec2,
-    modifiers: egui::Modifiers,
-) {
+fn drag(h: &mut Window, from: egui::Pos2, by: egui::Vec2, modifiers: egui::Modifiers) {
     h.event(egui::Event::ModifiersChanged(modifiers));
     h.hover_at(from);
     for (pressed, pos) in [(true, from), (false, from + by)] {
@@ -386,7 +341,7 @@ fn orbiting_the_scene_view_leaves_the_tree_and_the_render_unchanged() {
     settle(&mut h);
     let at = pixel_pos(&h, GLASS.0, GLASS.1);
     click(&mut h, at, egui::Modifiers::NONE);
-    let tree = h.state().tree.clone().expect("a tree");
+    let tree = h.state().selection.tree.clone().expect("a tree");
     let render_camera = h.state().scene().camera.clone();
     let generation = h.state().generation();
     let camera = h.state().scene_view.camera.clone();
@@ -403,7 +358,7 @@ fn orbiting_the_scene_view_leaves_the_tree_and_the_render_unchanged() {
         "the drag did not orbit"
     );
     assert_eq!(
-        h.state().tree.as_ref(),
+        h.state().selection.tree.as_ref(),
         Some(&tree),
         "the tree was re-traced"
     );
@@ -421,10 +376,10 @@ fn shift_click_adds_a_tree_and_a_plain_click_starts_over() {
     click(&mut h, b, egui::Modifiers::SHIFT);
     let c = pixel_pos(&h, 20, 100);
     click(&mut h, c, egui::Modifiers::SHIFT);
-    let pixels: Vec<[u32; 2]> = h.state().trees().map(|t| t.pixel).collect();
+    let pixels: Vec<[u32; 2]> = h.state().selection.trees().map(|t| t.pixel).collect();
     assert_eq!(pixels, vec![[60, 69], [99, 53], [20, 100]]);
     click(&mut h, b, egui::Modifiers::NONE);
-    assert_eq!(h.state().trees().count(), 1);
+    assert_eq!(h.state().selection.trees().count(), 1);
 }
 
 #[test]
@@ -438,7 +393,7 @@ fn the_depth_slider_hides_deeper_segments() {
         .set_value_accesskit(0.0);
     h.step();
     h.step();
-    assert_eq!(h.state().tree_state.reveal, Some(0));
+    assert_eq!(h.state().selection.tree_state.reveal, Some(0));
     let first = h.state().scene_view.drawn_count();
     assert!(
         first > 0 && first < all,
@@ -448,7 +403,7 @@ fn the_depth_slider_hides_deeper_segments() {
 
 /// Hides the status line's timings and rates, which differ from run to run: from the start of
 /// its label to the window's right edge (the text's width varies with its digits).
-fn mask_status(h: &mut Harness<'static, ViewerApp>) {
+fn mask_status(h: &mut Window) {
     let status = h.get_by_label_contains("Mrays/s").rect();
     let right = h.ctx.content_rect().right();
     h.mask(egui::Rect::from_min_max(
@@ -465,7 +420,7 @@ fn window_snapshot(size: [f32; 2], name: &str) {
     follow_pane(&mut h);
     settle(&mut h);
     // The toast of the hidden settings (at 1024) fades on a timer: take it off.
-    h.state_mut().clear_toasts();
+    h.state_mut().messages.clear_toasts();
     h.step();
     // Timings and rates differ from run to run: hide the status line that shows them.
     mask_status(&mut h);
@@ -495,12 +450,12 @@ fn speed_vs_accuracy_window_runs_the_sweep_and_a_point_applies() {
         .click();
     h.run_steps(2);
     let deadline = Instant::now() + Duration::from_secs(300);
-    while h.state().sweep.report.is_none() {
+    while h.state().workspace.sweep.report.is_none() {
         assert!(Instant::now() < deadline, "the sweep did not finish");
         h.step();
         std::thread::sleep(Duration::from_millis(20));
     }
-    let report = h.state().sweep.report.clone().expect("a report");
+    let report = h.state().workspace.sweep.report.clone().expect("a report");
     assert!(report.points.iter().any(|p| p.pareto), "no Pareto front");
     // The plot's click handler picks the nearest point; here, the 4-sample point.
     let p = report
@@ -526,10 +481,11 @@ fn ctrl_drag_traces_a_sparse_grid_of_the_rectangle() {
     settle(&mut h);
     let (from, to) = (pixel_pos(&h, 10, 10), pixel_pos(&h, 150, 110));
     drag(&mut h, from, to - from, egui::Modifiers::COMMAND);
-    let n = h.state().trees().count();
+    let n = h.state().selection.trees().count();
     assert_eq!(n, 64, "an 8×8 grid");
     assert!(
         h.state()
+            .selection
             .trees()
             .all(|t| (10..=150).contains(&t.pixel[0]) && (10..=110).contains(&t.pixel[1])),
         "every pixel inside the rectangle"
@@ -542,12 +498,12 @@ fn ctrl_drag_traces_a_sparse_grid_of_the_rectangle() {
     // Full: one more pixel is refused with a message.
     let at = pixel_pos(&h, 1, 1);
     click(&mut h, at, egui::Modifiers::SHIFT);
-    assert_eq!(h.state().trees().count(), 64);
+    assert_eq!(h.state().selection.trees().count(), 64);
     assert!(
         h.state()
             .messages
             .last()
-            .is_some_and(|m| m.1.contains("at most 64"))
+            .is_some_and(|m| m.text.contains("at most 64"))
     );
 }
 
@@ -560,17 +516,17 @@ fn play_reveals_the_tree_generation_by_generation() {
     h.state_mut().scene_view.speed = 8.0;
     h.get_by_role_and_label(Role::Button, "Play").click();
     h.step();
-    let mut seen = vec![h.state().tree_state.reveal];
+    let mut seen = vec![h.state().selection.tree_state.reveal];
     let deadline = Instant::now() + Duration::from_secs(30);
     while h.state().scene_view.playing.is_some() {
         assert!(Instant::now() < deadline, "the playback did not end");
         h.step();
         std::thread::sleep(Duration::from_millis(20));
-        if seen.last() != Some(&h.state().tree_state.reveal) {
-            seen.push(h.state().tree_state.reveal);
+        if seen.last() != Some(&h.state().selection.tree_state.reveal) {
+            seen.push(h.state().selection.tree_state.reveal);
         }
     }
-    let deepest = raytree::app::scene_pane::deepest(h.state().trees());
+    let deepest = raytree::app::scene_pane::deepest(h.state().selection.trees());
     let mut expected: Vec<Option<u32>> = (0..=deepest).map(Some).collect();
     expected.push(None);
     assert_eq!(
@@ -592,25 +548,26 @@ fn opening_another_scene_clears_the_pinned_and_extra_trees() {
     h.get_by_role_and_label(Role::Button, "Pin for comparison")
         .click();
     h.step();
-    assert!(h.state().tree_state.pinned.is_some());
-    assert_eq!(h.state().trees().count(), 2);
+    assert!(h.state().selection.tree_state.pinned.is_some());
+    assert_eq!(h.state().selection.trees().count(), 2);
     h.state_mut()
         .command(raytree::app::Command::OpenBuiltin("quiz".into()));
     h.step();
     h.step();
-    assert!(h.state().tree_state.pinned.is_none());
-    assert_eq!(h.state().trees().count(), 0);
+    assert!(h.state().selection.tree_state.pinned.is_none());
+    assert_eq!(h.state().selection.trees().count(), 0);
 }
 
 /// Steps until the render follows the pane (the pane's pixels are the render's), or panics.
-fn follow_pane(h: &mut Harness<'static, ViewerApp>) {
+fn follow_pane(h: &mut Window) {
     let deadline = Instant::now() + Duration::from_secs(30);
     loop {
         h.step();
         let image = h.get_by_label("render viewport").rect();
         let (w, hh) = h.state().render_size();
         // The pane's pixels are the render's, and the image fills it 1:1.
-        if h.state().pane_pixels() == Some((w, hh))
+        let app = h.state();
+        if app.render.pane_seen(&app.workspace.prefs) == Some((w, hh))
             && (image.width() - w as f32).abs() <= 1.0
             && (image.height() - hh as f32).abs() <= 1.0
         {
@@ -625,7 +582,7 @@ fn follow_pane(h: &mut Harness<'static, ViewerApp>) {
 }
 
 /// The render image's area as a fraction of the window's.
-fn image_share(h: &Harness<'static, ViewerApp>) -> f32 {
+fn image_share(h: &Window) -> f32 {
     let image = h.get_by_label("render viewport").rect();
     let window = h.ctx.content_rect();
     image.area() / window.area()
@@ -633,7 +590,7 @@ fn image_share(h: &Harness<'static, ViewerApp>) -> f32 {
 
 /// Clicks the render image a third of the way across and a little below the middle, lets the
 /// tree open, and gives the point clicked.
-fn click_a_third_across(h: &mut Harness<'static, ViewerApp>) -> egui::Pos2 {
+fn click_a_third_across(h: &mut Window) -> egui::Pos2 {
     let image = h.get_by_label("render viewport").rect();
     let at = image.lerp_inside(egui::vec2(0.35, 0.6));
     click(h, at, egui::Modifiers::NONE);
@@ -652,7 +609,7 @@ fn the_scene_view_keeps_a_third_of_the_height_beside_a_tree() {
         follow_pane(&mut h);
         click_a_third_across(&mut h);
         assert!(
-            h.state().tree.is_some(),
+            h.state().selection.tree.is_some(),
             "{size:?}: no tree after the click"
         );
         let view = h.get_by_label("scene view").rect();
@@ -702,7 +659,12 @@ fn the_render_holds_half_the_window_and_its_place_when_a_pixel_is_clicked() {
         );
         // Click a third of the way across: the tree is of the pixel under the pointer.
         let at = click_a_third_across(&mut h);
-        let tree = h.state().tree.clone().expect("a tree after the click");
+        let tree = h
+            .state()
+            .selection
+            .tree
+            .clone()
+            .expect("a tree after the click");
         let after = h.get_by_label("render viewport").rect();
         assert_eq!(before, after, "{size:?}: the render moved or changed size");
         assert!(image_share(&h) >= 0.5);
@@ -729,14 +691,18 @@ fn toasts_do_not_move_the_layout() {
     follow_pane(&mut h);
     let before = h.get_by_label("render viewport").rect();
     let menu = h.get_by_label("Scene").rect();
-    let shown = h.state().toasts_shown();
+    let shown = h.state().messages.toasts_shown();
     for i in 0..4 {
-        h.state_mut()
-            .messages
-            .push((i % 2 == 0, format!("message {i}")));
+        let text = format!("message {i}");
+        let message = if i % 2 == 0 {
+            Message::error(text)
+        } else {
+            Message::notice(text)
+        };
+        h.state_mut().messages.push(message);
     }
     h.run_steps(3);
-    assert_eq!(h.state().toasts_shown(), shown + 4);
+    assert_eq!(h.state().messages.toasts_shown(), shown + 4);
     assert_eq!(h.get_by_label("render viewport").rect(), before);
     assert_eq!(h.get_by_label("Scene").rect(), menu);
 }
@@ -790,7 +756,10 @@ fn render_at_pane_size_follows_the_window_and_export_keeps_the_scene_size() {
     assert_ne!(second, first);
     // The scene's own size is kept for export and saving.
     assert_eq!(
-        (h.state().edit.render.width, h.state().edit.render.height),
+        (
+            h.state().working.scene.render.width,
+            h.state().working.scene.render.height
+        ),
         (160, 120)
     );
     settle(&mut h);
@@ -798,7 +767,7 @@ fn render_at_pane_size_follows_the_window_and_export_keeps_the_scene_size() {
     let out = dir.path().join("shot.png");
     export_via(&mut h, "Render (PNG or EXR)", &out);
     let deadline = Instant::now() + Duration::from_secs(60);
-    while h.state().exporting() {
+    while h.state().render.exporting() {
         assert!(Instant::now() < deadline, "the export did not finish");
         h.step();
         std::thread::sleep(Duration::from_millis(20));
@@ -816,11 +785,14 @@ fn render_at_pane_size_follows_the_window_and_export_keeps_the_scene_size() {
 fn ctrl_b_hides_the_settings_and_the_render_takes_the_room() {
     let mut h = window(small("default"), [1600.0, 1000.0]);
     follow_pane(&mut h);
-    assert!(h.state().prefs.settings_panel, "shown in a 1600 px window");
+    assert!(
+        h.state().workspace.prefs.settings_panel,
+        "shown in a 1600 px window"
+    );
     let before = h.get_by_label("render viewport").rect();
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::B);
     h.step();
-    assert!(!h.state().prefs.settings_panel);
+    assert!(!h.state().workspace.prefs.settings_panel);
     follow_pane(&mut h);
     let after = h.get_by_label("render viewport").rect();
     assert!(
@@ -830,5 +802,5 @@ fn ctrl_b_hides_the_settings_and_the_render_takes_the_room() {
     // The strip left in its place brings the settings back.
     h.get_by_role_and_label(Role::Button, "»").click();
     h.step();
-    assert!(h.state().prefs.settings_panel);
+    assert!(h.state().workspace.prefs.settings_panel);
 }

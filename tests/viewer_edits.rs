@@ -4,76 +4,30 @@
 //! the scene's camera back, a drag across the whole image orbits about 180°, and the value
 //! modes get a colour scale beside the image.
 
-use std::panic::AssertUnwindSafe;
-use std::time::{Duration, Instant};
+#[path = "common/viewer.rs"]
+mod viewer;
 
 use eframe::egui;
 use egui::accesskit::Role;
-use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use glam::Vec3;
-use raytree::app::ViewerApp;
 use raytree::app::modes::ImageMode;
 use raytree::scene::Scene;
-use raytree::scene::builtin::load_builtin;
+use viewer::{Window, harness, settle, small};
 
-fn small(name: &str) -> Scene {
-    let mut s = load_builtin(name).expect("built-in scene");
-    s.render.width = 160;
-    s.render.height = 120;
-    s
-}
-
-fn harness(scene: Scene) -> Harness<'static, ViewerApp> {
-    let renderer =
-        std::panic::catch_unwind(AssertUnwindSafe(egui_kittest::wgpu::WgpuTestRenderer::new))
-            .unwrap_or_else(|_| {
-                panic!(
-                    "no wgpu adapter for the viewer tests: install Mesa's software Vulkan \
-                     (apt-get install mesa-vulkan-drivers libvulkan1)"
-                )
-            });
-    let samples = scene.render.samples;
-    let mut h = Harness::builder()
-        .with_size([1280.0, 800.0])
-        .renderer(renderer)
-        .build_eframe(|cc| ViewerApp::new(cc, scene, "test".into()).expect("the viewer starts"));
-    // The scene's own size and samples (quick to settle), the settings shown.
-    h.state_mut().set_view(samples, false);
-    h.state_mut().set_settings_panel(true);
-    h.step();
-    h
-}
-
-/// Steps frames until both progressive renders reach their target.
-fn settle(h: &mut Harness<'static, ViewerApp>) {
-    let deadline = Instant::now() + Duration::from_secs(120);
-    while !h.state().is_finished() || !h.state().scene_view.is_finished() {
-        assert!(Instant::now() < deadline, "the render did not finish");
-        h.step();
-        std::thread::sleep(Duration::from_millis(2));
-    }
-    h.step();
-}
-
-fn keys(h: &mut Harness<'static, ViewerApp>, modifiers: egui::Modifiers, key: egui::Key) {
+fn keys(h: &mut Window, modifiers: egui::Modifiers, key: egui::Key) {
     h.key_press_modifiers(modifiers, key);
     h.step();
     h.step();
 }
 
 /// Drags from `from` by `by` with the primary button, in five moves.
-fn drag(h: &mut Harness<'static, ViewerApp>, from: egui::Pos2, by: egui::Vec2) {
+fn drag(h: &mut Window, from: egui::Pos2, by: egui::Vec2) {
     drag_with(h, from, by, egui::Modifiers::NONE);
 }
 
 /// [`drag`] with `modifiers` held.
-fn drag_with(
-    h: &mut Harness<'static, ViewerApp>,
-    from: egui::Pos2,
-    by: egui::Vec2,
-    modifiers: egui::Modifiers,
-) {
+fn drag_with(h: &mut Window, from: egui::Pos2, by: egui::Vec2, modifiers: egui::Modifiers) {
     h.event(egui::Event::ModifiersChanged(modifiers));
     h.hover_at(from);
     h.step();
@@ -110,14 +64,14 @@ fn undo_restores_the_previous_scene_exactly_and_redo_reapplies() {
     h.step();
     let after = h.state().scene().clone();
     assert_eq!(after.render.max_depth, 1);
-    assert_eq!(h.state().history.undo_steps(), 1);
+    assert_eq!(h.state().working.history.undo_steps(), 1);
 
     keys(&mut h, egui::Modifiers::COMMAND, egui::Key::Z);
     assert!(
         *h.state().scene() == before,
         "undo did not restore the scene"
     );
-    assert!(h.state().edit == before);
+    assert!(h.state().working.scene == before);
     keys(
         &mut h,
         egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
@@ -145,9 +99,9 @@ fn a_scalar_colour_edit_changes_all_three_channels_in_one_step() {
         .expect("a grey kr");
     let old = m.reflectivity;
     let mut h = harness(scene.clone());
-    h.state_mut().selected_material = Some(i);
+    h.state_mut().selection.selected_material = Some(i);
     settle(&mut h);
-    let steps = h.state().history.undo_steps();
+    let steps = h.state().working.history.undo_steps();
     let target = if old.x == 0.5 { 0.25 } else { 0.5 };
     h.get_by_role_and_label(Role::SpinButton, "reflect kr")
         .set_value_accesskit(target as f64);
@@ -158,7 +112,11 @@ fn a_scalar_colour_edit_changes_all_three_channels_in_one_step() {
         Vec3::splat(target),
         "one edit sets R, G and B"
     );
-    assert_eq!(h.state().history.undo_steps(), steps + 1, "one undo step");
+    assert_eq!(
+        h.state().working.history.undo_steps(),
+        steps + 1,
+        "one undo step"
+    );
     keys(&mut h, egui::Modifiers::COMMAND, egui::Key::Z);
     assert_eq!(h.state().scene().materials[i].reflectivity, old);
     assert!(*h.state().scene() == scene);
@@ -191,12 +149,12 @@ fn a_drag_across_the_image_orbits_about_180_degrees_as_one_step_and_home_resets(
     let distance = |s: &Scene| (s.camera.position - s.camera.look_at).length();
     assert!((distance(h.state().scene()) - distance(&scene)).abs() < 1e-3);
     // The whole drag is one step.
-    assert_eq!(h.state().history.undo_steps(), 1);
+    assert_eq!(h.state().working.history.undo_steps(), 1);
     keys(&mut h, egui::Modifiers::COMMAND, egui::Key::Z);
     assert_eq!(h.state().scene().camera, scene.camera);
 
     // A half-width drag at half the orbit speed: about 45°.
-    h.state_mut().prefs.orbit_degrees = 90.0;
+    h.state_mut().workspace.prefs.orbit_degrees = 90.0;
     drag(&mut h, from, egui::vec2(image.width() * 0.5, 0.0));
     let turned = yaw_between(&scene, h.state().scene());
     assert!((turned - 45.0).abs() < 6.0, "turned {turned}°");
@@ -219,7 +177,7 @@ fn value_modes_show_a_colour_scale_beside_the_image() {
         (ImageMode::Depth, "colour scale: Depth reached from 0 to 5"),
         (ImageMode::Cost, "colour scale: Cost from 1 to 256+"),
     ] {
-        h.state_mut().prefs.mode = mode;
+        h.state_mut().workspace.prefs.mode = mode;
         h.step();
         h.step();
         let bar = h.get_by_label(scale).rect();
@@ -230,16 +188,16 @@ fn value_modes_show_a_colour_scale_beside_the_image() {
         );
         assert!(image.width() <= full.width());
     }
-    h.state_mut().prefs.mode = ImageMode::Termination;
+    h.state_mut().workspace.prefs.mode = ImageMode::Termination;
     h.step();
     h.step();
     h.get_by_label("max depth reached");
     h.get_by_label("escaped (no hit)");
-    h.state_mut().prefs.mode = ImageMode::Normals;
+    h.state_mut().workspace.prefs.mode = ImageMode::Normals;
     h.step();
     h.step();
     h.get_by_label("no hit");
-    h.state_mut().prefs.mode = ImageMode::Render;
+    h.state_mut().workspace.prefs.mode = ImageMode::Render;
     h.step();
     h.step();
     assert!(h.query_by_label_contains("colour scale").is_none());
@@ -253,7 +211,7 @@ fn in_a_small_window_the_scale_goes_under_the_image() {
     h.set_size(egui::vec2(1024.0, 640.0));
     settle(&mut h);
     let full = h.get_by_label("render viewport").rect();
-    h.state_mut().prefs.mode = ImageMode::Depth;
+    h.state_mut().workspace.prefs.mode = ImageMode::Depth;
     h.step();
     h.step();
     let bar = h
@@ -310,7 +268,7 @@ fn dragging_a_light_in_the_scene_view_moves_it_as_one_undoable_step() {
         "the light went from {from:?} to {now:?}"
     );
     assert_eq!(h.state().scene_view.camera, view_camera, "the view orbited");
-    assert_eq!(h.state().history.undo_steps(), 1);
+    assert_eq!(h.state().working.history.undo_steps(), 1);
     keys(&mut h, egui::Modifiers::COMMAND, egui::Key::Z);
     settle(&mut h);
     assert!(*h.state().scene() == scene);
@@ -355,7 +313,7 @@ fn shift_dragging_a_sphere_in_the_scene_view_moves_it_as_one_undoable_step() {
         "the sphere did not follow the pointer"
     );
     assert_eq!(h.state().scene_view.camera, view_camera, "the view orbited");
-    assert_eq!(h.state().history.undo_steps(), 1);
+    assert_eq!(h.state().working.history.undo_steps(), 1);
     keys(&mut h, egui::Modifiers::COMMAND, egui::Key::Z);
     settle(&mut h);
     assert!(*h.state().scene() == scene);

@@ -1,61 +1,33 @@
-//! Faults in the viewer (SPEC §9): bursts of edits (hundreds a second) never deadlock and never
-//! leave a stale tile (after the burst, the converged film equals the batch render of the final
+//! Faults in the viewer (docs/reliability.md): bursts of edits never deadlock and never leave a
+//! stale tile (after the burst, the converged film equals the batch render of the final
 //! scene); a new scene opened mid-render replaces the old one cleanly, a bad one leaves it
 //! rendering; the window survives being 0×0. The logic runs headless
-//! (`ViewerApp::headless`); the window cases drive the real app through egui_kittest on the
-//! wgpu software adapter, like `tests/viewer.rs` (same environment: `XDG_RUNTIME_DIR=/tmp
-//! WGPU_BACKEND=vulkan` where needed).
+//! (`ViewerApp::headless`); the window cases drive the real app through the harness of
+//! `tests/common/viewer.rs`.
 
-use std::panic::AssertUnwindSafe;
+#[path = "common/viewer.rs"]
+mod viewer;
+
 use std::path::Path;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use eframe::egui;
 use egui::accesskit::Role;
-use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use glam::Vec3;
 use raytree::app::{Command, ViewerApp};
 use raytree::render::{Image, render};
 use raytree::scene::Scene;
-use raytree::scene::builtin::{load_builtin, scene_text};
+use raytree::scene::builtin::scene_text;
 use raytree::trace::{TraceSettings, Tracer};
-
-fn small(name: &str, width: u32, height: u32, samples: u32) -> Scene {
-    let mut s = load_builtin(name).expect("built-in scene");
-    s.render.width = width;
-    s.render.height = height;
-    s.render.samples = samples;
-    s
-}
-
-/// The viewer without a window, refining to the scene's own sample count (not the viewer's
-/// target), so its converged film is the batch render's.
-fn headless(scene: Scene, label: &str) -> ViewerApp {
-    let samples = scene.render.samples;
-    let mut app = ViewerApp::headless(scene, label.into()).expect("the viewer starts");
-    app.set_view(samples, false);
-    app.apply();
-    app
-}
+use viewer::{at_scene_size, frames_until, headless, settle_headless, settle_render, sized};
 
 fn batch(scene: &Scene, trace: TraceSettings) -> Image {
     let tracer = Tracer::new(Arc::new(scene.clone()), trace);
     render(&tracer, scene.render.samples, 0, &|_, _| {})
         .expect("render")
         .0
-}
-
-/// Polls until the current generation finishes. The deadline is a hang guard, not a measure of
-/// speed: a deadlock fails here instead of hanging the suite.
-fn settle(app: &mut ViewerApp) {
-    let deadline = Instant::now() + Duration::from_secs(120);
-    while !app.is_finished() {
-        assert!(Instant::now() < deadline, "the render did not finish");
-        app.poll_session();
-        std::thread::sleep(Duration::from_millis(1));
-    }
 }
 
 fn assert_converged(app: &ViewerApp) {
@@ -69,22 +41,22 @@ fn assert_converged(app: &ViewerApp) {
     let mut scene = scene.clone();
     scene.render.samples = app.viewer_target();
     assert!(
-        image == batch(&scene, app.settings.trace),
+        image == batch(&scene, app.working.settings.trace),
         "the converged film differs from the batch render of the final scene: a stale tile"
     );
 }
 
 /// Edits as fast as they come, of every kind that restarts the render: camera, depth, light
 /// colour, material, image size (so stale tiles of another size are in flight), accelerator
-/// rebuilds. No edit waits for a render, and then the film converges to the final scene exactly.
+/// rebuilds. Every edit starts its own generation and none waits for its render; then the film
+/// converges to the final scene exactly.
 #[test]
 fn bursts_of_edits_never_deadlock_or_leave_stale_tiles() {
-    let mut app = headless(small("default", 48, 36, 4), "burst");
-    let start = Instant::now();
+    let mut app = headless(sized("default", 48, 36, Some(4)), "burst");
     let edits = 400;
-    let mut finished_at_once = 0u32;
+    let first = app.generation();
     for i in 0..edits {
-        let e = &mut app.edit;
+        let e = &mut app.working.scene;
         e.camera.position.x += 0.002;
         e.render.max_depth = i % 7;
         e.render.width = 40 + i % 17;
@@ -101,24 +73,26 @@ fn bursts_of_edits_never_deadlock_or_leave_stale_tiles() {
             Command::Restart
         });
         app.apply();
+        // Each edit starts exactly one generation and returns before any pass of it is
+        // taken: the render runs on the workers, after the edit, never inside it.
+        assert_eq!(
+            app.generation(),
+            first + u64::from(i) + 1,
+            "edit {i} started no generation of its own"
+        );
+        assert!(
+            app.samples_done() == 0 && !app.is_finished(),
+            "edit {i} returned with its render done"
+        );
         app.poll_session();
-        finished_at_once += u32::from(app.is_finished());
     }
-    let per_second = edits as f64 / start.elapsed().as_secs_f64();
-    eprintln!("{edits} edits at {per_second:.0} a second");
-    // An edit returns while its render runs on the workers. Were the render done on the UI
-    // thread, every edit would find its render finished.
-    assert!(
-        finished_at_once < edits / 2,
-        "{finished_at_once} of {edits} edits waited for their render"
-    );
-    settle(&mut app);
+    settle_headless(&mut app);
     assert_eq!(app.scene().render.width, 40 + (edits - 1) % 17);
     assert_converged(&app);
     assert!(
-        app.messages.iter().all(|(error, _)| !error),
+        app.messages.log().iter().all(|m| !m.is_error()),
         "{:?}",
-        app.messages
+        app.messages.log()
     );
 }
 
@@ -128,7 +102,7 @@ fn bursts_of_edits_never_deadlock_or_leave_stale_tiles() {
 #[test]
 fn opening_a_scene_mid_render() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let mut app = headless(small("default", 160, 120, 8), "default");
+    let mut app = headless(sized("default", 160, 120, Some(8)), "default");
     app.poll_session();
 
     let bad = dir.path().join("bad.toml");
@@ -136,20 +110,21 @@ fn opening_a_scene_mid_render() {
     app.command(Command::OpenFile(bad.clone()));
     app.apply();
     // Read and parsed in the background: the error comes when the open ends.
-    settle(&mut app);
-    assert_eq!(app.opening(), None);
-    let (error, message) = app.messages.last().cloned().expect("a message");
+    settle_headless(&mut app);
+    assert_eq!(app.files.opening(), None);
+    let last = app.messages.last().cloned().expect("a message");
+    let (error, message) = (last.is_error(), last.text);
     assert!(error, "{message}");
     assert!(
         message.starts_with(&format!("{}:2:9: render field `width`", bad.display())),
         "{message}"
     );
     assert_eq!(app.scene().render.width, 160, "the old scene stays");
-    settle(&mut app);
+    settle_headless(&mut app);
     assert_converged(&app);
 
     // Restart a long render, then open a scene of another size in the middle of it.
-    app.edit.camera.position.y += 0.1;
+    app.working.scene.camera.position.y += 0.1;
     app.command(Command::Restart);
     app.apply();
     app.poll_session();
@@ -170,41 +145,13 @@ fn opening_a_scene_mid_render() {
     app.command(Command::OpenFile(good.clone()));
     app.apply();
     // The new scene's accelerator is built off the UI thread; it replaces the old one when built.
-    settle(&mut app);
+    settle_headless(&mut app);
     assert_eq!(app.scene().source.as_deref(), Some(good.as_path()));
     assert_eq!(
         (app.scene().render.width, app.scene().render.height),
         (50, 30)
     );
     assert_converged(&app);
-}
-
-fn harness(scene: Scene, size: egui::Vec2) -> Harness<'static, ViewerApp> {
-    let renderer =
-        std::panic::catch_unwind(AssertUnwindSafe(egui_kittest::wgpu::WgpuTestRenderer::new))
-            .unwrap_or_else(|_| panic!("no wgpu adapter: see tests/viewer.rs"));
-    Harness::builder()
-        .with_size(size)
-        .renderer(renderer)
-        .build_eframe(|cc| {
-            // The scene's size and sample count, the settings shown whatever the width.
-            let samples = scene.render.samples;
-            let mut app = ViewerApp::new(cc, scene, "faults".into()).expect("the viewer starts");
-            app.set_view(samples, false);
-            app.set_settings_panel(true);
-            app
-        })
-}
-
-/// Steps the window until its render finishes. The deadline is a hang guard, not a measure of
-/// speed: a render that stopped making progress fails here instead of hanging the suite.
-fn settle_window(h: &mut Harness<'static, ViewerApp>, what: &str) {
-    let deadline = Instant::now() + Duration::from_secs(60);
-    while !h.state().is_finished() {
-        assert!(Instant::now() < deadline, "{what}");
-        h.step();
-        std::thread::sleep(Duration::from_millis(2));
-    }
 }
 
 /// A window of no area, or of one pixel, and shrinking to nothing mid-render: frames still run,
@@ -216,13 +163,13 @@ fn zero_and_tiny_windows_survive() {
         egui::vec2(1.0, 1.0),
         egui::vec2(3.0, 2.0),
     ] {
-        let mut h = harness(small("quiz", 40, 30, 2), size);
+        let mut h = at_scene_size(sized("quiz", 40, 30, Some(2)), size);
         for _ in 0..5 {
             h.step();
         }
-        settle_window(&mut h, &format!("no progress in a {size:?} window"));
+        settle_render(&mut h, &format!("no progress in a {size:?} window"));
     }
-    let mut h = harness(small("quiz", 40, 30, 2), egui::vec2(800.0, 500.0));
+    let mut h = at_scene_size(sized("quiz", 40, 30, Some(2)), egui::vec2(800.0, 500.0));
     h.step();
     h.set_size(egui::vec2(0.0, 0.0));
     for _ in 0..5 {
@@ -237,7 +184,7 @@ fn zero_and_tiny_windows_survive() {
 /// Edits through the real window as fast as frames go: the max-depth slider moved every frame.
 #[test]
 fn slider_bursts_through_the_window() {
-    let mut h = harness(small("default", 48, 36, 2), egui::vec2(1000.0, 700.0));
+    let mut h = at_scene_size(sized("default", 48, 36, Some(2)), egui::vec2(1000.0, 700.0));
     h.step();
     let start = Instant::now();
     let edits = 120;
@@ -250,7 +197,7 @@ fn slider_bursts_through_the_window() {
         "{edits} slider edits through the window in {:.2} s",
         start.elapsed().as_secs_f64()
     );
-    settle_window(&mut h, "the render did not finish");
+    settle_render(&mut h, "the render did not finish");
     assert_eq!(h.state().scene().render.max_depth, (edits - 1) % 9);
     assert_converged(h.state());
 }
@@ -266,8 +213,8 @@ fn a_scene_wider_than_the_largest_texture_is_refused() {
             eframe::egui_wgpu::WgpuSetupCreateNew::without_display_handle().device_descriptor;
     }
     let renderer = egui_kittest::wgpu::WgpuTestRenderer::from_setup(setup);
-    let scene = small("quiz", 9000, 4, 1);
-    let mut h = Harness::builder()
+    let scene = sized("quiz", 9000, 4, Some(1));
+    let mut h = egui_kittest::Harness::builder()
         .with_size(egui::vec2(800.0, 500.0))
         .renderer(renderer)
         .build_eframe(|cc| ViewerApp::new(cc, scene, "wide".into()).expect("the viewer starts"));
@@ -277,7 +224,7 @@ fn a_scene_wider_than_the_largest_texture_is_refused() {
     // Drawing runs the paint callback, which creates the texture.
     h.render().expect("the window draws");
     assert!(
-        h.state().messages.iter().any(|(error, _)| *error),
+        h.state().messages.log().iter().any(|m| m.is_error()),
         "no message about the size"
     );
 }
@@ -287,22 +234,23 @@ fn a_scene_wider_than_the_largest_texture_is_refused() {
 /// scene stays and renders.
 #[test]
 fn an_edit_far_beyond_the_scene_size_limit_is_refused() {
-    let mut app = headless(small("default", 32, 24, 1), "far");
+    let mut app = headless(sized("default", 32, 24, Some(1)), "far");
     let spheres = app.scene().spheres.clone();
     let messages = app.messages.len();
-    let mut far = app.edit.spheres[0];
+    let mut far = app.working.scene.spheres[0];
     far.center = Vec3::new(3e38, 0.0, 0.0);
     for _ in 0..8 {
-        app.edit.spheres.push(far);
+        app.working.scene.spheres.push(far);
     }
     app.command(Command::Rebuild);
     app.apply();
-    assert_eq!(app.messages.len(), messages + 1, "{:?}", app.messages);
-    let (error, message) = app.messages.last().cloned().expect("a message");
+    assert_eq!(app.messages.len(), messages + 1, "{:?}", app.messages.log());
+    let last = app.messages.last().cloned().expect("a message");
+    let (error, message) = (last.is_error(), last.text);
     assert!(error, "{message}");
     assert_eq!(app.scene().spheres, spheres, "the scene stays");
-    assert_eq!(app.edit.spheres, spheres, "the edit is undone");
-    settle(&mut app);
+    assert_eq!(app.working.scene.spheres, spheres, "the edit is undone");
+    settle_headless(&mut app);
     assert_converged(&app);
 }
 
@@ -311,7 +259,7 @@ fn an_edit_far_beyond_the_scene_size_limit_is_refused() {
 /// loader's sentence, and the scene being shown stays exactly as it was.
 #[test]
 fn opening_each_refused_hostile_file_keeps_the_scene() {
-    let mut app = headless(small("default", 64, 48, 1), "default");
+    let mut app = headless(sized("default", 64, 48, Some(1)), "default");
     let before = app.scene().clone();
     let mut paths: Vec<_> = std::fs::read_dir("tests/fixtures/hostile")
         .expect("the hostile corpus")
@@ -329,15 +277,11 @@ fn opening_each_refused_hostile_file_keeps_the_scene() {
         app.command(Command::OpenFile(path.clone()));
         app.apply();
         // The open runs in the background: its sentence comes when it ends.
-        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
-        while app.opening().is_some() && std::time::Instant::now() < deadline {
-            app.poll_session();
-            app.apply();
-            std::thread::sleep(std::time::Duration::from_millis(5));
-        }
-        assert!(app.opening().is_none(), "{}: still opening", path.display());
-        assert_eq!(app.messages.len(), messages + 1, "{:?}", app.messages);
-        let (error, message) = app.messages.last().cloned().expect("a message");
+        let what = format!("{}: still opening", path.display());
+        frames_until(&mut app, &what, |a| a.files.opening().is_none());
+        assert_eq!(app.messages.len(), messages + 1, "{:?}", app.messages.log());
+        let last = app.messages.last().cloned().expect("a message");
+        let (error, message) = (last.is_error(), last.text);
         assert!(error, "{}: {message}", path.display());
         assert_eq!(message, e.to_string());
         assert!(
@@ -347,6 +291,6 @@ fn opening_each_refused_hostile_file_keeps_the_scene() {
         );
     }
     assert!(refused >= 40, "{refused} refused files");
-    settle(&mut app);
+    settle_headless(&mut app);
     assert_converged(&app);
 }

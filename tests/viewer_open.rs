@@ -1,24 +1,25 @@
-//! Opening a file never freezes the viewer (issue 14.5): the read, the parse and the build run
+//! Opening a file never freezes the viewer: the read, the parse and the build run
 //! in the background while the previous scene stays up and usable; a second open cancels the
 //! first, which never installs; the progress only goes up and stays below 100 % until the new
 //! scene is in; a headlight follows the camera without a rebuild. Headless
 //! (`ViewerApp::headless`), the open held at a stage boundary by the open hook; the window
-//! case drives the real app through egui_kittest (`WGPU_BACKEND=vulkan XDG_RUNTIME_DIR=...`).
+//! case drives the real app through the harness of `tests/common/viewer.rs`.
 
-use std::panic::AssertUnwindSafe;
+#[path = "common/viewer.rs"]
+mod viewer;
+
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, Instant};
 
-use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use raytree::accel::AccelKind;
 use raytree::app::opening::OpenStage;
 use raytree::app::{Command, ViewerApp};
 use raytree::scene::Scene;
-use raytree::scene::builtin::load_builtin;
 use raytree::scene::procedural::bumpy_torus_obj;
 use raytree::trace::TraceSettings;
+use viewer::{frame, frames_until, headless, sized, steps_until, window_with};
 
 /// Holds background opens at one stage boundary until told to let go, and records the
 /// stages they reached.
@@ -38,7 +39,7 @@ impl Gate {
 
     fn install(self: &Arc<Self>, app: &mut ViewerApp) {
         let gate = self.clone();
-        app.set_open_hook(Some(Arc::new(move |stage| {
+        app.files.set_hook(Some(Arc::new(move |stage| {
             gate.seen.lock().expect("gate").push(stage);
             let mut hold = gate.hold.lock().expect("gate");
             // Held for at most a minute: a test that forgets to let go fails instead of hanging.
@@ -69,33 +70,7 @@ impl Gate {
 }
 
 fn small_default() -> Scene {
-    let mut s = load_builtin("default").expect("built-in scene");
-    (s.render.width, s.render.height, s.render.samples) = (96, 72, 4);
-    s
-}
-
-fn headless(scene: Scene) -> ViewerApp {
-    let samples = scene.render.samples;
-    let mut app = ViewerApp::headless(scene, "default".into()).expect("the viewer starts");
-    app.set_view(samples, false);
-    app.apply();
-    app
-}
-
-/// One UI frame without a window: what `ui` does around the panels.
-fn frame(app: &mut ViewerApp) {
-    app.poll_session();
-    app.apply();
-    std::thread::sleep(Duration::from_millis(2));
-}
-
-/// Frames until `done`; a hang guard, not a measure of speed.
-fn frames_until(app: &mut ViewerApp, what: &str, done: impl Fn(&ViewerApp) -> bool) {
-    let deadline = Instant::now() + Duration::from_secs(120);
-    while !done(app) {
-        assert!(Instant::now() < deadline, "{what}: timed out");
-        frame(app);
-    }
+    sized("default", 96, 72, Some(4))
 }
 
 fn write_obj(dir: &Path, name: &str, triangles: usize) -> PathBuf {
@@ -109,7 +84,7 @@ struct Watch(f32);
 
 impl Watch {
     fn check(&mut self, app: &mut ViewerApp) {
-        if let Some((label, percent)) = app.open_status() {
+        if let Some((label, percent)) = app.files.status() {
             assert!(percent >= self.0, "{percent} % after {} %", self.0);
             assert!(percent < 100.0, "{label} before the scene is in");
             assert!(
@@ -126,7 +101,7 @@ impl Watch {
 fn an_open_held_in_the_background_leaves_the_old_scene_usable_then_installs() {
     let dir = tempfile::tempdir().expect("temp dir");
     let obj = write_obj(dir.path(), "torus.obj", 20_000);
-    let mut app = headless(small_default());
+    let mut app = headless(small_default(), "default");
     frames_until(&mut app, "first render", ViewerApp::is_finished);
     let old_triangles = app.scene().triangles.len();
     let gate = Gate::new(Some(OpenStage::Parse));
@@ -134,7 +109,7 @@ fn an_open_held_in_the_background_leaves_the_old_scene_usable_then_installs() {
 
     app.command(Command::OpenFile(obj.clone()));
     app.apply();
-    assert_eq!(app.opening(), Some(obj.as_path()));
+    assert_eq!(app.files.opening(), Some(obj.as_path()));
     let mut watch = Watch(0.0);
     // Held before the parse: the UI goes on with the old scene.
     let generation = app.generation();
@@ -144,14 +119,14 @@ fn an_open_held_in_the_background_leaves_the_old_scene_usable_then_installs() {
     }
     assert_eq!(app.scene().source, None, "the old (built-in) scene stays");
     assert_eq!(app.scene().triangles.len(), old_triangles);
-    let (label, _) = app.open_status().expect("still opening");
+    let (label, _) = app.files.status().expect("still opening");
     assert!(label.starts_with("loading torus.obj… "), "{label}");
     // The old scene is usable: a click gives its tree, a camera move renders it again.
     app.command(Command::Pick(48, 36));
-    app.edit.camera.position.x += 0.2;
+    app.working.scene.camera.position.x += 0.2;
     app.command(Command::MoveCamera);
     app.apply();
-    assert!(app.tree.is_some(), "a tree of the old scene");
+    assert!(app.selection.tree.is_some(), "a tree of the old scene");
     assert!(app.generation() > generation, "the old scene re-renders");
     let moved = app.generation();
     frames_until(&mut app, "the old scene's first pass", |a| {
@@ -166,25 +141,28 @@ fn an_open_held_in_the_background_leaves_the_old_scene_usable_then_installs() {
         frame(&mut app);
         watch.check(&mut app);
     }
-    let (label, _) = app.open_status().expect("still opening");
+    let (label, _) = app.files.status().expect("still opening");
     assert!(label.starts_with("building BVH… "), "{label}");
     assert_eq!(app.scene().source, None, "not installed before it is built");
 
     gate.hold_at(None);
     let deadline = Instant::now() + Duration::from_secs(120);
-    while app.opening().is_some() {
+    while app.files.opening().is_some() {
         assert!(Instant::now() < deadline, "the install timed out");
         watch.check(&mut app);
         frame(&mut app);
     }
     assert_eq!(app.scene().source.as_deref(), Some(obj.as_path()));
     assert!(app.scene().triangles.len() > 10_000);
-    assert!(app.tree.is_none(), "the old scene's trees went with it");
+    assert!(
+        app.selection.tree.is_none(),
+        "the old scene's trees went with it"
+    );
     let names: Vec<&str> = app.scene().lights.iter().map(|l| l.name.as_str()).collect();
     assert_eq!(names, ["key", "headlight"]);
     frames_until(&mut app, "the new scene's render", ViewerApp::is_finished);
     assert!(app.samples_done() >= 1);
-    let timings = app.last_open.expect("the open's times");
+    let timings = app.files.last_open.expect("the open's times");
     assert!(timings.built && timings.triangles > 10_000, "{timings:?}");
 }
 
@@ -193,7 +171,7 @@ fn a_second_open_cancels_the_first_which_never_installs() {
     let dir = tempfile::tempdir().expect("temp dir");
     let first = write_obj(dir.path(), "first.obj", 3_000);
     let second = write_obj(dir.path(), "second.obj", 2_000);
-    let mut app = headless(small_default());
+    let mut app = headless(small_default(), "default");
     let gate = Gate::new(Some(OpenStage::Parse));
     gate.install(&mut app);
 
@@ -204,14 +182,14 @@ fn a_second_open_cancels_the_first_which_never_installs() {
     });
     app.command(Command::OpenFile(second.clone()));
     app.apply();
-    assert_eq!(app.opening(), Some(second.as_path()));
+    assert_eq!(app.files.opening(), Some(second.as_path()));
     frames_until(&mut app, "the second open's read", |_| {
         gate.count(OpenStage::Parse) == 2
     });
     // Both let go at once: the first stops at its boundary, the second goes on.
     gate.hold_at(None);
     let deadline = Instant::now() + Duration::from_secs(120);
-    while app.opening().is_some() || !app.is_finished() {
+    while app.files.opening().is_some() || !app.is_finished() {
         assert!(Instant::now() < deadline, "the second open did not finish");
         frame(&mut app);
         assert_ne!(
@@ -238,7 +216,7 @@ fn a_second_open_cancels_the_first_which_never_installs() {
 fn an_accelerator_change_mid_open_starts_it_again_with_that_accelerator() {
     let dir = tempfile::tempdir().expect("temp dir");
     let obj = write_obj(dir.path(), "grid.obj", 3_000);
-    let mut app = headless(small_default());
+    let mut app = headless(small_default(), "default");
     let gate = Gate::new(Some(OpenStage::Build));
     gate.install(&mut app);
     app.command(Command::OpenFile(obj.clone()));
@@ -249,10 +227,10 @@ fn an_accelerator_change_mid_open_starts_it_again_with_that_accelerator() {
         ..TraceSettings::default()
     });
     app.apply();
-    assert_eq!(app.opening(), Some(obj.as_path()), "opening again");
+    assert_eq!(app.files.opening(), Some(obj.as_path()), "opening again");
     gate.hold_at(None);
     frames_until(&mut app, "the open", |a| {
-        a.opening().is_none() && a.is_finished()
+        a.files.opening().is_none() && a.is_finished()
     });
     assert_eq!(app.scene().source.as_deref(), Some(obj.as_path()));
     assert_eq!(app.accel().kind(), AccelKind::Grid);
@@ -268,11 +246,12 @@ fn a_broken_file_opened_in_the_background_is_one_sentence_and_the_scene_stays() 
     let dir = tempfile::tempdir().expect("temp dir");
     let bad = dir.path().join("bad.obj");
     std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nf 1 2 9\n").expect("write");
-    let mut app = headless(small_default());
+    let mut app = headless(small_default(), "default");
     app.command(Command::OpenFile(bad.clone()));
     app.apply();
-    frames_until(&mut app, "the open", |a| a.opening().is_none());
-    let (error, message) = app.messages.last().cloned().expect("a message");
+    frames_until(&mut app, "the open", |a| a.files.opening().is_none());
+    let last = app.messages.last().cloned().expect("a message");
+    let (error, message) = (last.is_error(), last.text);
     assert!(error, "{message}");
     let direct = raytree::scene::load_scene_file(&bad)
         .expect_err("the file is broken")
@@ -285,11 +264,11 @@ fn a_broken_file_opened_in_the_background_is_one_sentence_and_the_scene_stays() 
 fn a_moved_camera_moves_the_headlight_without_a_rebuild() {
     let dir = tempfile::tempdir().expect("temp dir");
     let obj = write_obj(dir.path(), "lamp.obj", 2_000);
-    let mut app = headless(small_default());
+    let mut app = headless(small_default(), "default");
     app.command(Command::OpenFile(obj));
     app.apply();
     frames_until(&mut app, "the open", |a| {
-        a.opening().is_none() && a.is_finished()
+        a.files.opening().is_none() && a.is_finished()
     });
     let head = app
         .scene()
@@ -303,7 +282,7 @@ fn a_moved_camera_moves_the_headlight_without_a_rebuild() {
     );
     let accel = app.accel() as *const _;
     let triangles = app.scene().triangles.clone();
-    app.edit.camera.orbit(0.8, 0.1);
+    app.working.scene.camera.orbit(0.8, 0.1);
     app.command(Command::MoveCamera);
     app.apply();
     frames_until(&mut app, "the render", ViewerApp::is_finished);
@@ -314,7 +293,7 @@ fn a_moved_camera_moves_the_headlight_without_a_rebuild() {
         "rendered at the new eye"
     );
     assert_eq!(
-        app.edit.lights[head].position, eye,
+        app.working.scene.lights[head].position, eye,
         "the panel shows it there"
     );
     assert!(
@@ -329,11 +308,13 @@ fn a_moved_camera_moves_the_headlight_without_a_rebuild() {
     app.command(Command::Pick(48, 36));
     app.apply();
     if let Some(shadow) = app
+        .selection
         .tree
         .as_ref()
         .and_then(|t| t.root.shadow_rays.iter().find(|s| s.light == "headlight"))
     {
         let point = app
+            .selection
             .tree
             .as_ref()
             .and_then(|t| t.root.hit.as_ref())
@@ -348,21 +329,12 @@ fn a_moved_camera_moves_the_headlight_without_a_rebuild() {
 fn the_window_keeps_drawing_and_says_what_it_loads() {
     let dir = tempfile::tempdir().expect("temp dir");
     let obj = write_obj(dir.path(), "window.obj", 5_000);
-    let renderer =
-        std::panic::catch_unwind(AssertUnwindSafe(egui_kittest::wgpu::WgpuTestRenderer::new))
-            .unwrap_or_else(|_| panic!("no wgpu adapter: see tests/viewer.rs"));
     let gate = Gate::new(Some(OpenStage::Parse));
     let hook_gate = gate.clone();
-    let mut h: Harness<'static, ViewerApp> = Harness::builder()
-        .with_size(eframe::egui::vec2(1024.0, 640.0))
-        .renderer(renderer)
-        .build_eframe(move |cc| {
-            let mut app =
-                ViewerApp::new(cc, small_default(), "default".into()).expect("the viewer starts");
-            app.set_view(4, false);
-            hook_gate.install(&mut app);
-            app
-        });
+    let mut h = window_with(small_default(), [1024.0, 640.0], move |app| {
+        app.set_view(4, false);
+        hook_gate.install(app);
+    });
     h.run_steps(3);
     h.state_mut().command(Command::OpenFile(obj.clone()));
     let mut steps = 0;
@@ -371,14 +343,12 @@ fn the_window_keeps_drawing_and_says_what_it_loads() {
         steps += 1;
     }
     assert_eq!(steps, 15, "the window drew while the open was held");
-    assert!(h.state().opening().is_some());
+    assert!(h.state().files.opening().is_some());
     h.get_by_label_contains("loading window.obj… ");
     gate.hold_at(None);
-    let deadline = Instant::now() + Duration::from_secs(120);
-    while h.state().opening().is_some() {
-        assert!(Instant::now() < deadline, "the open did not finish");
-        h.step();
-    }
+    steps_until(&mut h, "the open did not finish", |a| {
+        a.files.opening().is_none()
+    });
     assert_eq!(h.state().scene().source.as_deref(), Some(obj.as_path()));
 }
 
@@ -399,7 +369,7 @@ fn an_open_does_not_wait_for_the_previous_render_to_converge() {
     app.apply();
     let deadline = Instant::now() + Duration::from_secs(300);
     let mut old_samples = 0;
-    while app.opening().is_some() {
+    while app.files.opening().is_some() {
         assert!(Instant::now() < deadline, "the open did not finish");
         old_samples = app.samples_done();
         frame(&mut app);
@@ -416,7 +386,7 @@ fn an_open_does_not_wait_for_the_previous_render_to_converge() {
 fn stopping_cancels_the_open() {
     let dir = tempfile::tempdir().expect("temp dir");
     let obj = write_obj(dir.path(), "stopped.obj", 2_000);
-    let mut app = headless(small_default());
+    let mut app = headless(small_default(), "default");
     let gate = Gate::new(Some(OpenStage::Parse));
     gate.install(&mut app);
     app.command(Command::OpenFile(obj.clone()));
@@ -424,7 +394,7 @@ fn stopping_cancels_the_open() {
     frames_until(&mut app, "the read", |_| gate.count(OpenStage::Parse) == 1);
     app.command(Command::Stop);
     app.apply();
-    assert_eq!(app.opening(), None);
+    assert_eq!(app.files.opening(), None);
     gate.hold_at(None);
     for _ in 0..50 {
         frame(&mut app);

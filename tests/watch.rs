@@ -2,11 +2,16 @@
 //! the camera moved in the viewer and the clicked tree when the geometry is unchanged; a change
 //! of geometry rebuilds; a broken save shows its error and keeps the last good scene.
 
+#[path = "common/viewer.rs"]
+mod viewer;
+
 use std::path::Path;
 use std::time::{Duration, Instant};
 
+use raytree::app::watch::DEBOUNCE;
 use raytree::app::{Command, ViewerApp};
 use raytree::scene::load_scene_file;
+use viewer::{frame, frames_until, frames_within};
 
 const SCENE: &str = r#"
 [render]
@@ -34,20 +39,6 @@ radius = 0.7
 material = "red"
 "#;
 
-/// Polls the viewer until `done` or 20 s pass; false on timeout.
-fn poll_until(app: &mut ViewerApp, done: impl Fn(&ViewerApp) -> bool) -> bool {
-    let deadline = Instant::now() + Duration::from_secs(20);
-    while Instant::now() < deadline {
-        app.poll_session();
-        app.apply();
-        if done(app) {
-            return true;
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    false
-}
-
 /// Saves `text` as an editor does: a new file renamed over the old one.
 fn save(path: &Path, text: &str) {
     let tmp = path.with_extension("toml.tmp");
@@ -62,34 +53,37 @@ fn saving_the_scene_reloads_it_and_a_broken_save_keeps_the_last_good_one() {
     std::fs::write(&path, SCENE).expect("write");
     let scene = load_scene_file(&path).expect("loads");
     let mut app = ViewerApp::headless(scene, "watched".into()).expect("the viewer starts");
-    assert!(poll_until(&mut app, ViewerApp::is_finished));
+    assert!(frames_within(&mut app, ViewerApp::is_finished));
     // The user moves the camera and clicks a pixel.
-    app.edit.camera.position.x += 0.25;
+    app.working.scene.camera.position.x += 0.25;
     app.command(Command::MoveCamera);
     app.command(Command::Pick(20, 15));
     app.apply();
-    assert!(poll_until(&mut app, ViewerApp::is_finished));
+    assert!(frames_within(&mut app, ViewerApp::is_finished));
     let camera = app.scene().camera.clone();
-    assert!(app.tree.is_some());
+    assert!(app.selection.tree.is_some());
 
     // A save that changes the light only: reloaded, camera and tree kept.
-    std::thread::sleep(Duration::from_millis(50));
+    frames_until(&mut app, "nothing waits for a reload", |a| {
+        !a.reload_pending()
+    });
     save(
         &path,
         &SCENE.replace("color = [1, 1, 1]", "color = [0.5, 0.5, 1]"),
     );
     assert!(
-        poll_until(&mut app, |a| a.scene().lights[0].color.x == 0.5
+        frames_within(&mut app, |a| a.scene().lights[0].color.x == 0.5
             && a.is_finished()),
         "the save was not reloaded: {:?}",
-        app.messages
+        app.messages.log()
     );
     assert_eq!(app.scene().camera, camera, "the viewer's camera stays");
-    assert!(app.tree.is_some(), "the clicked tree stays");
+    assert!(app.selection.tree.is_some(), "the clicked tree stays");
     assert!(
         app.messages
+            .log()
             .iter()
-            .any(|(e, m)| !e && m.starts_with("reloaded "))
+            .any(|m| !m.is_error() && m.text.starts_with("reloaded "))
     );
 
     // A save that moves the sphere: a new scene (rebuilt), its own camera.
@@ -98,25 +92,32 @@ fn saving_the_scene_reloads_it_and_a_broken_save_keeps_the_last_good_one() {
         &SCENE.replace("center = [0, 0.5, 0]", "center = [0.3, 0.5, 0]"),
     );
     assert!(
-        poll_until(&mut app, |a| a.scene().spheres[0].center.x == 0.3
+        frames_within(&mut app, |a| a.scene().spheres[0].center.x == 0.3
             && a.is_finished()),
         "the geometry change was not reloaded"
     );
 
     // A broken save: its error, and the scene stays.
-    let errors = app.messages.iter().filter(|(e, _)| *e).count();
+    let errors = app.messages.log().iter().filter(|m| m.is_error()).count();
     save(&path, "[render]\nwidth = 0\n");
     assert!(
-        poll_until(&mut app, |a| a.messages.iter().filter(|(e, _)| *e).count()
+        frames_within(&mut app, |a| a
+            .messages
+            .log()
+            .iter()
+            .filter(|m| m.is_error())
+            .count()
             > errors),
         "no error for the broken save"
     );
-    let (_, message) = app
+    let message = &app
         .messages
+        .log()
         .iter()
         .rev()
-        .find(|(e, _)| *e)
-        .expect("an error");
+        .find(|m| m.is_error())
+        .expect("an error")
+        .text;
     assert!(
         message.contains("watched.toml:2:9: render field `width`")
             && message.contains("the last good scene stays"),
@@ -132,7 +133,7 @@ fn saving_the_scene_reloads_it_and_a_broken_save_keeps_the_last_good_one() {
     // Fixed again: reloaded.
     save(&path, SCENE);
     assert!(
-        poll_until(&mut app, |a| a.scene().spheres[0].center.x == 0.0
+        frames_within(&mut app, |a| a.scene().spheres[0].center.x == 0.0
             && a.is_finished()),
         "the fixed file was not reloaded"
     );
@@ -150,10 +151,10 @@ fn a_reload_is_read_and_parsed_off_the_ui_thread() {
     std::fs::write(&path, SCENE).expect("write");
     let scene = load_scene_file(&path).expect("loads");
     let mut app = ViewerApp::headless(scene, "held".into()).expect("the viewer starts");
-    assert!(poll_until(&mut app, ViewerApp::is_finished));
+    assert!(frames_within(&mut app, ViewerApp::is_finished));
     let gate = Arc::new((Mutex::new(true), Condvar::new()));
     let hook_gate = gate.clone();
-    app.set_open_hook(Some(Arc::new(move |stage| {
+    app.files.set_hook(Some(Arc::new(move |stage| {
         let (held, released) = &*hook_gate;
         let mut held = held.lock().expect("gate");
         let deadline = Instant::now() + Duration::from_secs(60);
@@ -164,36 +165,38 @@ fn a_reload_is_read_and_parsed_off_the_ui_thread() {
                 .0;
         }
     })));
-    std::thread::sleep(Duration::from_millis(50));
+    frames_until(&mut app, "nothing waits for a reload", |a| {
+        !a.reload_pending()
+    });
     save(
         &path,
         &SCENE.replace("color = [1, 1, 1]", "color = [0.25, 0.5, 1]"),
     );
     assert!(
-        poll_until(&mut app, |a| a.opening() == Some(path.as_path())),
+        frames_within(&mut app, |a| a.files.opening() == Some(path.as_path())),
         "the save started no reload"
     );
     // Held: the old scene stays and renders an edit.
-    app.edit.camera.position.y += 0.1;
+    app.working.scene.camera.position.y += 0.1;
     app.command(Command::MoveCamera);
     app.apply();
     let generation = app.generation();
-    assert!(poll_until(&mut app, |a| a.samples_done() >= 1
+    assert!(frames_within(&mut app, |a| a.samples_done() >= 1
         && a.generation() == generation));
     assert_eq!(app.scene().lights[0].color.x, 1.0, "the old scene stays");
     assert!(
-        app.opening().is_some(),
+        app.files.opening().is_some(),
         "the reload waits in the background"
     );
-    let camera = app.edit.camera.clone();
+    let camera = app.working.scene.camera.clone();
     // Let go: the reload comes in, keeping the camera as moved.
     *gate.0.lock().expect("gate") = false;
     gate.1.notify_all();
     assert!(
-        poll_until(&mut app, |a| a.scene().lights[0].color.x == 0.25
+        frames_within(&mut app, |a| a.scene().lights[0].color.x == 0.25
             && a.is_finished()),
         "the reload did not come in: {:?}",
-        app.messages
+        app.messages.log()
     );
     assert_eq!(app.scene().camera, camera, "the viewer's camera stays");
 }
@@ -223,28 +226,33 @@ fn the_used_texture_reloads_and_other_images_beside_it_do_not() {
     let scene = load_scene_file(&obj).expect("loads");
     assert_eq!(scene.textures.len(), 1, "{:?}", scene.warnings);
     let mut app = ViewerApp::headless(scene, "quad".into()).expect("the viewer starts");
-    assert!(poll_until(&mut app, ViewerApp::is_finished));
+    assert!(frames_within(&mut app, ViewerApp::is_finished));
     let reloads = |app: &ViewerApp| {
         app.messages
+            .log()
             .iter()
-            .filter(|(e, m)| !e && m.starts_with("reloaded "))
+            .filter(|m| !m.is_error() && m.text.starts_with("reloaded "))
             .count()
     };
-    // A screenshot saved beside the model is not part of the scene: no reload.
+    // A screenshot saved beside the model is not part of the scene: no reload, and nothing
+    // waits for one, for several times the watch's settling time (a change it took for the
+    // scene's would be pending within it, and reloaded at its end).
     png(&dir.path().join("screenshot.png"), 3, [1, 2, 3]);
-    let quiet = Instant::now() + Duration::from_millis(800);
+    let quiet = Instant::now() + 4 * DEBOUNCE;
     while Instant::now() < quiet {
-        app.poll_session();
-        app.apply();
-        std::thread::sleep(Duration::from_millis(10));
+        assert!(
+            !app.reload_pending(),
+            "the screenshot was taken for the scene's"
+        );
+        frame(&mut app);
     }
-    assert_eq!(reloads(&app), 0, "{:?}", app.messages);
+    assert_eq!(reloads(&app), 0, "{:?}", app.messages.log());
     assert!(!app.reload_pending());
     // The texture the material uses: reloaded with its new colour.
     png(&dir.path().join("wood.png"), 2, [10, 200, 30]);
     assert!(
-        poll_until(&mut app, |a| reloads(a) == 1 && a.is_finished()),
+        frames_within(&mut app, |a| reloads(a) == 1 && a.is_finished()),
         "the texture's save was not reloaded: {:?}",
-        app.messages
+        app.messages.log()
     );
 }

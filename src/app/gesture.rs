@@ -3,17 +3,20 @@
 
 use eframe::egui;
 
-use super::{Command, ViewerApp};
-use crate::scene::CameraFrame;
+use super::Command;
+use crate::scene::{CameraFrame, Scene};
 
 /// How near (points) a press must be to a light's marker to grab it.
 pub const LIGHT_GRAB_RADIUS: f32 = 12.0;
 
 /// A drag that starts on a light's marker in a view seen through `camera` over `rect` moves
 /// that light in the plane facing the camera (it stays under the pointer); returns whether
-/// the drag is the light's (then the view must not orbit).
+/// the drag is the light's (then the view must not orbit). The light moved becomes the
+/// `selected_light`.
 pub fn drag_light(
-    app: &mut ViewerApp,
+    edit: &mut Scene,
+    selected_light: &mut Option<usize>,
+    pending: &mut Vec<Command>,
     ui: &egui::Ui,
     response: &egui::Response,
     camera: &crate::scene::Camera,
@@ -29,8 +32,7 @@ pub fn drag_light(
     };
     let i = match held(ui, response, key, || {
         let origin = ui.input(|i| i.pointer.press_origin())?;
-        app.edit
-            .lights
+        edit.lights
             .iter()
             .enumerate()
             // A headlight stays at the eye: it is moved with the camera, not dragged.
@@ -44,12 +46,12 @@ pub fn drag_light(
         Err(ours) => return ours,
     };
     let delta = response.drag_delta();
-    if let Some(light) = app.edit.lights.get_mut(i)
+    if let Some(light) = edit.lights.get_mut(i)
         && delta != egui::Vec2::ZERO
     {
         light.position += plane_move(camera, light.position, delta, rect.height());
-        app.selected_light = Some(i);
-        app.pending.push(Command::Restart);
+        *selected_light = Some(i);
+        pending.push(Command::Restart);
     }
     true
 }
@@ -89,7 +91,8 @@ pub fn sphere_at(
 /// the sphere in the plane facing the camera (the accelerator is rebuilt as it moves); returns
 /// whether the drag is the sphere's.
 pub fn drag_sphere(
-    app: &mut ViewerApp,
+    edit: &mut Scene,
+    pending: &mut Vec<Command>,
     ui: &egui::Ui,
     response: &egui::Response,
     camera: &crate::scene::Camera,
@@ -100,17 +103,17 @@ pub fn drag_sphere(
         let shift = ui.input(|i| i.modifiers.shift);
         ui.input(|i| i.pointer.press_origin())
             .filter(|_| shift)
-            .and_then(|origin| sphere_at(&app.edit.spheres, camera, rect, origin))
+            .and_then(|origin| sphere_at(&edit.spheres, camera, rect, origin))
     }) {
         Ok(i) => i,
         Err(ours) => return ours,
     };
     let delta = response.drag_delta();
-    if let Some(sphere) = app.edit.spheres.get_mut(i)
+    if let Some(sphere) = edit.spheres.get_mut(i)
         && delta != egui::Vec2::ZERO
     {
         sphere.center += plane_move(camera, sphere.center, delta, rect.height());
-        app.pending.push(Command::Rebuild);
+        pending.push(Command::Rebuild);
     }
     true
 }

@@ -1,11 +1,11 @@
-//! Opening a scene file off the UI thread (issue 14.5, SPEC §4: the window never freezes). One
-//! background job reads the file (in chunks, with the bytes counted), parses it (meshes,
-//! materials, attributes, the first look of a bare OBJ), makes the viewer's copy at the render
-//! size and builds the accelerator (on rayon's global pool, beside the render's workers); the
-//! UI keeps drawing the previous scene and takes the result when it is ready
-//! ([`OpenJob::try_take`]). A newer open, an accelerator change or a
-//! reload cancels the job: its flag is checked at every stage boundary (and between chunks
-//! of the read), and a cancelled job never sends a result.
+//! Opening a scene file off the UI thread, so the window never freezes (docs/design.md, "The
+//! viewer"). One background job reads the file (in chunks, with the bytes counted), parses it
+//! (meshes, materials, attributes, the first look of a bare OBJ), makes the viewer's copy at
+//! the render size and builds the accelerator (on rayon's global pool, beside the render's
+//! workers); the UI keeps drawing the previous scene and takes the result when it is ready
+//! ([`OpenJob::try_take`]). A newer open, an accelerator change or a reload cancels the job:
+//! its flag is checked at every stage boundary (and between chunks of the read), and a
+//! cancelled job never sends a result.
 //!
 //! Progress is stage-weighted (see [`OpenJob::percent`] and the README): the read is counted in
 //! bytes; the parse and the build, which report nothing, are timed against estimates from the
@@ -234,11 +234,20 @@ pub enum Outcome {
     Failed(String),
 }
 
+/// Why a file is opened.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OpenKind {
+    /// Another scene, asked for by the user.
+    Open,
+    /// The scene shown, again, after a save.
+    Reload,
+}
+
 /// An open under way.
 pub struct OpenJob {
     pub path: PathBuf,
     /// Whether it reloads the open scene after a save.
-    pub reload: bool,
+    pub kind: OpenKind,
     /// The accelerator it builds.
     pub accel: crate::accel::AccelKind,
     cancel: Arc<AtomicBool>,
@@ -259,7 +268,11 @@ impl OpenJob {
         let (sender, receiver) = channel();
         let job = Self {
             path: request.path.clone(),
-            reload: request.reload.is_some(),
+            kind: if request.reload.is_some() {
+                OpenKind::Reload
+            } else {
+                OpenKind::Open
+            },
             accel: request.settings.accel,
             cancel: cancel.clone(),
             progress: progress.clone(),

@@ -1,15 +1,24 @@
 //! The panels: each edits the working copy of the scene or settings and queues commands; none
 //! applies anything itself.
 
+use std::sync::atomic::Ordering;
+
 use eframe::egui::{self, DragValue, RichText, Ui};
 use glam::Vec3;
 
-use super::dialog::{BrowseFor, FileBrowser};
+use super::dialog::BrowseFor;
+use super::messages::Messages;
 use super::modes::ImageMode;
-use super::tree_view;
-use super::{Command, ViewerApp};
+use super::render_view::RenderView;
+use super::scene_files::SceneFiles;
+use super::selection::TreeSelection;
+use super::undo::WorkingCopy;
+use super::viewport::Tonemap;
+use super::workspace::{self, Prefs, Workspace};
+use super::{Command, tree_view};
 use crate::choice::Choice;
 use crate::scene::{Light, Material, builtin, rules};
+use crate::trace::Tracer;
 
 // ---- what each setting does, in the lecture's words ---------------------------------------
 
@@ -167,75 +176,90 @@ fn combo<T: Choice>(ui: &mut Ui, label: &str, value: &mut T, tip: &str) -> bool 
 
 // ---- panels -------------------------------------------------------------------------------
 
-pub fn top_bar(app: &mut ViewerApp, ui: &mut Ui) {
+/// The menu bar: Scene, Edit, View, the sweep, help, and the scene's name.
+pub fn top_bar(
+    ui: &mut Ui,
+    ws: &mut Workspace,
+    working: &mut WorkingCopy,
+    files: &SceneFiles,
+    messages: &mut Messages,
+    pending: &mut Vec<Command>,
+) {
     egui::Panel::top("menu").show(ui, |ui| {
         egui::MenuBar::new().ui(ui, |ui| {
             ui.menu_button("Scene", |ui| {
                 if ui.button("Open... (Ctrl+O)").clicked() {
-                    app.browser = Some(FileBrowser::new(BrowseFor::Open, app.start_dir(), ""));
+                    ws.browse(BrowseFor::Open, "");
                 }
                 ui.menu_button("Built-in", |ui| {
                     for name in builtin::NAMES {
                         if ui.button(*name).clicked() {
-                            app.command(Command::OpenBuiltin(name.to_string()));
+                            pending.push(Command::OpenBuiltin(name.to_string()));
                         }
                     }
                 });
                 if ui.button("Save scene as...").clicked() {
-                    let name = format!("{}.toml", app.file_stem());
-                    app.browser = Some(FileBrowser::new(
-                        BrowseFor::SaveScene,
-                        app.start_dir(),
-                        &name,
-                    ));
+                    ws.browse(BrowseFor::SaveScene, &format!("{}.toml", files.file_stem()));
                 }
                 if ui.button("Export... (Ctrl+S)").clicked() {
-                    app.export_choice = true;
+                    ws.export_choice = true;
                 }
             });
             ui.menu_button("Edit", |ui| {
                 if ui
-                    .add_enabled(app.history.can_undo(), egui::Button::new("Undo (Ctrl+Z)"))
+                    .add_enabled(
+                        working.history.can_undo(),
+                        egui::Button::new("Undo (Ctrl+Z)"),
+                    )
                     .clicked()
                 {
-                    app.undo();
+                    working.undo(pending);
                 }
                 if ui
                     .add_enabled(
-                        app.history.can_redo(),
+                        working.history.can_redo(),
                         egui::Button::new("Redo (Ctrl+Shift+Z, Ctrl+Y)"),
                     )
                     .clicked()
                 {
-                    app.redo();
+                    working.redo(pending);
                 }
                 ui.separator();
                 if ui.button("Reset camera to the scene's (Home)").clicked() {
-                    app.reset_camera();
+                    working.reset_camera(pending);
                 }
             });
             ui.menu_button("View", |ui| {
                 for mode in ImageMode::ALL {
-                    ui.radio_value(&mut app.prefs.mode, mode, mode.label());
+                    ui.radio_value(&mut ws.prefs.mode, mode, mode.label());
                 }
                 ui.separator();
-                super::workspace::pane_toggles(app, ui);
+                workspace::pane_toggles(ws, messages, ui);
             });
             if ui.button("Speed vs accuracy").clicked() {
-                app.sweep.open = true;
+                ws.sweep.open = true;
             }
             if ui.button("Help (F1)").clicked() {
-                app.show_help = true;
+                ws.show_help = true;
             }
             ui.separator();
-            ui.label(RichText::new(&app.scene_label).strong());
+            ui.label(RichText::new(&files.label).strong());
         });
     });
 }
 
-pub fn status_bar(app: &mut ViewerApp, ui: &mut Ui) {
+/// The status bar: the open under way, the render's progress and rates, and the pixel under
+/// the pointer.
+pub fn status_bar(
+    ui: &mut Ui,
+    render: &RenderView,
+    files: &mut SceneFiles,
+    selection: &TreeSelection,
+    target: u32,
+    finished: bool,
+) {
     egui::Panel::bottom("status").show(ui, |ui| {
-        if let Some((label, percent)) = app.open_status() {
+        if let Some((label, percent)) = files.status() {
             // The open runs in the background; the scene shown stays usable meanwhile.
             ui.horizontal(|ui| {
                 ui.add(egui::ProgressBar::new(percent / 100.0).desired_width(220.0));
@@ -243,18 +267,14 @@ pub fn status_bar(app: &mut ViewerApp, ui: &mut Ui) {
                 ui.weak("(the scene shown stays until the new one is ready)");
             });
         }
-        let target = app.viewer_target();
-        let stats = app.session.stats().counts();
-        let elapsed = match (app.progress.finished_secs, app.progress.started) {
-            (Some(s), _) => s,
-            (None, Some(t)) => t.elapsed().as_secs_f64(),
-            _ => 0.0,
-        };
+        let stats = render.session.stats().counts();
+        let elapsed = render.progress.elapsed();
         let mrays = |n: u64| n as f64 / elapsed.max(1e-6) / 1e6;
-        let (w, h) = (app.scene.render.width as u64, app.scene.render.height as u64);
-        let pass_fraction = app.session.stats().pixels_done.load(std::sync::atomic::Ordering::Relaxed) as f32 / (w * h).max(1) as f32;
-        let done = app.progress.samples_done as f32 / target.max(1) as f32;
-        let fraction = if app.is_finished() {
+        let (w, h) = render.size();
+        let pixels_done = render.session.stats().pixels_done.load(Ordering::Relaxed);
+        let pass_fraction = pixels_done as f32 / (w as u64 * h as u64).max(1) as f32;
+        let done = render.progress.samples_done as f32 / target.max(1) as f32;
+        let fraction = if finished {
             1.0
         } else {
             // Passes double the samples, so the last pass is half the work.
@@ -264,23 +284,23 @@ pub fn status_bar(app: &mut ViewerApp, ui: &mut Ui) {
             ui.add(
                 egui::ProgressBar::new(fraction)
                     .desired_width(220.0)
-                    .text(format!("{}/{} spp", app.progress.samples_done, target)),
+                    .text(format!("{}/{} spp", render.progress.samples_done, target)),
             );
             ui.label(format!(
                 "{} · {:.2} s · {:.2} Mrays/s (primary {:.2}, reflected {:.2}, refracted {:.2}, shadow {:.2}) · {} threads",
-                if app.is_finished() { "done" } else { &app.progress.pass_label },
+                if finished { "done" } else { &render.progress.pass_label },
                 elapsed,
                 mrays(stats.total()),
                 mrays(stats.primary),
                 mrays(stats.reflected),
                 mrays(stats.refracted),
                 mrays(stats.shadow),
-                app.session.threads(),
+                render.session.threads(),
             ));
         });
         ui.horizontal(|ui| {
-            if let Some((x, y)) = app.hover {
-                let (c, a) = app.film.pixel(x, y);
+            if let Some((x, y)) = selection.hover {
+                let (c, a) = render.film.pixel(x, y);
                 ui.monospace(format!(
                     "pixel ({x}, {y})  rgb ({:.4}, {:.4}, {:.4})  depth {}  rays {}  normal ({:.2}, {:.2}, {:.2})",
                     c.x, c.y, c.z, a.depth_reached, a.rays, a.normal.x, a.normal.y, a.normal.z
@@ -292,14 +312,54 @@ pub fn status_bar(app: &mut ViewerApp, ui: &mut Ui) {
     });
 }
 
-pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
+/// The viewer's own settings, in the render panel: the sample target and the pane size.
+fn view_settings(
+    ui: &mut Ui,
+    prefs: &mut Prefs,
+    render: &mut RenderView,
+    pending: &mut Vec<Command>,
+) {
+    let mut target = prefs.viewer_samples;
+    let mut pane = prefs.pane_size;
+    let changed_target = ui
+        .add(
+            egui::Slider::new(&mut target, 1..=4096)
+                .logarithmic(true)
+                .text("viewer samples"),
+        )
+        .on_hover_text(
+            "samples per pixel the viewer refines to, then it idles; the scene's `samples` \
+             is for export and `raytree render`",
+        )
+        .changed();
+    let changed_pane = ui
+        .checkbox(&mut pane, "render at pane size")
+        .on_hover_text(
+            "render as many pixels as the render pane has (sharp at any window size); the \
+             scene's width and height stay for export and saving",
+        )
+        .changed();
+    if changed_target || changed_pane {
+        render.set_view(prefs, pending, target, pane);
+    }
+}
+
+/// The settings panel: render settings, display, camera, lights, materials and the scene.
+pub fn side_panel(
+    ui: &mut Ui,
+    working: &mut WorkingCopy,
+    prefs: &mut Prefs,
+    render: &mut RenderView,
+    selection: &TreeSelection,
+    pending: &mut Vec<Command>,
+) {
     let mut restart = false;
     let mut rebuild = false;
     egui::CollapsingHeader::new("Render settings")
         .default_open(true)
         .show(ui, |ui| {
-            app.view_settings_ui(ui);
-            let r = &mut app.edit.render;
+            view_settings(ui, prefs, render, pending);
+            let r = &mut working.scene.render;
             restart |= ui
                 .add(egui::Slider::new(&mut r.max_depth, rules::DEPTH).text("max depth"))
                 .on_hover_text(tips::MAX_DEPTH)
@@ -334,7 +394,7 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                 &mut r.ambient_light,
                 tips::AMBIENT_LIGHT,
             );
-            let t = &mut app.settings.trace;
+            let t = &mut working.settings.trace;
             restart |= combo(ui, "sphere", &mut t.methods.sphere, tips::SPHERE);
             restart |= combo(ui, "triangle", &mut t.methods.triangle, tips::TRIANGLE);
             restart |= combo(ui, "offset", &mut t.methods.offset, tips::OFFSET);
@@ -360,41 +420,41 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                 restart |= drag(
                     ui,
                     "threads (0 = all)",
-                    DragValue::new(&mut app.settings.threads).range(0..=rules::MAX_THREADS),
+                    DragValue::new(&mut working.settings.threads).range(0..=rules::MAX_THREADS),
                     tips::THREADS,
                 );
             });
-            ui.label(format!("accelerator in use: {:?}", app.tracer.accel.kind()));
+            ui.label(format!("accelerator in use: {:?}", render.accel().kind()));
         });
     egui::CollapsingHeader::new("Display")
         .default_open(true)
         .show(ui, |ui| {
             egui::ComboBox::from_label("image")
-                .selected_text(app.prefs.mode.label())
+                .selected_text(prefs.mode.label())
                 .show_ui(ui, |ui| {
                     for m in ImageMode::ALL {
-                        ui.selectable_value(&mut app.prefs.mode, m, m.label());
+                        ui.selectable_value(&mut prefs.mode, m, m.label());
                     }
                 })
                 .response
                 .on_hover_text(tips::IMAGE_MODE);
             ui.add(
-                egui::Slider::new(&mut app.prefs.exposure, 0.01..=16.0)
+                egui::Slider::new(&mut prefs.exposure, 0.01..=16.0)
                     .logarithmic(true)
                     .text("exposure"),
             )
             .on_hover_text(tips::EXPOSURE);
             ui.horizontal(|ui| {
                 ui.label("tonemap").on_hover_text(tips::TONEMAP);
-                ui.radio_value(&mut app.prefs.tonemap, 0, "clamp");
-                ui.radio_value(&mut app.prefs.tonemap, 1, "Reinhard");
-                ui.radio_value(&mut app.prefs.tonemap, 2, "ACES");
+                for t in Tonemap::ALL {
+                    ui.radio_value(&mut prefs.tonemap, t, t.label());
+                }
             });
         });
     egui::CollapsingHeader::new("Camera")
         .default_open(true)
         .show(ui, |ui| {
-            let c = &mut app.edit.camera;
+            let c = &mut working.scene.camera;
             restart |= vec3_edit(ui, "position", &mut c.position, 0.05, tips::POSITION);
             restart |= vec3_edit(ui, "look at ", &mut c.look_at, 0.05, tips::LOOK_AT);
             restart |= vec3_edit(ui, "up      ", &mut c.up, 0.01, tips::UP);
@@ -408,7 +468,7 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                     .on_hover_text("move the camera back until every object is in view")
                     .clicked()
                 {
-                    app.pending.push(Command::FrameAll);
+                    pending.push(Command::FrameAll);
                 }
                 if ui
                     .button("Reset to the scene's")
@@ -417,23 +477,24 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                     )
                     .clicked()
                 {
-                    app.reset_camera();
+                    working.reset_camera(pending);
                 }
             });
             ui.add(
-                egui::Slider::new(&mut app.prefs.orbit_degrees, 30.0..=720.0)
+                egui::Slider::new(&mut prefs.orbit_degrees, 30.0..=720.0)
                     .text("orbit (° per width)")
                     .max_decimals(0),
             )
             .on_hover_text(tips::ORBIT);
             ui.small("drag: orbit · right/middle drag: pan · wheel: zoom · Home: reset");
         });
-    egui::CollapsingHeader::new(format!("Lights ({})", app.edit.lights.len()))
+    let edit = &mut working.scene;
+    egui::CollapsingHeader::new(format!("Lights ({})", edit.lights.len()))
         .default_open(true)
         .show(ui, |ui| {
             let mut remove = None;
-            for (i, l) in app.edit.lights.iter_mut().enumerate() {
-                let selected = app.selected_light == Some(i);
+            for (i, l) in edit.lights.iter_mut().enumerate() {
+                let selected = selection.selected_light == Some(i);
                 egui::CollapsingHeader::new(&l.name)
                     .id_salt(("light", i))
                     .default_open(selected)
@@ -482,22 +543,17 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                     });
             }
             if let Some(i) = remove {
-                app.edit.lights.remove(i);
+                edit.lights.remove(i);
                 restart = true;
             }
             if ui.button("Add light").clicked() {
                 // A name no light has (after a removal, `light {len + 1}` may be taken).
-                let mut n = app.edit.lights.len() + 1;
-                while app
-                    .edit
-                    .lights
-                    .iter()
-                    .any(|l| l.name == format!("light {n}"))
-                {
+                let mut n = edit.lights.len() + 1;
+                while edit.lights.iter().any(|l| l.name == format!("light {n}")) {
                     n += 1;
                 }
-                let pos = app.edit.camera.position + Vec3::Y;
-                app.edit.lights.push(Light {
+                let pos = edit.camera.position + Vec3::Y;
+                edit.lights.push(Light {
                     name: format!("light {n}"),
                     position: pos,
                     color: Vec3::ONE,
@@ -507,12 +563,12 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
                 restart = true;
             }
         });
-    egui::CollapsingHeader::new(format!("Materials ({})", app.edit.materials.len()))
+    egui::CollapsingHeader::new(format!("Materials ({})", edit.materials.len()))
         .default_open(true)
         .show(ui, |ui| {
             ui.small("click an object in the image to select its material");
-            for (i, m) in app.edit.materials.iter_mut().enumerate() {
-                let selected = app.selected_material == Some(i);
+            for (i, m) in edit.materials.iter_mut().enumerate() {
+                let selected = selection.selected_material == Some(i);
                 let title = if selected {
                     RichText::new(format!("> {}", m.name)).strong()
                 } else {
@@ -530,7 +586,7 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
     egui::CollapsingHeader::new("Scene")
         .default_open(false)
         .show(ui, |ui| {
-            let s = &app.scene;
+            let s = render.scene();
             ui.label(format!(
                 "{} spheres, {} triangles, {} lights, {} materials",
                 s.spheres.len(),
@@ -540,14 +596,14 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
             ));
             for name in builtin::NAMES {
                 if ui.button(format!("Open built-in \"{name}\"")).clicked() {
-                    app.pending.push(Command::OpenBuiltin(name.to_string()));
+                    pending.push(Command::OpenBuiltin(name.to_string()));
                 }
             }
         });
     if rebuild {
-        app.pending.push(Command::Rebuild);
+        pending.push(Command::Rebuild);
     } else if restart {
-        app.pending.push(Command::Restart);
+        pending.push(Command::Restart);
     }
 }
 
@@ -581,8 +637,8 @@ fn material_editor(ui: &mut Ui, m: &mut Material) -> bool {
 
 /// The clicked pixel's tree: the list (or the pinned and current trees side by side, changed
 /// nodes marked), and the numbers of the selected node.
-pub fn tree_panel(app: &mut ViewerApp, ui: &mut Ui) {
-    let Some(tree) = app.tree.clone() else {
+pub fn tree_panel(ui: &mut Ui, selection: &mut TreeSelection, ws: &mut Workspace, tracer: &Tracer) {
+    let Some(tree) = selection.tree.clone() else {
         return;
     };
     ui.horizontal(|ui| {
@@ -591,7 +647,7 @@ pub fn tree_panel(app: &mut ViewerApp, ui: &mut Ui) {
             tree.pixel[0], tree.pixel[1]
         ));
         if ui.small_button("x").clicked() {
-            app.tree = None;
+            selection.tree = None;
         }
     });
     ui.label(format!(
@@ -603,28 +659,24 @@ pub fn tree_panel(app: &mut ViewerApp, ui: &mut Ui) {
         if tree.truncated { " (truncated)" } else { "" }
     ));
     ui.horizontal(|ui| {
-        if app.tree_state.pinned.is_some() {
+        if selection.tree_state.pinned.is_some() {
             if ui.button("Unpin").clicked() {
-                app.tree_state.pinned = None;
+                selection.tree_state.pinned = None;
             }
         } else if ui
             .button("Pin for comparison")
             .on_hover_text("keep this tree, then change a setting to compare")
             .clicked()
         {
-            app.tree_state.pinned = Some(tree.clone());
+            selection.tree_state.pinned = Some(tree.clone());
         }
         if ui.button("Export tree as JSON...").clicked() {
             let name = format!("tree-{}-{}.json", tree.pixel[0], tree.pixel[1]);
-            app.browser = Some(FileBrowser::new(
-                BrowseFor::ExportTree,
-                app.start_dir(),
-                &name,
-            ));
+            ws.browse(BrowseFor::ExportTree, &name);
         }
     });
     ui.separator();
-    let state = &mut app.tree_state;
+    let state = &mut selection.tree_state;
     egui::ScrollArea::both()
         .id_salt("tree list")
         .max_height(ui.available_height() * 0.5)
@@ -646,13 +698,13 @@ pub fn tree_panel(app: &mut ViewerApp, ui: &mut Ui) {
     ui.separator();
     let selected = state.selected.clone().unwrap_or_default();
     // What the accelerator did for the selected ray (replayed: one query, cheap).
-    if let Some((_, visits)) = crate::scene_view::visit_segments(&app.tracer, &tree, &selected) {
+    if let Some((_, visits)) = crate::scene_view::visit_segments(tracer, &tree, &selected) {
         let mut prims = visits.prims.clone();
         prims.sort_unstable();
         prims.dedup();
         ui.label(format!(
             "accelerator ({}): this ray entered {} boxes and tested {} primitives ({} tests)",
-            crate::choice::Choice::name(app.tracer.accel.kind()),
+            crate::choice::Choice::name(tracer.accel.kind()),
             visits.boxes.len(),
             prims.len(),
             visits.prims.len(),
@@ -668,15 +720,14 @@ pub fn tree_panel(app: &mut ViewerApp, ui: &mut Ui) {
 
 /// What Ctrl+S offers: the clean render, the render with the rays drawn over it, or the scene
 /// view; each then asks for a file name.
-pub fn export_window(app: &mut ViewerApp, ctx: &egui::Context) {
-    let mut open = app.export_choice;
+pub fn export_window(ctx: &egui::Context, ws: &mut Workspace, has_tree: bool, stem: &str) {
+    let mut open = ws.export_choice;
     let mut chosen = None;
     egui::Window::new("Export")
         .open(&mut open)
         .collapsible(false)
         .resizable(false)
         .show(ctx, |ui| {
-            let has_tree = app.tree.is_some();
             for (what, label, enabled, hint) in [
                 (BrowseFor::Export, "Render (PNG or EXR)", true, "the film at full resolution, as rendered"),
                 (BrowseFor::ExportOverlay, "Render with rays (PNG)", has_tree, "the render with the trees drawn over it, as in the render view"),
@@ -690,15 +741,14 @@ pub fn export_window(app: &mut ViewerApp, ctx: &egui::Context) {
                 ui.weak("click a pixel for a ray tree to export the rays");
             }
         });
-    app.export_choice = open && chosen.is_none();
+    ws.export_choice = open && chosen.is_none();
     if let Some(what) = chosen {
         let suffix = match what {
             BrowseFor::ExportOverlay => "-rays",
             BrowseFor::ExportSceneView => "-scene-view",
             _ => "",
         };
-        let name = format!("{}{suffix}.png", app.file_stem());
-        app.browser = Some(FileBrowser::new(what, app.start_dir(), &name));
+        ws.browse(what, &format!("{stem}{suffix}.png"));
     }
 }
 

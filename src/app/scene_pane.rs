@@ -1,4 +1,4 @@
-//! The scene view (SPEC §5c): the scene seen from a camera of its own, independent of the render
+//! The scene view (docs/design.md, "The viewer"): the scene seen from a camera of its own, independent of the render
 //! camera, with the render camera (frustum, image plane, clicked pixel), the lights and the ray
 //! trees drawn over it, parts behind surfaces dimmed.
 //!
@@ -23,8 +23,10 @@ use glam::Vec3;
 use super::film::Film;
 use super::modes::ImageMode;
 use super::paint3d::{self, Drawn, Look, ScreenView};
-use super::viewport::{DisplayCallback, DisplayId, DisplayState, SharedDisplay};
-use super::{ViewerApp, tree_view};
+use super::selection::TreeSelection;
+use super::viewport::{DisplayCallback, DisplayId, DisplayState, SharedDisplay, Tonemap};
+use super::workspace::Prefs;
+use super::{Command, tree_view};
 use crate::accel::Accel;
 use crate::render::session::{Session, SessionEvent, View};
 use crate::scene::camera::FRAME_MARGIN;
@@ -201,7 +203,7 @@ impl SceneView {
     }
 
     /// Matches the display's exposure and tonemap to the render view's.
-    fn set_params(&self, exposure: f32, tonemap: u32) {
+    fn set_params(&self, exposure: f32, tonemap: Tonemap) {
         let mut d = crate::sync::lock(&self.display);
         if d.params.exposure != exposure || d.params.tonemap != tonemap {
             d.params.exposure = exposure;
@@ -230,20 +232,21 @@ pub fn deepest<'a>(trees: impl IntoIterator<Item = &'a crate::ray_tree::RayTree>
 
 /// Advances the step-through's playback: one more generation every `1 / speed` seconds, stopping
 /// at the deepest.
-pub fn advance_playback(app: &mut ViewerApp, ctx: &egui::Context) {
-    let Some(since) = app.scene_view.playing else {
+pub fn advance_playback(view: &mut SceneView, selection: &mut TreeSelection, ctx: &egui::Context) {
+    let Some(since) = view.playing else {
         return;
     };
-    let deepest = deepest(app.trees());
-    let step = 1.0 / app.scene_view.speed.max(0.05);
+    let deepest = deepest(selection.trees());
+    let step = 1.0 / view.speed.max(0.05);
     if since.elapsed().as_secs_f32() >= step {
-        let next = app.tree_state.reveal.map_or(0, |g| g + 1);
+        let reveal = &mut selection.tree_state.reveal;
+        let next = reveal.map_or(0, |g| g + 1);
         if next > deepest {
-            app.scene_view.playing = None;
-            app.tree_state.reveal = None;
+            view.playing = None;
+            *reveal = None;
         } else {
-            app.tree_state.reveal = Some(next);
-            app.scene_view.playing = Some(Instant::now());
+            *reveal = Some(next);
+            view.playing = Some(Instant::now());
         }
     }
     ctx.request_repaint();
@@ -260,21 +263,21 @@ const KEY_MIN_VIEW: (f32, f32) = (360.0, 320.0);
 
 /// The toolbar: the step-through (play, depth slider, speed), "Frame", and the filters, inline
 /// in a wide pane and in the "Show" menu otherwise (two rows, three in the narrowest pane).
-fn toolbar(app: &mut ViewerApp, ui: &mut Ui) {
+fn toolbar(ui: &mut Ui, view: &mut SceneView, selection: &mut TreeSelection, tracer: &Arc<Tracer>) {
     let inline = ui.available_width() >= FILTERS_INLINE_WIDTH;
     if inline {
         ui.horizontal_wrapped(|ui| {
-            step_through(app, ui);
-            speed_and_frame(app, ui, true);
+            step_through(ui, view, selection);
+            speed_and_frame(ui, view, tracer, true);
         });
-        ui.horizontal_wrapped(|ui| filters(app, ui));
+        ui.horizontal_wrapped(|ui| filters(ui, view, tracer));
     } else {
-        ui.horizontal(|ui| step_through(app, ui));
+        ui.horizontal(|ui| step_through(ui, view, selection));
         ui.horizontal_wrapped(|ui| {
-            speed_and_frame(app, ui, false);
+            speed_and_frame(ui, view, tracer, false);
             MenuButton::new("Show")
                 .config(stays_open())
-                .ui(ui, |ui| filters(app, ui))
+                .ui(ui, |ui| filters(ui, view, tracer))
                 .0
                 .on_hover_text("ray kinds, normals, visits, BVH level and end reasons shown");
         });
@@ -282,22 +285,23 @@ fn toolbar(app: &mut ViewerApp, ui: &mut Ui) {
 }
 
 /// Play (or Pause) and the depth slider, which takes the row's remaining width.
-fn step_through(app: &mut ViewerApp, ui: &mut Ui) {
-    let deepest = deepest(app.trees());
-    let playing = app.scene_view.playing.is_some();
+fn step_through(ui: &mut Ui, view: &mut SceneView, selection: &mut TreeSelection) {
+    let deepest = deepest(selection.trees());
+    let reveal = &mut selection.tree_state.reveal;
+    let playing = view.playing.is_some();
     if ui
         .button(if playing { "Pause" } else { "Play" })
         .on_hover_text("reveal the tree generation by generation")
         .clicked()
     {
         if playing {
-            app.scene_view.playing = None;
+            view.playing = None;
         } else {
-            app.tree_state.reveal = Some(0);
-            app.scene_view.playing = Some(Instant::now());
+            *reveal = Some(0);
+            view.playing = Some(Instant::now());
         }
     }
-    let mut depth = app.tree_state.reveal.unwrap_or(deepest).min(deepest);
+    let mut depth = reveal.unwrap_or(deepest).min(deepest);
     let l = ui.label("depth");
     // What the slider's value box and the spacing before it take.
     const VALUE_BOX: f32 = 48.0;
@@ -307,14 +311,14 @@ fn step_through(app: &mut ViewerApp, ui: &mut Ui) {
         .labelled_by(l.id)
         .on_hover_text("show the tree down to this generation");
     if r.changed() {
-        app.tree_state.reveal = (depth < deepest).then_some(depth);
-        app.scene_view.playing = None;
+        *reveal = (depth < deepest).then_some(depth);
+        view.playing = None;
     }
 }
 
 /// The playback speed (labelled where there is room) and "Frame".
-fn speed_and_frame(app: &mut ViewerApp, ui: &mut Ui, labelled: bool) {
-    let speed = egui::DragValue::new(&mut app.scene_view.speed)
+fn speed_and_frame(ui: &mut Ui, view: &mut SceneView, tracer: &Arc<Tracer>, labelled: bool) {
+    let speed = egui::DragValue::new(&mut view.speed)
         .range(0.25..=8.0)
         .speed(0.05)
         .suffix(" gen/s");
@@ -329,9 +333,8 @@ fn speed_and_frame(app: &mut ViewerApp, ui: &mut Ui, labelled: bool) {
         .on_hover_text("frame the scene and the render camera")
         .clicked()
     {
-        let scene = app.scene.clone();
-        app.scene_view.frame(&scene);
-        app.scene_view.restart(&app.tracer);
+        view.frame(&tracer.scene);
+        view.restart(tracer);
     }
 }
 
@@ -343,31 +346,30 @@ fn stays_open() -> MenuConfig {
 
 /// The scene view's filters: ray kinds, normals, the selected ray's visits, one BVH level, and
 /// the end reasons (a menu of its own).
-fn filters(app: &mut ViewerApp, ui: &mut Ui) {
-    let f = &mut app.scene_view.filter;
+fn filters(ui: &mut Ui, view: &mut SceneView, tracer: &Arc<Tracer>) {
+    let f = &mut view.filter;
     ui.checkbox(&mut f.primary, "primary");
     ui.checkbox(&mut f.reflected, "reflected");
     ui.checkbox(&mut f.refracted, "refracted");
     ui.checkbox(&mut f.shadow, "shadow");
     ui.checkbox(&mut f.normals, "normals");
-    ui.checkbox(&mut app.scene_view.show_visits, "visits")
+    ui.checkbox(&mut view.show_visits, "visits")
         .on_hover_text("the boxes the selected ray's traversal entered (BVH nodes or grid cells)");
-    let levels = app.tracer.accel.levels();
-    let mut on = app.scene_view.bvh_level.is_some();
+    let levels = tracer.accel.levels();
+    let mut on = view.bvh_level.is_some();
     ui.horizontal(|ui| {
         if ui
             .checkbox(&mut on, "BVH level")
             .on_hover_text("every box of one level of the accelerator")
             .changed()
         {
-            app.scene_view.bvh_level = on.then_some(0);
+            view.bvh_level = on.then_some(0);
         }
-        if let Some(level) = &mut app.scene_view.bvh_level {
+        if let Some(level) = &mut view.bvh_level {
             ui.add(egui::DragValue::new(level).range(0..=levels.saturating_sub(1)));
         }
     });
-    let accel = app.tracer.accel.clone();
-    if let Some(level) = app.scene_view.level_segments(&accel) {
+    if let Some(level) = view.level_segments(&tracer.accel) {
         let text = match (level.drawn, level.total) {
             (_, 1) => "1 box".to_owned(),
             (drawn, total) if drawn < total => format!("the largest {drawn} of {total} boxes"),
@@ -378,7 +380,7 @@ fn filters(app: &mut ViewerApp, ui: &mut Ui) {
             scene_view::MAX_LEVEL_BOXES
         ));
     }
-    let f = &mut app.scene_view.filter;
+    let f = &mut view.filter;
     let ends = |ui: &mut Ui| {
         for end in [
             EndReason::NoHit,
@@ -420,14 +422,15 @@ pub fn shown_segments(
 /// Draws the trees through `view` (the current tree, the extra trees, the pinned tree in its
 /// own style) and returns what was drawn, tree 0 being the current tree, 1.. the extra trees.
 pub(super) fn draw_trees(
-    app: &ViewerApp,
+    selection: &TreeSelection,
+    scene: &Scene,
     painter: &egui::Painter,
     view: &ScreenView,
     depth: &crate::scene_view::occlusion::DepthImage,
     filter: &Filter,
 ) -> Vec<Drawn> {
-    let extent = scene_view::extent(&app.scene);
-    let state = &app.tree_state;
+    let extent = scene_view::extent(scene);
+    let state = &selection.tree_state;
     let active: Vec<&[usize]> = [state.selected.as_deref(), state.hovered.as_deref()]
         .into_iter()
         .flatten()
@@ -447,12 +450,13 @@ pub(super) fn draw_trees(
         .iter()
         .map(|t| (t, None, pinned))
         .chain(
-            app.extra_trees
+            selection
+                .extra_trees
                 .iter()
                 .enumerate()
                 .map(|(i, t)| (t, Some(i + 1), extra)),
         )
-        .chain(app.tree.iter().map(|t| (t, Some(0), Look::default())));
+        .chain(selection.tree.iter().map(|t| (t, Some(0), Look::default())));
     let mut drawn = Vec::new();
     let mut unpickable = Vec::new();
     for (tree, number, look) in layers {
@@ -478,8 +482,17 @@ pub(super) fn draw_trees(
 
 /// The scene view pane: toolbar, the image, the camera, lights and trees over it; drag to
 /// orbit, right/middle drag to pan, wheel to zoom, click a ray to select its node.
-pub fn scene_view_ui(app: &mut ViewerApp, ui: &mut Ui) {
-    toolbar(app, ui);
+/// `edit` is the working copy, whose lights and spheres can be dragged in the view.
+pub fn scene_view_ui(
+    ui: &mut Ui,
+    view: &mut SceneView,
+    tracer: &Arc<Tracer>,
+    selection: &mut TreeSelection,
+    edit: &mut Scene,
+    prefs: &Prefs,
+    pending: &mut Vec<Command>,
+) {
+    toolbar(ui, view, selection, tracer);
     let rect = ui.available_rect_before_wrap();
     if rect.width() < 8.0 || rect.height() < 8.0 {
         return;
@@ -487,25 +500,25 @@ pub fn scene_view_ui(app: &mut ViewerApp, ui: &mut Ui) {
     let response = ui.allocate_rect(rect, Sense::click_and_drag());
     response.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, "scene view"));
     let size = SceneView::size_for(rect);
-    let mut restart = size != app.scene_view.size;
-    app.scene_view.size = size;
+    let mut restart = size != view.size;
+    view.size = size;
     // Camera moves: only this view's render restarts.
     let delta = response.drag_delta();
     // A drag that starts on a light moves the light instead.
-    let camera = app.scene_view.camera.clone();
-    let light_drag = super::gesture::drag_light(app, ui, &response, &camera, rect)
-        || super::gesture::drag_sphere(app, ui, &response, &camera, rect);
+    let camera = view.camera.clone();
+    let light = &mut selection.selected_light;
+    let light_drag = super::gesture::drag_light(edit, light, pending, ui, &response, &camera, rect)
+        || super::gesture::drag_sphere(edit, pending, ui, &response, &camera, rect);
     if delta != egui::Vec2::ZERO && !light_drag {
         if response.dragged_by(egui::PointerButton::Primary) {
             let (yaw, pitch) =
-                super::gesture::orbit_angles(delta, rect.width(), app.prefs.orbit_degrees);
-            app.scene_view.camera.orbit(yaw, pitch);
+                super::gesture::orbit_angles(delta, rect.width(), prefs.orbit_degrees);
+            view.camera.orbit(yaw, pitch);
             restart = true;
         } else if response.dragged_by(egui::PointerButton::Secondary)
             || response.dragged_by(egui::PointerButton::Middle)
         {
-            app.scene_view
-                .camera
+            view.camera
                 .pan(delta.x / rect.height(), delta.y / rect.height());
             restart = true;
         }
@@ -513,55 +526,53 @@ pub fn scene_view_ui(app: &mut ViewerApp, ui: &mut Ui) {
     if response.hovered() {
         let scroll = ui.input(|i| i.smooth_scroll_delta.y);
         if scroll != 0.0 {
-            app.scene_view.camera.zoom((-scroll * 0.002).exp());
+            view.camera.zoom((-scroll * 0.002).exp());
             restart = true;
         }
     }
     if restart {
-        let tracer = app.tracer.clone();
-        app.scene_view.restart(&tracer);
+        view.restart(tracer);
     }
-    app.scene_view
-        .set_params(app.prefs.exposure, app.prefs.tonemap);
+    view.set_params(prefs.exposure, prefs.tonemap);
     ui.painter()
         .add(eframe::egui_wgpu::Callback::new_paint_callback(
             rect,
             DisplayCallback {
                 id: DisplayId::SceneView,
-                shared: app.scene_view.display.clone(),
+                shared: view.display.clone(),
             },
         ));
-    let (w, h) = app.scene_view.size;
-    let view = ScreenView {
+    let (w, h) = view.size;
+    let screen = ScreenView {
         rect,
-        frame: CameraFrame::new(&app.scene_view.camera, w, h),
+        frame: CameraFrame::new(&view.camera, w, h),
         width: w,
         height: h,
     };
-    let depth = app.scene_view.film.depth();
+    let depth = view.film.depth();
+    let scene = &tracer.scene;
     let painter = ui.painter_at(rect);
     // The render camera with its image plane where the headless scene view puts it.
-    let (plane, pixel) = match &app.tree {
+    let (plane, pixel) = match &selection.tree {
         Some(t) => (
-            scene_view::headless::image_plane_distance(&app.scene, t),
+            scene_view::headless::image_plane_distance(scene, t),
             Some(t.pixel),
         ),
-        None => (0.15 * scene_view::extent(&app.scene), None),
+        None => (0.15 * scene_view::extent(scene), None),
     };
-    let mut camera = scene_view::camera_segments(&app.scene, plane.max(1e-6), pixel);
+    let mut camera = scene_view::camera_segments(scene, plane.max(1e-6), pixel);
     // The accelerator made visible: the boxes the selected ray's traversal entered, and all
     // boxes of one BVH level.
-    if app.scene_view.show_visits
-        && let (Some(tree), Some(path)) = (&app.tree, &app.tree_state.selected)
-        && let Some((boxes, _)) = scene_view::visit_segments(&app.tracer, tree, path)
+    if view.show_visits
+        && let (Some(tree), Some(path)) = (&selection.tree, &selection.tree_state.selected)
+        && let Some((boxes, _)) = scene_view::visit_segments(tracer, tree, path)
     {
         camera.extend(boxes);
     }
-    let accel = app.tracer.accel.clone();
-    let level = app.scene_view.level_segments(&accel);
+    let level = view.level_segments(&tracer.accel);
     paint3d::draw_segments(
         &painter,
-        &view,
+        &screen,
         &depth,
         camera.iter().chain(level.iter().flat_map(|l| &l.segments)),
         usize::MAX,
@@ -569,20 +580,21 @@ pub fn scene_view_ui(app: &mut ViewerApp, ui: &mut Ui) {
         Look::default(),
         &mut Vec::new(),
     );
-    paint3d::draw_lights(&painter, &view, &app.scene.lights);
+    paint3d::draw_lights(&painter, &screen, &scene.lights);
     let filter = Filter {
-        max_generation: app.tree_state.reveal.unwrap_or(u32::MAX),
-        ..app.scene_view.filter.clone()
+        max_generation: selection.max_generation(),
+        ..view.filter.clone()
     };
-    let drawn = draw_trees(app, &painter, &view, &depth, &filter);
+    let drawn = draw_trees(selection, scene, &painter, &screen, &depth, &filter);
     // The key of ray colours, where it leaves most of the view free (the render pane shows
     // the same key over the image).
-    if app.tree.is_some() && rect.width() >= KEY_MIN_VIEW.0 && rect.height() >= KEY_MIN_VIEW.1 {
+    if selection.tree.is_some() && rect.width() >= KEY_MIN_VIEW.0 && rect.height() >= KEY_MIN_VIEW.1
+    {
         super::legend::ray_key(&painter, rect);
     }
-    pick_and_hover(app, &response, &drawn);
-    app.scene_view.drawn = drawn;
-    if app.tree.is_none() {
+    pick_and_hover(selection, &response, &drawn);
+    view.drawn = drawn;
+    if selection.tree.is_none() {
         // Wrapped to the pane: a narrow pane must not cut the hint off.
         let hint = painter.layout(
             "click a pixel in the render view to see its rays here".to_owned(),
@@ -630,27 +642,35 @@ fn corner_fit(
 }
 
 /// Hover on drawn rays: the current tree's node under the pointer lights up everywhere.
-pub(super) fn pick_and_hover_only(app: &mut ViewerApp, response: &egui::Response, drawn: &[Drawn]) {
+pub(super) fn pick_and_hover_only(
+    selection: &mut TreeSelection,
+    response: &egui::Response,
+    drawn: &[Drawn],
+) {
     if let Some(pos) = response.hover_pos()
         && let Some(d) = paint3d::pick(drawn, pos)
         && d.tree == 0
     {
-        app.tree_state.hovered = Some(d.path.clone());
+        selection.tree_state.hovered = Some(d.path.clone());
     }
 }
 
 /// Hover and click on drawn rays: the node lights up everywhere, a click selects it (a ray of
 /// an extra tree makes that tree the current one).
-pub(super) fn pick_and_hover(app: &mut ViewerApp, response: &egui::Response, drawn: &[Drawn]) {
-    pick_and_hover_only(app, response, drawn);
+pub(super) fn pick_and_hover(
+    selection: &mut TreeSelection,
+    response: &egui::Response,
+    drawn: &[Drawn],
+) {
+    pick_and_hover_only(selection, response, drawn);
     if response.clicked()
         && let Some(pos) = response.interact_pointer_pos()
         && let Some(d) = paint3d::pick(drawn, pos)
     {
         if d.tree > 0 {
-            app.make_current(d.tree - 1);
+            selection.make_current(d.tree - 1);
         }
-        app.tree_state.selected = Some(d.path.clone());
+        selection.tree_state.selected = Some(d.path.clone());
     }
 }
 
@@ -711,7 +731,7 @@ mod tests {
 
     /// A flat floor with a few objects, seen from above at an angle: every corner lies inside
     /// the view with the margin, one of them on its edge (the fit is tight), and the camera is
-    /// closer than the bounding sphere's framing (which the pane used before) puts it.
+    /// closer than framing the bounding sphere would put it.
     #[test]
     fn corner_fit_frames_a_flat_box_tightly() {
         let (lo, hi) = (Vec3::new(-12.0, 0.0, -12.0), Vec3::new(12.0, 2.0, 12.0));

@@ -179,10 +179,29 @@ struct DiagramView {
     fit: bool,
     /// The tree (pixel, nodes, max depth) and generations the view was made for.
     key: Option<([u32; 2], usize, u32, Option<u32>)>,
-    /// The legend as the user set it; `None`: shown when it fits beside the tree.
-    legend: Option<bool>,
+    /// Whether the legend is shown.
+    legend: Legend,
     /// Whether the legend fitted beside the tree in the last frame.
     legend_fits: bool,
+}
+
+/// Whether the diagram's legend is shown: as the user set it with its toggle, or, before that,
+/// when it fits beside the tree.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Legend {
+    WhenItFits,
+    Shown,
+    Hidden,
+}
+
+impl Legend {
+    fn shown(self, fits: bool) -> bool {
+        match self {
+            Legend::WhenItFits => fits,
+            Legend::Shown => true,
+            Legend::Hidden => false,
+        }
+    }
 }
 
 impl Default for DiagramView {
@@ -192,7 +211,7 @@ impl Default for DiagramView {
             offset: Vec2::ZERO,
             fit: true,
             key: None,
-            legend: None,
+            legend: Legend::WhenItFits,
             legend_fits: true,
         }
     }
@@ -362,9 +381,13 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
         {
             view.fit = true;
         }
-        let mut legend = view.legend.unwrap_or(view.legend_fits);
+        let mut legend = view.legend.shown(view.legend_fits);
         if ui.toggle_value(&mut legend, "Legend").changed() {
-            view.legend = Some(legend);
+            view.legend = if legend {
+                Legend::Shown
+            } else {
+                Legend::Hidden
+            };
         }
         if ui
             .button("Export SVG...")
@@ -399,7 +422,7 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
     );
     // The tree fits beside the open legend, unless that leaves it too little room.
     view.legend_fits = legend_rect.min.x - rect.min.x > 240.0;
-    let legend_on = view.legend.unwrap_or(view.legend_fits);
+    let legend_on = view.legend.shown(view.legend_fits);
     let area = if legend_on && view.legend_fits {
         Rect::from_min_max(rect.min, Pos2::new(legend_rect.min.x - 6.0, rect.max.y))
     } else {

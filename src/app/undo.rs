@@ -3,14 +3,15 @@
 //!
 //! The history keeps what the viewer can edit ([`Edits`]: render parameters, camera, lights,
 //! materials, spheres (they can be dragged) and trace settings), not the triangles, so a step
-//! stays small even for a mesh of millions of triangles. It is watched once a frame, after the commands are
-//! applied: a change that the loader's rules refused never becomes a step, and a change made
-//! while a gesture is under way (a button held: a drag of a value, an orbit, the colour
-//! picker; the wheel still turning) becomes one step when the gesture ends.
+//! stays small even for a mesh of millions of triangles. It is watched once a frame, after the
+//! commands are applied: a change that the loader's rules refused never becomes a step, and a
+//! change made while a gesture is under way (a button held: a drag of a value, an orbit, the
+//! colour picker; the wheel still turning) becomes one step when the gesture ends.
 
 use eframe::egui;
 
-use super::{Command, ViewerApp};
+use super::Command;
+use crate::render::RenderSettings;
 use crate::scene::{Camera, Light, Material, RenderParams, Scene, Sphere};
 use crate::trace::TraceSettings;
 
@@ -126,23 +127,39 @@ pub fn gesture_under_way(ctx: &egui::Context) -> bool {
         || ctx.input(|i| i.pointer.any_down() || i.smooth_scroll_delta != egui::Vec2::ZERO)
 }
 
-impl ViewerApp {
+/// The working copy the panels edit (the scene and the settings), and its undo history.
+pub struct WorkingCopy {
+    pub scene: Scene,
+    pub settings: RenderSettings,
+    /// Undo and redo of the edits.
+    pub history: History,
+}
+
+impl WorkingCopy {
+    pub fn new(scene: Scene, settings: RenderSettings) -> Self {
+        Self {
+            scene,
+            settings,
+            history: History::default(),
+        }
+    }
+
     /// What the viewer's edits are now.
     pub fn edits(&self) -> Edits {
-        Edits::of(&self.edit, self.settings.trace)
+        Edits::of(&self.scene, self.settings.trace)
     }
 
     /// Records the frame's edits in the history (called once a frame, after the commands).
-    pub(super) fn track_edits(&mut self, ctx: &egui::Context) {
+    pub fn track(&mut self, ctx: &egui::Context) {
         let now = self.edits();
         self.history.observe(&now, gesture_under_way(ctx));
     }
 
-    fn restore(&mut self, to: Edits) {
+    fn restore(&mut self, to: Edits, pending: &mut Vec<Command>) {
         // Moved spheres need the accelerator rebuilt.
-        let rebuild = to.spheres != self.edit.spheres;
-        to.put(&mut self.edit, &mut self.settings.trace);
-        self.pending.push(if rebuild {
+        let rebuild = to.spheres != self.scene.spheres;
+        to.put(&mut self.scene, &mut self.settings.trace);
+        pending.push(if rebuild {
             Command::Rebuild
         } else {
             Command::Restart
@@ -150,11 +167,11 @@ impl ViewerApp {
     }
 
     /// Undoes the last edit; false when there is none.
-    pub fn undo(&mut self) -> bool {
+    pub fn undo(&mut self, pending: &mut Vec<Command>) -> bool {
         let now = self.edits();
         match self.history.undo(&now) {
             Some(to) => {
-                self.restore(to);
+                self.restore(to, pending);
                 true
             }
             None => false,
@@ -162,11 +179,11 @@ impl ViewerApp {
     }
 
     /// Redoes the last undone edit; false when there is none.
-    pub fn redo(&mut self) -> bool {
+    pub fn redo(&mut self, pending: &mut Vec<Command>) -> bool {
         let now = self.edits();
         match self.history.redo(&now) {
             Some(to) => {
-                self.restore(to);
+                self.restore(to, pending);
                 true
             }
             None => false,
@@ -174,12 +191,12 @@ impl ViewerApp {
     }
 
     /// Puts the camera back where the scene placed it (one undoable step).
-    pub fn reset_camera(&mut self) {
+    pub fn reset_camera(&mut self, pending: &mut Vec<Command>) {
         if let Some(home) = self.history.home_camera.clone()
-            && home != self.edit.camera
+            && home != self.scene.camera
         {
-            self.edit.camera = home;
-            self.pending.push(Command::MoveCamera);
+            self.scene.camera = home;
+            pending.push(Command::MoveCamera);
         }
     }
 }

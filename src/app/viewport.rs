@@ -9,17 +9,72 @@ use std::sync::{Arc, Mutex};
 
 use eframe::egui;
 use eframe::egui_wgpu::{self, CallbackResources, CallbackTrait, ScreenDescriptor, wgpu};
+use serde::{Deserialize, Serialize};
 
 use crate::render::Rect;
+
+/// How colours above 1 are shown. Saved in the preferences as its number (the shader's too).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(from = "u32", into = "u32")]
+pub enum Tonemap {
+    /// Cut at 1.
+    #[default]
+    Clamp,
+    /// Rolled off by `c / (1 + c)`.
+    Reinhard,
+    /// Rolled off by the ACES filmic curve.
+    Aces,
+}
+
+impl Tonemap {
+    pub const ALL: [Tonemap; 3] = [Tonemap::Clamp, Tonemap::Reinhard, Tonemap::Aces];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            Tonemap::Clamp => "clamp",
+            Tonemap::Reinhard => "Reinhard",
+            Tonemap::Aces => "ACES",
+        }
+    }
+}
+
+impl From<Tonemap> for u32 {
+    /// The number `shaders/display.wgsl` reads.
+    fn from(t: Tonemap) -> u32 {
+        match t {
+            Tonemap::Clamp => 0,
+            Tonemap::Reinhard => 1,
+            Tonemap::Aces => 2,
+        }
+    }
+}
+
+impl From<u32> for Tonemap {
+    /// An unknown number (a newer run's preferences) reads as clamp, as the shader does.
+    fn from(v: u32) -> Tonemap {
+        match v {
+            1 => Tonemap::Reinhard,
+            2 => Tonemap::Aces,
+            _ => Tonemap::Clamp,
+        }
+    }
+}
+
+/// What the texture's pixels are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pixels {
+    /// Linear radiance: exposure and the tonemap apply.
+    Radiance,
+    /// An image mode's colours, display colours already: no exposure, no tonemap.
+    Display,
+}
 
 /// How the texture is shown.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DisplayParams {
     pub exposure: f32,
-    /// 0: clamp, 1: Reinhard, 2: ACES.
-    pub tonemap: u32,
-    /// Image modes are display colours already: no exposure, no tonemap.
-    pub raw: bool,
+    pub tonemap: Tonemap,
+    pub pixels: Pixels,
     /// Bilinear filtering (the image drawn at a non-integer scale); otherwise nearest pixel.
     pub smooth: bool,
 }
@@ -47,8 +102,8 @@ impl DisplayState {
             full: true,
             params: DisplayParams {
                 exposure: 1.0,
-                tonemap: 0,
-                raw: false,
+                tonemap: Tonemap::Clamp,
+                pixels: Pixels::Radiance,
                 smooth: false,
             },
         }
@@ -345,9 +400,9 @@ impl CallbackTrait for DisplayCallback {
             }
             let u = Uniform {
                 exposure: state.params.exposure,
-                tonemap: state.params.tonemap,
+                tonemap: state.params.tonemap.into(),
                 encode_srgb: encode_srgb as u32,
-                raw: state.params.raw as u32,
+                raw: (state.params.pixels == Pixels::Display) as u32,
                 smooth: state.params.smooth as u32,
                 _pad: [0; 3],
             };

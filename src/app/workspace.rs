@@ -1,16 +1,197 @@
 //! The workspace of panes (egui_tiles): the render view, the scene view, the tree diagram and
 //! the tree list with its detail, resizable, hideable (View menu) and re-dockable by dragging
-//! their tabs. The render has the left of the workspace to itself; the scene view and the
-//! tree's panes share a column on the right, so the tree's panes, which open when a pixel is
-//! clicked, never move or shrink the render. The layout is part of [`super::Prefs`], so it is
+//! their tabs; and the rest of the window's state around them: the preferences, the settings
+//! panel, the file dialog and the windows (help, export, the sweep).
+//!
+//! The render has the left of the workspace to itself; the scene view and the tree's panes
+//! share a column on the right, so the tree's panes, which open when a pixel is clicked, never
+//! move or shrink the render. The layout is part of [`Prefs`], so it is
 //! remembered between runs; a saved layout that lacks a pane or holds one twice, or grew from
 //! an older default, is replaced by the default.
+
+use std::path::{Path, PathBuf};
 
 use eframe::egui::{self, Ui};
 use egui_tiles::{Behavior, Linear, LinearDir, SimplificationOptions, Tile, TileId};
 use serde::{Deserialize, Serialize};
 
-use super::ViewerApp;
+use super::dialog::{self, BrowseFor, FileBrowser};
+use super::messages::Messages;
+use super::modes::ImageMode;
+use super::sweep::SweepWindow;
+use super::viewport::Tonemap;
+use super::{Command, ViewerApp};
+use crate::scene;
+
+/// UI state kept between runs.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Prefs {
+    pub exposure: f32,
+    pub tonemap: Tonemap,
+    pub mode: ImageMode,
+    pub last_dir: Option<PathBuf>,
+    /// The panes' arrangement (replaced by the default when unusable).
+    pub layout: Layout,
+    /// Degrees the camera orbits for a drag across the whole image width.
+    pub orbit_degrees: f32,
+    /// The version of the default layout `layout` grew from: an older one is replaced (the
+    /// preferences of a run before versions were kept read as 0).
+    #[serde(default)]
+    pub layout_version: u32,
+    /// Samples per pixel the viewer refines to before it idles (the scene's `samples` is the
+    /// batch render's, for export and the command line).
+    pub viewer_samples: u32,
+    /// Render at the render pane's pixel size (the scene's width and height are kept for
+    /// export and saving); off: render at the scene's size.
+    pub pane_size: bool,
+    /// Whether the settings panel on the left is shown (Ctrl+B).
+    pub settings_panel: bool,
+}
+
+/// The viewer's default sample target.
+pub const VIEWER_SAMPLES: u32 = 64;
+
+/// The narrowest window (points) whose first run shows the settings panel: below it the render
+/// would get less than half the window, so the panel starts hidden (Ctrl+B shows it).
+pub const SETTINGS_MIN_WIDTH: f32 = 1300.0;
+
+impl Default for Prefs {
+    fn default() -> Self {
+        Self {
+            exposure: 1.0,
+            tonemap: Tonemap::Clamp,
+            mode: ImageMode::Render,
+            last_dir: None,
+            layout: default_layout(),
+            orbit_degrees: 180.0,
+            layout_version: LAYOUT_VERSION,
+            viewer_samples: VIEWER_SAMPLES,
+            pane_size: true,
+            settings_panel: true,
+        }
+    }
+}
+
+impl Prefs {
+    /// Saved preferences made usable: a layout of another version replaced, the sample target
+    /// within the loader's limits.
+    pub fn checked(mut self) -> Self {
+        if self.layout_version != LAYOUT_VERSION {
+            self.layout = default_layout();
+            self.layout_version = LAYOUT_VERSION;
+        }
+        self.viewer_samples = self.viewer_samples.clamp(1, scene::rules::MAX_SAMPLES);
+        self
+    }
+
+    /// Samples per pixel the viewer refines to (then it idles).
+    pub fn viewer_target(&self) -> u32 {
+        self.viewer_samples.max(1)
+    }
+}
+
+/// Whether the tree's panes were last opened or closed (for want of a tree).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum TreePanes {
+    Open,
+    Closed,
+}
+
+/// The window's state around the render: preferences, the settings panel, the file dialog
+/// and the windows over the panes.
+#[derive(Default)]
+pub struct Workspace {
+    pub prefs: Prefs,
+    /// Whether the settings panel's visibility is settled: by the saved preferences, or on
+    /// the first frame by the window's width (shown from [`SETTINGS_MIN_WIDTH`] up).
+    settings_settled: bool,
+    /// How the tree's panes were last set (`None`: not yet, or the layout was reset).
+    tree_panes: Option<TreePanes>,
+    pub(super) browser: Option<FileBrowser>,
+    pub(super) show_help: bool,
+    /// The Ctrl+S window: which picture to export.
+    pub(super) export_choice: bool,
+    /// The "Speed vs accuracy" window and its background sweep.
+    pub sweep: SweepWindow,
+}
+
+impl Workspace {
+    /// `settled`: the preferences were saved by a run before, so the settings panel is as
+    /// they have it.
+    pub fn new(prefs: Prefs, settled: bool) -> Self {
+        Self {
+            prefs,
+            settings_settled: settled,
+            ..Self::default()
+        }
+    }
+
+    /// Where the file dialog starts: the folder of the last file chosen, else the current one.
+    pub fn start_dir(&self) -> PathBuf {
+        self.prefs
+            .last_dir
+            .clone()
+            .or_else(|| std::env::current_dir().ok())
+            .unwrap_or_else(|| PathBuf::from("."))
+    }
+
+    /// Opens the file dialog for `purpose`, offering `name`.
+    pub fn browse(&mut self, purpose: BrowseFor, name: &str) {
+        self.browser = Some(FileBrowser::new(purpose, self.start_dir(), name));
+    }
+
+    /// Draws the file dialog, if one is open; a file chosen is the command for its purpose,
+    /// and the next dialog starts in its folder.
+    pub fn show_browser(&mut self, ctx: &egui::Context) -> Option<Command> {
+        let browser = self.browser.as_mut()?;
+        match browser.show(ctx) {
+            dialog::Outcome::Open => None,
+            dialog::Outcome::Cancel => {
+                self.browser = None;
+                None
+            }
+            dialog::Outcome::Chose(purpose, path) => {
+                self.prefs.last_dir = path.parent().map(Path::to_path_buf);
+                self.browser = None;
+                Some(match purpose {
+                    BrowseFor::Open => Command::OpenFile(path),
+                    BrowseFor::SaveScene => Command::SaveScene(path),
+                    BrowseFor::Export => Command::Export(path),
+                    BrowseFor::ExportOverlay => Command::ExportOverlay(path),
+                    BrowseFor::ExportSceneView => Command::ExportSceneView(path),
+                    BrowseFor::ExportTree => Command::ExportTree(path),
+                    BrowseFor::ExportDiagram => Command::ExportDiagram(path),
+                })
+            }
+        }
+    }
+
+    /// Shows or hides the settings panel (whatever the window's width).
+    pub fn set_settings_panel(&mut self, shown: bool) {
+        self.prefs.settings_panel = shown;
+        self.settings_settled = true;
+    }
+
+    /// Shows the settings panel, or hides it (saying how it comes back).
+    pub fn toggle_settings_panel(&mut self, messages: &mut Messages) {
+        self.prefs.settings_panel = !self.prefs.settings_panel;
+        if !self.prefs.settings_panel {
+            messages.notice("settings hidden: Ctrl+B or View > Settings panel shows them");
+        }
+    }
+
+    /// On the first frame of a first run, a window narrower than [`SETTINGS_MIN_WIDTH`]
+    /// (points) hides the settings panel.
+    pub fn settle_settings_panel(&mut self, window_width: f32, messages: &mut Messages) {
+        if !self.settings_settled {
+            self.settings_settled = true;
+            if window_width < SETTINGS_MIN_WIDTH {
+                self.toggle_settings_panel(messages);
+            }
+        }
+    }
+}
 
 /// One pane of the workspace.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -94,15 +275,19 @@ pub fn tile_of(layout: &Layout, pane: Pane) -> Option<TileId> {
 /// Opens the tree's panes (diagram, list) when a tree appears and closes them when it goes,
 /// so that before any click the render and scene views share the whole workspace. Only the
 /// change is acted on: a pane hidden or shown from the View menu stays so meanwhile.
-fn follow_tree(app: &mut ViewerApp) {
-    let want = app.tree.is_some();
-    if app.tree_panes_shown == Some(want) {
+fn follow_tree(ws: &mut Workspace, has_tree: bool) {
+    let want = if has_tree {
+        TreePanes::Open
+    } else {
+        TreePanes::Closed
+    };
+    if ws.tree_panes == Some(want) {
         return;
     }
-    app.tree_panes_shown = Some(want);
+    ws.tree_panes = Some(want);
     for pane in [Pane::Diagram, Pane::TreeList] {
-        if let Some(id) = tile_of(&app.prefs.layout, pane) {
-            app.prefs.layout.tiles.set_visible(id, want);
+        if let Some(id) = tile_of(&ws.prefs.layout, pane) {
+            ws.prefs.layout.tiles.set_visible(id, has_tree);
         }
     }
 }
@@ -112,40 +297,41 @@ pub type PaneUi = fn(&mut ViewerApp, &mut Ui, Pane);
 
 /// Draws the panes of `app`'s layout into `ui`, each by `pane_ui`.
 pub fn show(app: &mut ViewerApp, ui: &mut Ui, pane_ui: PaneUi) {
-    if !usable(&app.prefs.layout) {
-        app.prefs.layout = default_layout();
-        app.tree_panes_shown = None;
+    let ws = &mut app.workspace;
+    if !usable(&ws.prefs.layout) {
+        ws.prefs.layout = default_layout();
+        ws.tree_panes = None;
     }
-    follow_tree(app);
+    follow_tree(ws, app.selection.tree.is_some());
     let mut layout = std::mem::replace(
-        &mut app.prefs.layout,
+        &mut app.workspace.prefs.layout,
         egui_tiles::Tree::empty(egui::Id::unique("none")),
     );
     layout.ui(&mut Panes { app, pane_ui }, ui);
-    app.prefs.layout = layout;
+    app.workspace.prefs.layout = layout;
 }
 
 /// A checkbox per pane, to hide or show it (View menu).
-pub fn pane_toggles(app: &mut ViewerApp, ui: &mut Ui) {
+pub fn pane_toggles(ws: &mut Workspace, messages: &mut Messages, ui: &mut Ui) {
     for pane in Pane::ALL {
-        if let Some(id) = tile_of(&app.prefs.layout, pane) {
-            let mut visible = app.prefs.layout.tiles.is_visible(id);
+        if let Some(id) = tile_of(&ws.prefs.layout, pane) {
+            let mut visible = ws.prefs.layout.tiles.is_visible(id);
             if ui.checkbox(&mut visible, pane.title()).changed() {
-                app.prefs.layout.tiles.set_visible(id, visible);
+                ws.prefs.layout.tiles.set_visible(id, visible);
             }
         }
     }
-    let mut settings = app.prefs.settings_panel;
+    let mut settings = ws.prefs.settings_panel;
     if ui
         .checkbox(&mut settings, "Settings panel (Ctrl+B)")
         .changed()
     {
-        app.toggle_settings_panel();
+        ws.toggle_settings_panel(messages);
     }
     if ui.button("Reset layout").clicked() {
-        app.prefs.layout = default_layout();
-        app.prefs.settings_panel = true;
-        app.tree_panes_shown = None;
+        ws.prefs.layout = default_layout();
+        ws.prefs.settings_panel = true;
+        ws.tree_panes = None;
     }
 }
 
@@ -180,6 +366,26 @@ impl Behavior<Pane> for Panes<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn preferences_saved_before_layout_versions_get_the_new_layout() {
+        let old: Prefs = serde_json::from_str(r#"{"exposure": 2.0}"#).expect("old prefs");
+        assert_eq!(old.layout_version, 0);
+        assert_eq!(old.exposure, 2.0);
+        assert_eq!(old.viewer_samples, VIEWER_SAMPLES);
+        assert!(old.pane_size);
+        let now = Prefs::default();
+        assert_eq!(now.layout_version, LAYOUT_VERSION);
+        assert_eq!(old.checked().layout_version, LAYOUT_VERSION);
+    }
+
+    #[test]
+    fn the_tonemap_is_saved_as_the_number_the_shader_reads() {
+        let prefs: Prefs = serde_json::from_str(r#"{"tonemap": 2}"#).expect("prefs");
+        assert_eq!(prefs.tonemap, Tonemap::Aces);
+        let json = serde_json::to_value(&prefs).expect("serialises");
+        assert_eq!(json["tonemap"], 2);
+    }
 
     #[test]
     fn the_default_layout_is_usable_and_survives_a_round_trip() {

@@ -1,4 +1,4 @@
-//! The ray tree in 3D (SPEC §5c), as data every view draws the same way: the tree's rays as
+//! The ray tree in 3D (docs/design.md, "The viewer"), as data every view draws the same way: the tree's rays as
 //! world-space segments with a style (the one palette of ray kinds), the render camera as a
 //! frustum with its image plane and the clicked pixel, the lights as markers, and the filters
 //! (generation, ray kind, end reason) that hide segments. The viewer's render overlay and scene

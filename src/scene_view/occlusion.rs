@@ -77,11 +77,11 @@ impl DepthImage {
     }
 
     /// Whether a point `distance` from the eye that projects to image position (`x`, `y`) lies
-    /// behind the surfaces there (the rule of the module's notes); `None` off the image.
-    fn hides(&self, x: f32, y: f32, distance: f32) -> Option<bool> {
+    /// behind the surfaces there (the rule of the module's notes).
+    fn sight(&self, x: f32, y: f32, distance: f32) -> Sight {
         let (w, h) = (self.width as f32, self.height as f32);
         if !(x >= 0.0 && y >= 0.0 && x < w && y < h) {
-            return None;
+            return Sight::OffImage;
         }
         let (px, py) = (x as i64, y as i64);
         let mut farthest = 0.0f32;
@@ -90,7 +90,29 @@ impl DepthImage {
                 farthest = farthest.max(self.t[(ny * self.width as i64 + nx) as usize]);
             }
         }
-        Some(distance > farthest * (1.0 + DEPTH_TOLERANCE))
+        if distance > farthest * (1.0 + DEPTH_TOLERANCE) {
+            Sight::Hidden
+        } else {
+            Sight::Seen
+        }
+    }
+}
+
+/// What the depth image says of a point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sight {
+    /// In front of the surfaces there.
+    Seen,
+    /// Behind them.
+    Hidden,
+    /// Behind the camera or off the image: not tested.
+    OffImage,
+}
+
+impl Sight {
+    /// Whether the point is drawn as hidden (a point not tested is not).
+    pub fn is_hidden(self) -> bool {
+        self == Sight::Hidden
     }
 }
 
@@ -101,12 +123,14 @@ fn eye_and_view(frame: &CameraFrame, depth: &DepthImage) -> (Vec3, Vec3) {
 }
 
 /// Whether point `p` is hidden from the view, when `slack` of its distance is not counted (the
-/// radius of a visible light's ball, whose centre lies behind its own surface); `None` when it
-/// is behind the camera or off the image. The light markers use it.
-pub fn point_hidden(p: Vec3, slack: f32, frame: &CameraFrame, depth: &DepthImage) -> Option<bool> {
+/// radius of a visible light's ball, whose centre lies behind its own surface). The light
+/// markers use it.
+pub fn point_sight(p: Vec3, slack: f32, frame: &CameraFrame, depth: &DepthImage) -> Sight {
     let (eye, _) = eye_and_view(frame, depth);
-    let (x, y) = frame.project(p)?;
-    depth.hides(x, y, (p - eye).length() - slack)
+    match frame.project(p) {
+        Some((x, y)) => depth.sight(x, y, (p - eye).length() - slack),
+        None => Sight::OffImage,
+    }
 }
 
 /// `a..b` split into pieces in front of the surfaces the depth image saw (hidden: false) and behind them (hidden: true); the part behind the camera's near plane is dropped.
@@ -172,9 +196,7 @@ pub fn visible_pieces(a: Vec3, b: Vec3, frame: &CameraFrame, depth: &DepthImage)
     for k in 0..=n {
         let s = s0 + (s1 - s0) * k as f32 / n as f32;
         let p = pa + (pb - pa) * s;
-        let hidden = depth
-            .hides(p.x, p.y, (at(s) - eye).length())
-            .unwrap_or(false);
+        let hidden = depth.sight(p.x, p.y, (at(s) - eye).length()).is_hidden();
         match prev {
             None => push(s0, s, hidden),
             Some((sp, hp)) if hp != hidden => {
@@ -371,11 +393,11 @@ mod tests {
     fn a_light_inside_its_ball_is_not_hidden_by_it() {
         let (_, frame, depth) = view();
         // The sphere's centre is 1 behind its own front surface.
-        assert_eq!(point_hidden(Vec3::ZERO, 1.0, &frame, &depth), Some(false));
-        assert_eq!(point_hidden(Vec3::ZERO, 0.0, &frame, &depth), Some(true));
+        assert_eq!(point_sight(Vec3::ZERO, 1.0, &frame, &depth), Sight::Seen);
+        assert_eq!(point_sight(Vec3::ZERO, 0.0, &frame, &depth), Sight::Hidden);
         assert_eq!(
-            point_hidden(Vec3::new(0.0, 0.0, 9.0), 0.0, &frame, &depth),
-            None
+            point_sight(Vec3::new(0.0, 0.0, 9.0), 0.0, &frame, &depth),
+            Sight::OffImage
         );
     }
 }

@@ -9,7 +9,7 @@
 use glam::Vec2;
 use tiny_skia::{Color, FillRule, LineCap, Paint, PathBuilder, Pixmap, Stroke, Transform};
 
-use super::occlusion::{DepthImage, Piece, clip_to_rect, point_hidden, visible_pieces};
+use super::occlusion::{DepthImage, Piece, clip_to_rect, point_sight, visible_pieces};
 use super::{HIGHLIGHT_RGB, LightMarker, Segment, style_rgba};
 use crate::scene::CameraFrame;
 
@@ -181,7 +181,7 @@ impl Canvas {
             let Some(centre) = frame.project(m.position) else {
                 continue;
             };
-            let hidden = point_hidden(m.position, m.radius, frame, depth).unwrap_or(false);
+            let hidden = point_sight(m.position, m.radius, frame, depth).is_hidden();
             let alpha = if hidden {
                 (255.0 * HIDDEN_OPACITY).round() as u8
             } else {

@@ -1,0 +1,196 @@
+//! What the viewer writes to files: the scene as TOML, the render (at the size shown, or at
+//! the scene's own size in the background), the render with the trees drawn over it, the
+//! scene view, and the ray tree as JSON or as its SVG figure.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use super::ViewerApp;
+use super::messages::Message;
+use crate::export;
+use crate::ray_tree::RayTree;
+use crate::scene;
+use crate::trace::Tracer;
+
+/// A picture drawn with the trees.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Drawn {
+    /// The render with the trees drawn over it, as in the render view.
+    Overlay,
+    /// The scene view's camera at the scene's size.
+    SceneView,
+}
+
+impl ViewerApp {
+    /// Writes the working copy as a scene file.
+    pub(super) fn save_scene(&mut self, path: &Path) {
+        let text = scene::scene_to_toml(&self.working.scene);
+        match export::write_text(path, &text) {
+            Ok(()) => self.messages.notice(format!("saved {}", path.display())),
+            Err(e) => self.messages.error(e.to_string()),
+        }
+    }
+
+    /// Writes the current tree as JSON.
+    pub(super) fn export_tree(&mut self, path: &Path) {
+        let json = self
+            .selection
+            .tree
+            .as_ref()
+            .map(|t| serde_json::to_string_pretty(t).unwrap_or_default());
+        self.save_tree_text(path, json);
+    }
+
+    /// Writes the current tree's figure as SVG, to the generations shown.
+    pub(super) fn export_diagram(&mut self, path: &Path) {
+        let options = crate::diagram::Options {
+            max_generation: self.selection.max_generation(),
+        };
+        let svg = self
+            .selection
+            .tree
+            .as_ref()
+            .map(|t| crate::diagram::svg(t, &options));
+        self.save_tree_text(path, svg);
+    }
+
+    /// Writes the ray tree in some form (`None`: there is no tree yet).
+    fn save_tree_text(&mut self, path: &Path, text: Option<String>) {
+        match text.map(|text| export::write_text(path, &text)) {
+            Some(Ok(())) => self.messages.notice(format!("saved {}", path.display())),
+            Some(Err(e)) => self.messages.error(e.to_string()),
+            None => self
+                .messages
+                .error("no ray tree to export: click a pixel first"),
+        }
+    }
+
+    /// Writes the film at full resolution (never a window grab), stamped with its progress.
+    pub(super) fn export(&mut self, path: &Path) {
+        if self.render.size() != self.render.scene_size {
+            return self.export_at_scene_size(path);
+        }
+        let target = self.viewer_target();
+        let done = self.render.progress.samples_done;
+        let text = export::stamp(
+            &self.files.label,
+            done,
+            target,
+            &self.render.scene().render,
+            &self.working.settings.trace,
+            self.render.accel().kind(),
+        );
+        match export::write_image(path, &self.render.image(), &text) {
+            Ok(()) => self.messages.notice(format!(
+                "exported {} ({done}/{target} samples)",
+                path.display()
+            )),
+            Err(e) => self.messages.error(e.to_string()),
+        }
+    }
+
+    /// The render follows the pane: the export renders the scene at its own size and sample
+    /// count in the background (the viewer stays live) and says when the file is written.
+    fn export_at_scene_size(&mut self, path: &Path) {
+        if self.render.export_job.is_some() {
+            return self
+                .messages
+                .error("an export is still rendering: wait for its message");
+        }
+        let mut scene = (**self.render.scene()).clone();
+        (scene.render.width, scene.render.height) = self.render.scene_size;
+        let (w, h) = self.render.scene_size;
+        let samples = scene.render.samples;
+        let trace = self.working.settings.trace;
+        let stamp = export::stamp(
+            &self.files.label,
+            samples,
+            samples,
+            &scene.render,
+            &trace,
+            self.render.accel().kind(),
+        );
+        let tracer = Tracer::with_accel(Arc::new(scene), trace, self.render.tracer.accel.clone());
+        let threads = self.working.settings.threads;
+        let shown = path.display().to_string();
+        let path = path.to_path_buf();
+        let (tx, rx) = std::sync::mpsc::channel();
+        let job = move || {
+            let message = match crate::render::render(&tracer, samples, threads, &|_, _| {}) {
+                Ok((image, _)) => match export::write_image(&path, &image, &stamp) {
+                    Ok(()) => Message::notice(format!(
+                        "exported {} ({w}x{h}, the scene's size, {samples} samples)",
+                        path.display()
+                    )),
+                    Err(e) => Message::error(e.to_string()),
+                },
+                Err(e) => Message::error(format!("cannot export {}: {e}", path.display())),
+            };
+            // The viewer may have closed meanwhile: then nobody waits for the message.
+            let _ = tx.send(message);
+        };
+        match std::thread::Builder::new()
+            .name("raytree-export".into())
+            .spawn(job)
+        {
+            Ok(_) => {
+                self.render.export_job = Some(rx);
+                self.messages.notice(format!(
+                    "exporting {shown} at the scene's size ({w}x{h}, {samples} samples)..."
+                ));
+            }
+            Err(e) => self.messages.error(format!("cannot start the export: {e}")),
+        }
+    }
+
+    /// Writes `picture` as a stamped PNG, drawn by the headless scene view's rules.
+    pub(super) fn export_drawn(&mut self, path: &Path, picture: Drawn) {
+        let Some(tree) = self.selection.tree.clone() else {
+            self.messages
+                .error("no ray tree to draw: click a pixel first");
+            return;
+        };
+        let filter = crate::scene_view::Filter {
+            max_generation: self.selection.max_generation(),
+            ..self.scene_view.filter.clone()
+        };
+        let scene = self.render.scene().clone();
+        let drawn = if picture == Drawn::SceneView {
+            let (w, h) = self.render.scene_size;
+            crate::scene_view::headless::scene_view_image(
+                &scene,
+                self.working.settings.trace,
+                &tree,
+                &self.scene_view.camera,
+                w,
+                h,
+                &filter,
+            )
+        } else {
+            let trees: Vec<&RayTree> = self.selection.trees().collect();
+            crate::scene_view::headless::overlay_image(
+                &self.render.tracer,
+                &self.render.image(),
+                &trees,
+                &filter,
+            )
+        };
+        let canvas = match drawn {
+            Ok(c) => c,
+            Err(e) => return self.messages.error(e.to_string()),
+        };
+        let text = export::stamp(
+            &self.files.label,
+            self.render.progress.samples_done,
+            scene.render.samples,
+            &scene.render,
+            &self.working.settings.trace,
+            self.render.accel().kind(),
+        );
+        let (w, h) = (canvas.width(), canvas.height());
+        match export::write_png_rgba8(path, w, h, canvas.rgba(), &text) {
+            Ok(()) => self.messages.notice(format!("exported {}", path.display())),
+            Err(e) => self.messages.error(e.to_string()),
+        }
+    }
+}

@@ -1,0 +1,175 @@
+//! What the user picked: the ray trees shown (the current one and the extra ones), the node
+//! selected and hovered in them, the pixel under the pointer, the rectangle being dragged over
+//! the render, and the material and light selected in the settings.
+
+use eframe::egui;
+
+use super::messages::Messages;
+use super::tree_view::TreeState;
+use crate::ray_tree::{RayTree, pixel_tree};
+use crate::trace::Tracer;
+
+/// The most trees shown at once (the current one and the extra ones).
+pub const MAX_TREES: usize = 64;
+
+#[derive(Default)]
+pub struct TreeSelection {
+    /// The tree of the pixel clicked last: the list and the detail show it.
+    pub tree: Option<RayTree>,
+    /// More pixels' trees, drawn beside the current one (shift-click, a dragged rectangle);
+    /// at most [`MAX_TREES`] with the current one.
+    pub extra_trees: Vec<RayTree>,
+    /// Selection, hover and the pinned tree, shared by the tree's views.
+    pub tree_state: TreeState,
+    /// The render's pixel under the pointer.
+    pub hover: Option<(u32, u32)>,
+    /// The rectangle being dragged over the render with Ctrl or Alt (screen points).
+    pub rect_select: Option<(egui::Pos2, egui::Pos2)>,
+    pub selected_material: Option<usize>,
+    pub selected_light: Option<usize>,
+}
+
+/// Pixel `p` of a `from`-sized image as the pixel at the same place of a `to`-sized one.
+pub fn remap_pixel(p: [u32; 2], from: (u32, u32), to: (u32, u32)) -> [u32; 2] {
+    let axis = |v: u32, a: u32, b: u32| {
+        (((v as f64 + 0.5) * b as f64 / a.max(1) as f64) as u32).min(b.saturating_sub(1))
+    };
+    [axis(p[0], from.0, to.0), axis(p[1], from.1, to.1)]
+}
+
+impl TreeSelection {
+    /// The trees shown: the current one first, then the extra ones.
+    pub fn trees(&self) -> impl Iterator<Item = &RayTree> {
+        self.tree.iter().chain(self.extra_trees.iter())
+    }
+
+    /// The generation the step-through reveals down to (every one when it is off).
+    pub fn max_generation(&self) -> u32 {
+        self.tree_state.reveal.unwrap_or(u32::MAX)
+    }
+
+    /// Makes extra tree `i` the current one (the list and detail show it); the current one
+    /// joins the extra trees in its place.
+    pub fn make_current(&mut self, i: usize) {
+        if i < self.extra_trees.len() {
+            match self.tree.take() {
+                Some(current) => {
+                    self.tree = Some(std::mem::replace(&mut self.extra_trees[i], current))
+                }
+                None => self.tree = Some(self.extra_trees.remove(i)),
+            }
+        }
+    }
+
+    /// The tree of pixel (`x`, `y`) becomes the only one shown, its root selected; the
+    /// material its primary ray hit is selected.
+    pub fn pick(&mut self, tracer: &Tracer, x: u32, y: u32) {
+        self.extra_trees.clear();
+        self.tree = pixel_tree(tracer, x, y);
+        self.tree_state.selected = Some(Vec::new());
+        if let Some(hit) = self.tree.as_ref().and_then(|t| t.root.hit.as_ref()) {
+            self.selected_material = tracer
+                .scene
+                .materials
+                .iter()
+                .position(|m| m.name == hit.material);
+        }
+    }
+
+    /// Adds the tree of pixel (`x`, `y`) to the trees shown, unless it is there or the trees
+    /// are full (then says so). Returns false when full.
+    pub fn add(&mut self, tracer: &Tracer, x: u32, y: u32, messages: &mut Messages) -> bool {
+        if self.trees().any(|t| t.pixel == [x, y]) {
+            return true;
+        }
+        if self.trees().count() >= MAX_TREES {
+            messages.notice(format!(
+                "at most {MAX_TREES} trees are shown: click a pixel (without shift) to start over"
+            ));
+            return false;
+        }
+        let Some(tree) = pixel_tree(tracer, x, y) else {
+            return true;
+        };
+        match self.tree {
+            None => {
+                self.tree = Some(tree);
+                self.tree_state.selected = Some(Vec::new());
+            }
+            Some(_) => self.extra_trees.push(tree),
+        }
+        true
+    }
+
+    /// Adds the trees of a sparse grid of the pixels in `x0..=x1 × y0..=y1` (at most 8 × 8
+    /// spread over the rectangle), until the trees are full.
+    pub fn add_rect(
+        &mut self,
+        tracer: &Tracer,
+        [x0, y0]: [u32; 2],
+        [x1, y1]: [u32; 2],
+        messages: &mut Messages,
+    ) {
+        let axis = |a: u32, b: u32| -> Vec<u32> {
+            let n = (b - a + 1).min(8);
+            let mut v: Vec<u32> = (0..n)
+                .map(|i| a + ((b - a) as u64 * (2 * i as u64 + 1) / (2 * n as u64)) as u32)
+                .collect();
+            v.dedup();
+            v
+        };
+        for y in axis(y0.min(y1), y0.max(y1)) {
+            for x in axis(x0.min(x1), x0.max(x1)) {
+                if !self.add(tracer, x, y, messages) {
+                    return;
+                }
+            }
+        }
+    }
+
+    /// The trees follow a new tracer: pixels picked at the `old` render size keep their place
+    /// in the image, and every tree is traced again with the new scene and settings.
+    pub fn follow(&mut self, tracer: &Tracer, old: (u32, u32)) {
+        let new = (tracer.scene.render.width, tracer.scene.render.height);
+        if old != new {
+            for t in self.tree.iter_mut().chain(self.extra_trees.iter_mut()) {
+                t.pixel = remap_pixel(t.pixel, old, new);
+            }
+            self.hover = None;
+        }
+        if let Some(tree) = &self.tree {
+            let [x, y] = tree.pixel;
+            self.tree = pixel_tree(tracer, x, y);
+        }
+        self.extra_trees = self
+            .extra_trees
+            .iter()
+            .filter_map(|t| pixel_tree(tracer, t.pixel[0], t.pixel[1]))
+            .collect();
+    }
+
+    /// Another scene was opened: nothing of the old one stays picked (the pointer's pixel and
+    /// drag stay: they are the render pane's).
+    pub fn clear(&mut self) {
+        let (hover, rect_select) = (self.hover, self.rect_select);
+        *self = Self {
+            hover,
+            rect_select,
+            ..Self::default()
+        };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_pixel_keeps_its_place_at_another_render_size() {
+        assert_eq!(remap_pixel([0, 0], (640, 480), (1280, 960)), [1, 1]);
+        assert_eq!(remap_pixel([639, 479], (640, 480), (320, 240)), [319, 239]);
+        assert_eq!(remap_pixel([320, 240], (640, 480), (800, 300)), [400, 150]);
+        // Never outside the new image.
+        assert_eq!(remap_pixel([9, 9], (10, 10), (3, 3)), [2, 2]);
+    }
+}

@@ -1,0 +1,229 @@
+//! The window: eframe's entry point and the frame, which polls the renders, draws the panels
+//! and panes with the parts each needs, and applies the frame's commands at its end.
+
+use std::path::{Path, PathBuf};
+
+use eframe::egui;
+
+use super::dialog::BrowseFor;
+use super::{Command, ViewerApp, input, panels, scene_pane, tree_view, watch, workspace};
+use crate::scene;
+
+/// Opens the window and runs the viewer until it is closed.
+pub fn run(scene_arg: Option<&str>) -> anyhow::Result<()> {
+    // A file is opened in the background once the window is up (a big mesh takes seconds to
+    // read and build): the window shows the default scene and the open's progress meanwhile.
+    // Built-in scene names and missing files are answered at once.
+    let mut background = None;
+    let (scene, label) = match scene_arg {
+        Some(arg) if Path::new(arg).is_file() => {
+            background = Some(PathBuf::from(arg));
+            (
+                scene::builtin::load_builtin("default")?,
+                "default".to_string(),
+            )
+        }
+        Some(arg) => (scene::open_scene_arg(arg)?, arg.to_string()),
+        None => (
+            scene::builtin::load_builtin("default")?,
+            "default".to_string(),
+        ),
+    };
+    let options = eframe::NativeOptions {
+        renderer: eframe::Renderer::Wgpu,
+        viewport: egui::ViewportBuilder::default()
+            .with_title("raytree")
+            .with_inner_size([1400.0, 900.0])
+            .with_drag_and_drop(true),
+        ..Default::default()
+    };
+    eframe::run_native(
+        "raytree",
+        options,
+        Box::new(move |cc| {
+            let mut app = ViewerApp::new(cc, scene, label).map_err(|e| -> Box<dyn std::error::Error + Send + Sync> { e.into() })?;
+            if let Some(path) = background {
+                app.command(Command::OpenFile(path));
+            }
+            Ok(Box::new(app))
+        }),
+    )
+    .map_err(|e| {
+        anyhow::anyhow!(
+            "cannot open the viewer window ({e}); without a display or graphics adapter, use `raytree render SCENE -o out.png`"
+        )
+    })
+}
+
+impl eframe::App for ViewerApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let ctx = ui.ctx().clone();
+        self.poll_session();
+        self.render.poll_export(&mut self.messages);
+        input::shortcuts(
+            &ctx,
+            &mut self.workspace,
+            &mut self.working,
+            &mut self.pending,
+        );
+        let toggle = egui::KeyboardShortcut::new(egui::Modifiers::COMMAND, egui::Key::B);
+        if ctx.input_mut(|i| i.consume_shortcut(&toggle)) {
+            self.workspace.toggle_settings_panel(&mut self.messages);
+        }
+        panels::top_bar(
+            ui,
+            &mut self.workspace,
+            &mut self.working,
+            &self.files,
+            &mut self.messages,
+            &mut self.pending,
+        );
+        let finished = self.is_finished();
+        let target = self.viewer_target();
+        panels::status_bar(
+            ui,
+            &self.render,
+            &mut self.files,
+            &self.selection,
+            target,
+            finished,
+        );
+        // Hover is transient: the views set it again while the pointer stays on a node.
+        self.selection.tree_state.hovered = None;
+        scene_pane::advance_playback(&mut self.scene_view, &mut self.selection, &ctx);
+        self.workspace
+            .settle_settings_panel(ctx.content_rect().width(), &mut self.messages);
+        if !self.workspace.prefs.settings_panel {
+            // A slim strip keeps the hidden settings one click away.
+            egui::Panel::left("settings strip")
+                .resizable(false)
+                .exact_size(30.0)
+                .show(ui, |ui| {
+                    if ui
+                        .button("»")
+                        .on_hover_text("show the settings (Ctrl+B)")
+                        .clicked()
+                    {
+                        self.workspace.toggle_settings_panel(&mut self.messages);
+                    }
+                });
+        } else {
+            egui::Panel::left("settings")
+                .resizable(true)
+                .default_size(290.0)
+                .show(ui, |ui| {
+                    ui.with_layout(egui::Layout::right_to_left(egui::Align::Min), |ui| {
+                        if ui
+                            .small_button("« hide")
+                            .on_hover_text("hide the settings (Ctrl+B); the render gets the room")
+                            .clicked()
+                        {
+                            self.workspace.toggle_settings_panel(&mut self.messages);
+                        }
+                    });
+                    // Scrolled both ways: wide content (an opened material) scrolls instead of
+                    // widening the panel, which would move and resize the render.
+                    egui::ScrollArea::both().show(ui, |ui| {
+                        panels::side_panel(
+                            ui,
+                            &mut self.working,
+                            &mut self.workspace.prefs,
+                            &mut self.render,
+                            &self.selection,
+                            &mut self.pending,
+                        )
+                    });
+                });
+        }
+        // The panes fill the central panel edge to edge.
+        let frame = egui::Frame::central_panel(ui.style()).inner_margin(0);
+        egui::CentralPanel::default()
+            .frame(frame)
+            .show(ui, |ui| workspace::show(self, ui, pane_ui));
+        if let Some(command) = self.workspace.show_browser(&ctx) {
+            self.pending.push(command);
+        }
+        panels::help_window(&ctx, &mut self.workspace.show_help);
+        let has_tree = self.selection.tree.is_some();
+        panels::export_window(&ctx, &mut self.workspace, has_tree, &self.files.file_stem());
+        let working = &mut self.working;
+        let sweep = &mut self.workspace.sweep;
+        if sweep.open
+            && let Some(point) = sweep.show(&ctx, &working.scene, &working.settings.trace)
+        {
+            // A clicked point: its settings become the viewer's; say what changed.
+            if let Some(text) = sweep.applied.clone() {
+                self.messages.notice(text);
+            }
+            working.scene.render.max_depth = point.max_depth;
+            working.scene.render.samples = point.samples;
+            working.settings.trace = point.trace;
+            self.pending.push(Command::Rebuild);
+        }
+        self.messages.show(&ctx);
+        self.apply();
+        self.working.track(&ctx);
+        self.render.follow_display_prefs(&self.workspace.prefs);
+        if !self.is_finished() || !self.scene_view.is_finished() || self.render.export_job.is_some()
+        {
+            ctx.request_repaint();
+        } else if self.files.is_watched() {
+            // Idle: wake up now and then to see whether the scene was saved.
+            ctx.request_repaint_after(watch::DEBOUNCE);
+        }
+    }
+
+    fn save(&mut self, storage: &mut dyn eframe::Storage) {
+        eframe::set_value(storage, eframe::APP_KEY, &self.workspace.prefs);
+    }
+}
+
+/// What each pane of the workspace shows.
+fn pane_ui(app: &mut ViewerApp, ui: &mut egui::Ui, pane: workspace::Pane) {
+    use workspace::Pane;
+    match pane {
+        Pane::Render => input::render_pane(
+            ui,
+            &mut app.render,
+            &mut app.selection,
+            &mut app.working.scene.camera,
+            &app.workspace.prefs,
+            &app.scene_view.filter,
+            &mut app.pending,
+        ),
+        Pane::SceneView => scene_pane::scene_view_ui(
+            ui,
+            &mut app.scene_view,
+            &app.render.tracer,
+            &mut app.selection,
+            &mut app.working.scene,
+            &app.workspace.prefs,
+            &mut app.pending,
+        ),
+        Pane::Diagram => match app.selection.tree.clone() {
+            Some(tree) => {
+                if tree_view::diagram(ui, &tree, &mut app.selection.tree_state) {
+                    let name = format!("tree-{}-{}.svg", tree.pixel[0], tree.pixel[1]);
+                    app.workspace.browse(BrowseFor::ExportDiagram, &name);
+                }
+            }
+            None => {
+                ui.weak("click a pixel in the render view for its ray tree");
+            }
+        },
+        Pane::TreeList => {
+            if app.selection.tree.is_some() {
+                panels::tree_panel(
+                    ui,
+                    &mut app.selection,
+                    &mut app.workspace,
+                    &app.render.tracer,
+                );
+            } else {
+                ui.weak(
+                    "click a pixel in the render view for its ray tree; shift-click adds more pixels",
+                );
+            }
+        }
+    }
+}
