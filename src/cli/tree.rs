@@ -22,7 +22,8 @@ pub struct TreeArgs {
     /// The pixel, as X,Y (0,0 is the top-left corner).
     #[arg(long, value_parser = parse_pixel)]
     pixel: (u32, u32),
-    /// Print the tree as JSON (the schema in the README) instead of indented text.
+    /// Print the tree as JSON (the schema: docs/design.md, "The ray tree as data") instead of
+    /// indented text.
     #[arg(long)]
     json: bool,
     /// Also write the lecture's tree figure as SVG to this file.
