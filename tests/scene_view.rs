@@ -15,7 +15,7 @@ use golden_support::{golden_path, mismatch, read_png};
 use raytree::scene::{Camera, CameraFrame, Object, ObjectId, ObjectSource, Scene, Sphere};
 use raytree::scene_view::occlusion::DepthImage;
 use raytree::scene_view::raster::{Canvas, line_width};
-use raytree::scene_view::{Segment, Style};
+use raytree::scene_view::{Filter, Segment, Style, headless};
 use raytree::trace::{RayKind, TraceSettings, Tracer};
 
 fn raytree() -> Command {
@@ -270,4 +270,231 @@ fn the_command_wants_eye_and_target_with_a_scene_view() {
     ]);
     assert_eq!(code, Some(2));
     assert!(err.contains("`x` is not a number"), "{err}");
+}
+
+/// A closed room of twelve triangles (-2..2 on each axis, brown walls) around the render
+/// camera, a sphere on the floor and a light under the ceiling, written into `dir`; returns the
+/// scene file.
+fn closed_room(dir: &std::path::Path) -> std::path::PathBuf {
+    let corners: String = (0..8)
+        .map(|k| {
+            let c = |bit: usize| if k & bit == 0 { -2 } else { 2 };
+            format!("v {} {} {}\n", c(1), c(2), c(4))
+        })
+        .collect();
+    // Each side as four corners in order around it (1-based, bit 0 picks x, 1 y, 2 z).
+    let sides = [
+        [1, 3, 4, 2],
+        [5, 6, 8, 7],
+        [1, 2, 6, 5],
+        [3, 7, 8, 4],
+        [1, 5, 7, 3],
+        [2, 4, 8, 6],
+    ];
+    let faces: String = sides
+        .iter()
+        .map(|s| {
+            format!(
+                "f {} {} {}\nf {} {} {}\n",
+                s[0], s[1], s[2], s[0], s[2], s[3]
+            )
+        })
+        .collect();
+    std::fs::write(
+        dir.join("room.obj"),
+        format!("mtllib room.mtl\n{corners}usemtl brown\n{faces}"),
+    )
+    .expect("write the room");
+    std::fs::write(
+        dir.join("room.mtl"),
+        "newmtl brown\nKa 0.6 0.35 0.15\nKd 0.6 0.35 0.15\nKs 0 0 0\n",
+    )
+    .expect("write its material");
+    let scene = dir.join("room.toml");
+    std::fs::write(
+        &scene,
+        r#"
+[render]
+width = 320
+height = 240
+max_depth = 3
+samples = 1
+background = 0
+ambient_light = 0.1
+
+[camera]
+position = [0, 0, 1.4]
+look_at = [0, -1.2, -1]
+up = [0, 1, 0]
+fov_y = 50
+
+[[light]]
+name = "bulb"
+position = [0, 1.6, 0]
+color = 0.9
+
+[[material]]
+name = "matte"
+ambient = 0.5
+diffuse = 0.5
+specular = 0
+shininess = 10
+
+[[mesh]]
+name = "room"
+file = "room.obj"
+
+[[sphere]]
+name = "ball"
+center = [0, -1.2, -1]
+radius = 0.6
+material = "matte"
+"#,
+    )
+    .expect("write the scene");
+    scene
+}
+
+/// The scene view's camera outside the closed room, above its front right corner.
+fn outside_view() -> Camera {
+    Camera {
+        position: Vec3::new(7.0, 5.0, 8.0),
+        look_at: Vec3::new(0.0, -0.5, 0.0),
+        up: Vec3::Y,
+        fov_y_deg: 40.0,
+    }
+}
+
+/// Of points along the middle of the segments of `tree` drawn in `style`, the fraction where
+/// an RGBA picture seen through `frame` shows that style's colour (within 40 of each channel,
+/// in the 3 × 3 pixels around the point).
+fn colour_along(
+    rgba: &[u8],
+    frame: &CameraFrame,
+    (w, h): (u32, u32),
+    tree: &raytree::ray_tree::RayTree,
+    style: Style,
+) -> f32 {
+    let extent = 10.0;
+    let [r, g, b, _] = raytree::scene_view::style_rgba(style);
+    let segments: Vec<Segment> = raytree::scene_view::tree_segments(tree, extent)
+        .into_iter()
+        .filter(|s| s.style == style)
+        .collect();
+    assert!(!segments.is_empty(), "the tree has no {style:?} ray");
+    let (mut points, mut found) = (0, 0);
+    for s in &segments {
+        for i in 0..=20 {
+            let p = s.a.lerp(s.b, 0.2 + 0.6 * i as f32 / 20.0);
+            let Some((x, y)) = frame.project(p) else {
+                continue;
+            };
+            points += 1;
+            let near = (-1..=1).any(|dy| {
+                (-1..=1).any(|dx| {
+                    let (px, py) = (x as i64 + dx, y as i64 + dy);
+                    if px < 0 || py < 0 || px >= w as i64 || py >= h as i64 {
+                        return false;
+                    }
+                    let q = &rgba[((py as usize) * w as usize + px as usize) * 4..][..3];
+                    [r, g, b]
+                        .iter()
+                        .zip(q)
+                        .all(|(want, got)| want.abs_diff(*got) <= 40)
+                })
+            });
+            found += usize::from(near);
+        }
+    }
+    assert!(
+        points > 0,
+        "the {style:?} rays are not in front of the view"
+    );
+    found as f32 / points as f32
+}
+
+/// From outside a closed room around the render camera, the cut-away (on, and auto, which is
+/// on from there) shows the primary and shadow rays in their colours; with it off the walls
+/// hide them (dimmed over the wall, not their colour).
+#[test]
+fn the_cut_away_shows_the_rays_inside_a_closed_room() {
+    use raytree::scene_view::cutaway::Cutaway;
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = raytree::scene::files::load_scene_file(&closed_room(dir.path())).expect("loads");
+    assert_eq!(scene.triangles.len(), 12);
+    let tracer = Tracer::new(Arc::new(scene.clone()), TraceSettings::default());
+    let tree = raytree::ray_tree::pixel_tree(&tracer, 160, 120).expect("inside");
+    assert!(tree.root.hit.is_some(), "the pixel looks at the ball");
+    let view = outside_view();
+    let (w, h) = (320, 240);
+    let frame = CameraFrame::new(&view, w, h);
+    let draw = |cutaway| {
+        headless::scene_view_image(
+            &scene,
+            TraceSettings::default(),
+            &tree,
+            &view,
+            w,
+            h,
+            &Filter::default(),
+            cutaway,
+        )
+        .expect("drawn")
+    };
+    let (on, auto, off) = (draw(Cutaway::On), draw(Cutaway::Auto), draw(Cutaway::Off));
+    assert_eq!(on.rgba(), auto.rgba(), "auto cuts from outside the room");
+    for style in [Style::Ray(RayKind::Primary), Style::ShadowLit] {
+        let seen = colour_along(on.rgba(), &frame, (w, h), &tree, style);
+        let hidden = colour_along(off.rgba(), &frame, (w, h), &tree, style);
+        assert!(seen > 0.9, "{style:?} with the cut-away: {seen}");
+        assert!(hidden < 0.1, "{style:?} behind the walls: {hidden}");
+    }
+    // Not black on black: the walls inside are lit.
+    let lit_pixels = on.rgba().chunks(4).filter(|p| p[0] > 60).count();
+    assert!(lit_pixels > (w * h / 4) as usize, "{lit_pixels} lit pixels");
+}
+
+/// `raytree tree --scene-view` cuts the room open by itself (auto) and not with
+/// `--cutaway off`; the exported PNG shows the rays in their colours.
+#[test]
+fn the_exported_scene_view_of_a_closed_room_shows_its_rays() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let file = closed_room(dir.path());
+    let scene = raytree::scene::files::load_scene_file(&file).expect("loads");
+    let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());
+    let tree = raytree::ray_tree::pixel_tree(&tracer, 160, 120).expect("inside");
+    let export = |cutaway: &str| {
+        let out = dir.path().join(format!("view-{cutaway}.png"));
+        let status = raytree()
+            .arg("tree")
+            .arg(&file)
+            .args(["--pixel", "160,120", "--scene-view"])
+            .arg(&out)
+            .args(["--eye", "7,5,8", "--target", "0,-0.5,0", "--fov", "40"])
+            .args(["--cutaway", cutaway])
+            .stdout(std::process::Stdio::null())
+            .status()
+            .expect("runs");
+        assert!(status.success());
+        let (w, h, rgba) = read_png(&out, png::ColorType::Rgba, "");
+        assert_eq!((w, h), (320, 240));
+        rgba
+    };
+    let frame = CameraFrame::new(&outside_view(), 320, 240);
+    let primary = Style::Ray(RayKind::Primary);
+    let auto = colour_along(&export("auto"), &frame, (320, 240), &tree, primary);
+    let off = colour_along(&export("off"), &frame, (320, 240), &tree, primary);
+    assert!(auto > 0.9 && off < 0.1, "auto {auto}, off {off}");
+    let (code, err) = refused(&[
+        "--scene-view",
+        "v.png",
+        "--eye",
+        "1,2,3",
+        "--target",
+        "0,0,0",
+        "--cutaway",
+        "maybe",
+    ]);
+    assert_eq!(code, Some(2));
+    assert!(err.contains("auto, on or off"), "{err}");
 }

@@ -165,6 +165,7 @@ impl ViewerApp {
                 w,
                 h,
                 &filter,
+                self.scene_view.cutaway,
             )
         } else {
             let trees: Vec<&RayTree> = self.selection.trees().collect();

@@ -12,6 +12,11 @@
 //! instead of appearing at once as a raster would.
 //!
 //! Orbiting, panning or zooming restarts only this session; the trees are never re-traced.
+//!
+//! Inside a closed model (a room around the render camera) the view cuts away the walls
+//! between its eye and the render camera ([`crate::scene_view::cutaway`]): the session then
+//! renders a copy of the scene with those walls left out, rebuilt only when the walls cut
+//! change (and not during a drag, which keeps the last cut until the pointer lets go).
 
 use std::sync::{Arc, Mutex, Weak};
 use std::time::{Duration, Instant};
@@ -31,7 +36,8 @@ use crate::accel::Accel;
 use crate::render::session::{Session, SessionEvent, View};
 use crate::scene::camera::FRAME_MARGIN;
 use crate::scene::{Camera, CameraFrame, Scene};
-use crate::scene_view::{self, Filter, LevelSegments, Segment, box_corner};
+use crate::scene_view::cutaway::{Cutaway, cut_triangles, with_cut};
+use crate::scene_view::{self, Filter, LevelSegments, Segment, Style, box_corner};
 use crate::trace::{EndReason, Tracer};
 
 /// The longest side of the scene view's image, in pixels.
@@ -70,6 +76,13 @@ pub struct SceneView {
     /// The boxes of the level last drawn, and the accelerator and level they are of: worked
     /// out once, not every frame (a camera edit keeps the accelerator).
     level_cache: Option<(Weak<Accel>, u32, Arc<LevelSegments>)>,
+    /// When walls are cut away.
+    pub cutaway: Cutaway,
+    /// The tracer of the scene with walls cut, the tracer it was cut from and which
+    /// triangles were cut: kept while the same walls are cut (most camera moves).
+    cut_cache: Option<(Weak<Tracer>, Vec<u32>, Arc<Tracer>)>,
+    /// Whether the camera is being dragged: the cut then keeps its last walls.
+    moving: bool,
 }
 
 impl SceneView {
@@ -88,9 +101,12 @@ impl SceneView {
             framed: false,
             framed_view: None,
             finished: false,
-            show_visits: true,
+            show_visits: false,
             bvh_level: None,
             level_cache: None,
+            cutaway: Cutaway::Auto,
+            cut_cache: None,
+            moving: false,
         })
     }
 
@@ -178,7 +194,42 @@ impl SceneView {
         self.film.resize(w, h);
         crate::sync::lock(&self.display).resize(w, h);
         self.finished = false;
-        self.generation = self.session.start_view(tracer.clone(), view, samples);
+        let seen = self.view_tracer(tracer);
+        self.generation = self.session.start_view(seen, view, samples);
+    }
+
+    /// Whether walls are cut away from the current camera.
+    pub fn cuts(&self, scene: &Scene) -> bool {
+        self.cutaway.active(scene, self.camera.position)
+    }
+
+    /// The tracer the view renders: `tracer` itself, or one of its scene with the walls
+    /// between this view's eye and the render camera cut away when the cut-away is active.
+    fn view_tracer(&mut self, tracer: &Arc<Tracer>) -> Arc<Tracer> {
+        if !self.cuts(&tracer.scene) {
+            return tracer.clone();
+        }
+        let same_source = |of: &Weak<Tracer>| std::ptr::eq(of.as_ptr(), Arc::as_ptr(tracer));
+        if self.moving
+            && let Some((of, _, cut)) = &self.cut_cache
+            && same_source(of)
+        {
+            return cut.clone();
+        }
+        let walls = cut_triangles(&tracer.scene, self.camera.position);
+        if walls.is_empty() {
+            return tracer.clone();
+        }
+        if let Some((of, was, cut)) = &self.cut_cache
+            && same_source(of)
+            && *was == walls
+        {
+            return cut.clone();
+        }
+        let scene = Arc::new(with_cut(&tracer.scene, &walls));
+        let cut = Arc::new(Tracer::new(scene, tracer.settings));
+        self.cut_cache = Some((Arc::downgrade(tracer), walls, cut.clone()));
+        cut
     }
 
     /// Takes the tiles that arrived, within a time budget.
@@ -336,6 +387,36 @@ fn speed_and_frame(ui: &mut Ui, view: &mut SceneView, tracer: &Arc<Tracer>, labe
         view.frame(&tracer.scene);
         view.restart(tracer);
     }
+    cutaway_choice(ui, view, tracer);
+}
+
+/// The cut-away's choice, saying whether "auto" cuts from the current camera.
+fn cutaway_choice(ui: &mut Ui, view: &mut SceneView, tracer: &Arc<Tracer>) {
+    let text = match view.cutaway {
+        Cutaway::Auto if view.cuts(&tracer.scene) => "cut-away: auto (on)",
+        Cutaway::Auto => "cut-away: auto (off)",
+        Cutaway::On => "cut-away: on",
+        Cutaway::Off => "cut-away: off",
+    };
+    let before = view.cutaway;
+    egui::ComboBox::from_id_salt("scene view cut-away")
+        .selected_text(text)
+        .show_ui(ui, |ui| {
+            for (choice, what) in [
+                (Cutaway::Auto, "auto: on when the render camera is inside the model"),
+                (Cutaway::On, "on: leave out the walls facing this view"),
+                (Cutaway::Off, "off: the model whole"),
+            ] {
+                ui.selectable_value(&mut view.cutaway, choice, what);
+            }
+        })
+        .response
+        .on_hover_text(
+            "see inside a closed model: the walls between this view's eye and the render camera are left out",
+        );
+    if view.cutaway != before {
+        view.restart(tracer);
+    }
 }
 
 /// A menu of checkboxes that stays open while they are clicked (egui closes a menu on any click
@@ -354,7 +435,7 @@ fn filters(ui: &mut Ui, view: &mut SceneView, tracer: &Arc<Tracer>) {
     ui.checkbox(&mut f.shadow, "shadow");
     ui.checkbox(&mut f.normals, "normals");
     ui.checkbox(&mut view.show_visits, "visits")
-        .on_hover_text("the boxes the selected ray's traversal entered (BVH nodes or grid cells)");
+        .on_hover_text("cyan boxes: the BVH nodes (or grid cells) the selected ray entered");
     let levels = tracer.accel.levels();
     let mut on = view.bvh_level.is_some();
     ui.horizontal(|ui| {
@@ -531,6 +612,11 @@ pub fn scene_view_ui(
         }
     }
     if restart {
+        view.moving = response.dragged();
+        view.restart(tracer);
+        view.moving = false;
+    } else if response.drag_stopped() && view.cuts(&tracer.scene) {
+        // The cut kept during the drag, brought up to the camera's new place.
         view.restart(tracer);
     }
     view.set_params(prefs.exposure, prefs.tonemap);
@@ -563,11 +649,13 @@ pub fn scene_view_ui(
     let mut camera = scene_view::camera_segments(scene, plane.max(1e-6), pixel);
     // The accelerator made visible: the boxes the selected ray's traversal entered, and all
     // boxes of one BVH level.
+    let mut visits = None;
     if view.show_visits
         && let (Some(tree), Some(path)) = (&selection.tree, &selection.tree_state.selected)
-        && let Some((boxes, _)) = scene_view::visit_segments(tracer, tree, path)
+        && let Some((boxes, counts)) = scene_view::visit_segments(tracer, tree, path)
     {
         camera.extend(boxes);
+        visits = Some(counts.boxes.len());
     }
     let level = view.level_segments(&tracer.accel);
     paint3d::draw_segments(
@@ -587,10 +675,18 @@ pub fn scene_view_ui(
     };
     let drawn = draw_trees(selection, scene, &painter, &screen, &depth, &filter);
     // The key of ray colours, where it leaves most of the view free (the render pane shows
-    // the same key over the image).
-    if selection.tree.is_some() && rect.width() >= KEY_MIN_VIEW.0 && rect.height() >= KEY_MIN_VIEW.1
-    {
-        super::legend::ray_key(&painter, rect);
+    // the same key over the image); a row of swatches in a smaller view.
+    if selection.tree.is_some() {
+        if rect.width() >= KEY_MIN_VIEW.0 && rect.height() >= KEY_MIN_VIEW.1 {
+            super::legend::ray_key(&painter, rect);
+        } else if let Some(area) = compact_key(&painter, rect)
+            && response.hover_pos().is_some_and(|p| area.contains(p))
+        {
+            response.clone().on_hover_text_at_pointer(COMPACT_KEY_HOVER);
+        }
+    }
+    if view.show_visits {
+        visits_caption(&painter, rect, visits, tracer.accel.kind());
     }
     pick_and_hover(selection, &response, &drawn);
     view.drawn = drawn;
@@ -686,6 +782,112 @@ impl SceneView {
     }
 }
 
+/// The compact key's entries: a short label and the style whose colour it shows.
+const COMPACT_KEY: [(&str, Style); 5] = [
+    ("pri", Style::Ray(crate::trace::RayKind::Primary)),
+    ("refl", Style::Ray(crate::trace::RayKind::Reflected)),
+    ("refr", Style::Ray(crate::trace::RayKind::Refracted)),
+    ("lit", Style::ShadowLit),
+    ("blk", Style::ShadowBlocked),
+];
+
+/// What the compact key's short labels stand for, shown when the pointer is over it.
+const COMPACT_KEY_HOVER: &str = "pri: primary ray\nrefl: reflected ray\nrefr: refracted ray\nlit: shadow ray that reached its light\nblk: shadow ray blocked (faded past its blocker)";
+
+/// The width (points) of one entry of the compact key: a swatch and a short label.
+const COMPACT_ENTRY: f32 = 44.0;
+
+/// The places of the compact key's entries in a view `rect`: a row along its bottom left,
+/// wrapped to the view's width; `None` when the view is too small to spare it.
+pub fn compact_key_layout(rect: egui::Rect) -> Option<Vec<egui::Rect>> {
+    let row = 16.0;
+    let per_row = (((rect.width() - 12.0) / COMPACT_ENTRY).floor() as usize).min(COMPACT_KEY.len());
+    if per_row < 2 {
+        return None;
+    }
+    let rows = COMPACT_KEY.len().div_ceil(per_row);
+    if rect.height() < 4.0 * row * rows as f32 {
+        return None;
+    }
+    let top = rect.max.y - 6.0 - row * rows as f32;
+    Some(
+        (0..COMPACT_KEY.len())
+            .map(|i| {
+                let (r, c) = (i / per_row, i % per_row);
+                egui::Rect::from_min_size(
+                    egui::pos2(
+                        rect.min.x + 6.0 + c as f32 * COMPACT_ENTRY,
+                        top + r as f32 * row,
+                    ),
+                    egui::vec2(COMPACT_ENTRY, row),
+                )
+            })
+            .collect(),
+    )
+}
+
+/// Draws the compact key in `rect` and returns the area it covers (for its hover).
+fn compact_key(painter: &egui::Painter, rect: egui::Rect) -> Option<egui::Rect> {
+    let places = compact_key_layout(rect)?;
+    let area = places
+        .iter()
+        .fold(places[0], |a, p| a.union(*p))
+        .expand(2.0);
+    painter.rect_filled(area, 4.0, Color32::from_rgba_unmultiplied(25, 25, 25, 200));
+    let font = egui::FontId::proportional(11.0);
+    for (place, (label, style)) in places.iter().zip(COMPACT_KEY) {
+        let [r, g, b, _] = scene_view::style_rgba(style);
+        let y = place.center().y;
+        painter.line_segment(
+            [
+                egui::pos2(place.min.x + 3.0, y),
+                egui::pos2(place.min.x + 15.0, y),
+            ],
+            egui::Stroke::new(3.0, Color32::from_rgb(r, g, b)),
+        );
+        painter.text(
+            egui::pos2(place.min.x + 18.0, y),
+            egui::Align2::LEFT_CENTER,
+            label,
+            font.clone(),
+            Color32::from_gray(225),
+        );
+    }
+    Some(area)
+}
+
+/// What the cyan boxes are, at the top of the view while they are shown: `boxes` is how many
+/// the selected ray entered (`None`: no ray is selected).
+fn visits_caption(
+    painter: &egui::Painter,
+    rect: egui::Rect,
+    boxes: Option<usize>,
+    kind: crate::accel::AccelKind,
+) {
+    let what = if kind == crate::accel::AccelKind::Grid {
+        "grid cells"
+    } else {
+        "BVH nodes"
+    };
+    let text = match boxes {
+        Some(n) => format!("cyan: the {n} {what} the selected ray entered"),
+        None => format!("visits: select a ray to see the {what} it entered"),
+    };
+    let galley = painter.layout(
+        text,
+        egui::FontId::proportional(12.0),
+        Color32::from_rgb(0, 230, 230),
+        (rect.width() - 20.0).max(40.0),
+    );
+    let at = rect.left_top() + egui::vec2(8.0, 8.0);
+    painter.rect_filled(
+        egui::Rect::from_min_size(at, galley.size()).expand(3.0),
+        3.0,
+        Color32::from_rgba_unmultiplied(20, 20, 20, 190),
+    );
+    painter.galley(at, galley, Color32::PLACEHOLDER);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -716,6 +918,37 @@ mod tests {
         let other = view.level_segments(&rebuilt.accel).expect("boxes");
         assert!(!Arc::ptr_eq(&first, &other));
         assert_eq!(other.total, first.total);
+    }
+
+    /// A new view shows no visits (they say nothing until asked for) and cuts walls only
+    /// when the model encloses the render camera.
+    #[test]
+    fn visits_are_off_and_the_cut_away_automatic_by_default() {
+        let view = SceneView::new(1).expect("a scene view");
+        assert!(!view.show_visits);
+        assert_eq!(view.cutaway, Cutaway::Auto);
+    }
+
+    /// The compact key stays inside the view, its entries apart, in a narrow pane and a
+    /// narrower ones (two and three rows); a view too small for it gets none.
+    #[test]
+    fn the_compact_key_fits_the_view() {
+        for (w, rows) in [(250.0, 1), (160.0, 2), (110.0, 3)] {
+            let rect = egui::Rect::from_min_size(egui::pos2(10.0, 20.0), egui::vec2(w, 200.0));
+            let places = compact_key_layout(rect).expect("a key");
+            assert_eq!(places.len(), COMPACT_KEY.len());
+            assert!(places.iter().all(|p| rect.contains_rect(*p)), "{places:?}");
+            for (i, a) in places.iter().enumerate() {
+                for b in &places[i + 1..] {
+                    assert!(!a.shrink(0.5).intersects(*b), "{a:?} over {b:?}");
+                }
+            }
+            let tops: std::collections::BTreeSet<i32> =
+                places.iter().map(|p| p.min.y as i32).collect();
+            assert_eq!(tops.len(), rows);
+        }
+        let tiny = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(80.0, 30.0));
+        assert!(compact_key_layout(tiny).is_none());
     }
 
     /// Where a point lands in a view from `eye` towards `target`: tangents across and up.

@@ -10,6 +10,7 @@ use clap::Args;
 use glam::Vec3;
 use raytree::ray_tree::{self, RayTree};
 use raytree::scene::{Camera, Scene, rules};
+use raytree::scene_view::cutaway::Cutaway;
 use raytree::scene_view::{Filter, headless};
 use raytree::{export, trace::Tracer};
 
@@ -67,7 +68,7 @@ pub fn run_tree(args: &TreeArgs) -> Result<()> {
         }
     }
     if let (Some(path), Some(view)) = (&args.view.scene_view, view) {
-        write_scene_view(&args.scene, &tracer, &tree, &view, path)?;
+        write_scene_view(&args.scene, &tracer, &tree, &view, args.view.cutaway, path)?;
     }
     Ok(())
 }
@@ -97,6 +98,16 @@ pub struct SceneViewArgs {
         requires = "scene_view"
     )]
     fov: Option<f32>,
+    /// Cut away the walls between the scene view's eye and the render camera, to see inside
+    /// a closed model: auto does when the render camera is inside the model and the eye
+    /// outside it.
+    #[arg(
+        long,
+        value_name = "auto|on|off",
+        default_value = "auto",
+        requires = "scene_view"
+    )]
+    cutaway: Cutaway,
 }
 
 /// A point or direction written X,Y,Z.
@@ -161,12 +172,14 @@ fn write_scene_view(
     tracer: &Tracer,
     tree: &RayTree,
     view: &Camera,
+    cutaway: Cutaway,
     path: &Path,
 ) -> Result<()> {
     let scene = &tracer.scene;
     let (w, h) = (scene.render.width, scene.render.height);
     let filter = Filter::default();
-    let canvas = headless::scene_view_image(scene, tracer.settings, tree, view, w, h, &filter)?;
+    let canvas =
+        headless::scene_view_image(scene, tracer.settings, tree, view, w, h, &filter, cutaway)?;
     let text = export::stamp(
         label,
         1,

@@ -4,6 +4,7 @@
 
 use std::sync::Arc;
 
+use super::cutaway::{Cutaway, cut_triangles, with_cut};
 use super::occlusion::DepthImage;
 use super::raster::Canvas;
 use super::{Filter, Segment, camera_segments, extent, light_markers, tree_segments};
@@ -43,8 +44,11 @@ pub fn image_plane_distance(scene: &Scene, tree: &RayTree) -> f32 {
 /// `scene` rendered from `view` at `width × height` with raytree's own 1-sample render (the
 /// scene's settings, `settings` for tracing), with the render camera of `scene` (frustum, image
 /// plane, the tree's pixel), its lights and the segments of `tree` that `filter` shows drawn
-/// over it; parts behind surfaces are dimmed. The result is 8-bit sRGB, converted from the
-/// render as PNG export does.
+/// over it; parts behind surfaces are dimmed. With `cutaway` active for the view's eye
+/// ([`Cutaway::active`]) the walls between the eye and the render camera are left out of the
+/// render and of the depth the rays are hidden by ([`super::cutaway`]). The result is 8-bit
+/// sRGB, converted from the render as PNG export does.
+#[allow(clippy::too_many_arguments)]
 pub fn scene_view_image(
     scene: &Scene,
     settings: TraceSettings,
@@ -53,8 +57,13 @@ pub fn scene_view_image(
     width: u32,
     height: u32,
     filter: &Filter,
+    cutaway: Cutaway,
 ) -> Result<Canvas, SceneViewError> {
-    let mut seen = scene.clone();
+    let mut seen = if cutaway.active(scene, view.position) {
+        with_cut(scene, &cut_triangles(scene, view.position))
+    } else {
+        scene.clone()
+    };
     seen.camera = view.clone();
     seen.render.width = width;
     seen.render.height = height;

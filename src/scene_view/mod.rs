@@ -4,6 +4,7 @@
 //! (generation, ray kind, end reason) that hide segments. The viewer's render overlay and scene
 //! view and the headless `raytree tree --scene-view` draw these, so their rules cannot drift.
 
+pub mod cutaway;
 pub mod headless;
 pub mod occlusion;
 pub mod raster;
