@@ -21,6 +21,7 @@ mod open_scene;
 pub mod opening;
 mod paint3d;
 mod panels;
+pub mod picker;
 pub mod render_view;
 mod saving;
 pub mod scene_files;
