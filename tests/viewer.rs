@@ -479,6 +479,8 @@ fn speed_vs_accuracy_window_runs_the_sweep_and_a_point_applies() {
 fn ctrl_drag_traces_a_sparse_grid_of_the_rectangle() {
     let mut h = harness(small("default"));
     settle(&mut h);
+    // The densest grid (the picker's default is 4 × 4), which fills the trees.
+    h.state_mut().selection.picker.grid.per_side = 8;
     let (from, to) = (pixel_pos(&h, 10, 10), pixel_pos(&h, 150, 110));
     drag(&mut h, from, to - from, egui::Modifiers::COMMAND);
     let n = h.state().selection.trees().count();

@@ -155,10 +155,10 @@ fn swatch(ui: &mut Ui, tint: usize) {
 }
 
 /// Up/Down (or [ and ]) select the previous or next tree of the picker, unless a text field
-/// or another widget has the keyboard.
+/// has the keyboard.
 pub fn step_keys(ctx: &egui::Context, selection: &mut TreeSelection) {
     use egui::{Key, Modifiers};
-    if ctx.egui_wants_keyboard_input() || ctx.memory(|m| m.focused().is_some()) {
+    if ctx.egui_wants_keyboard_input() {
         return;
     }
     let (up, down) = ctx.input_mut(|i| {
