@@ -99,7 +99,11 @@ fn shift_clicked_trees_are_listed_and_the_arrow_keys_step_through_them() {
     assert_eq!(current(&h), Some(FLOOR));
     press(&mut h, egui::Key::OpenBracket);
     assert_eq!(current(&h), Some(GLASS));
-    assert_eq!(h.state().selection.trees().count(), 2, "stepping keeps every tree");
+    assert_eq!(
+        h.state().selection.trees().count(),
+        2,
+        "stepping keeps every tree"
+    );
 }
 
 #[test]
@@ -138,7 +142,10 @@ fn a_click_three_pixels_from_a_drawn_ray_selects_it_and_keeps_every_tree() {
     let selection = &h.state().selection;
     assert_eq!(selection.trees().count(), 2, "the click discarded trees");
     assert_eq!(current(&h), Some(GLASS));
-    assert_eq!(selection.tree_state.selected.as_deref(), Some(&[0usize][..]));
+    assert_eq!(
+        selection.tree_state.selected.as_deref(),
+        Some(&[0usize][..])
+    );
     // A click on the image far from every ray picks its pixel as before.
     let empty = pixel_pos(&h, 150, 5);
     click(&mut h, empty, egui::Modifiers::NONE);

@@ -248,6 +248,10 @@ fn pixel_rings(selection: &TreeSelection, painter: &egui::Painter, rect: egui::R
         } else {
             (4.5, 1.5)
         };
-        painter.circle_stroke(at, radius, egui::Stroke::new(width, egui::Color32::from_rgb(r, g, b)));
+        painter.circle_stroke(
+            at,
+            radius,
+            egui::Stroke::new(width, egui::Color32::from_rgb(r, g, b)),
+        );
     }
 }

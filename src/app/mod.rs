@@ -28,6 +28,7 @@ pub mod scene_files;
 pub mod scene_pane;
 pub mod selection;
 pub mod sweep;
+pub mod tree_picks;
 pub mod tree_view;
 pub mod undo;
 pub mod viewport;

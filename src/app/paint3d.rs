@@ -113,13 +113,14 @@ pub fn draw_segments<'a>(
             let [r, g, b] = HIGHLIGHT_RGB;
             [r, g, b, 255]
         } else {
-            look.tree.map_or_else(|| style_rgba(s.style), |t| t.rgba(s.style))
+            look.tree
+                .map_or_else(|| style_rgba(s.style), |t| t.rgba(s.style))
         };
         if rgba[3] == 0 {
             continue;
         }
-        let width = look.tree.map_or(1.0, |t| t.width())
-            * if highlighted { SELECTED_WIDTH } else { WIDTH };
+        let width =
+            look.tree.map_or(1.0, |t| t.width()) * if highlighted { SELECTED_WIDTH } else { WIDTH };
         for piece in visible_pieces(s.a, s.b, &view.frame, depth) {
             let (Some(a), Some(b)) = (view.screen_pos(piece.a), view.screen_pos(piece.b)) else {
                 continue;

@@ -447,20 +447,36 @@ pub(super) fn draw_trees(
     if let Some(tree) = &state.pinned {
         let segments = shown_segments(tree, extent, filter);
         let out = &mut Vec::new();
-        paint3d::draw_segments(painter, view, depth, &segments, usize::MAX, &[], pinned, out);
+        paint3d::draw_segments(
+            painter,
+            view,
+            depth,
+            &segments,
+            usize::MAX,
+            &[],
+            pinned,
+            out,
+        );
     }
     for (tree, number, tree_look, to_depth) in selection.layers() {
         let filter = Filter {
-            max_generation: to_depth.map_or(filter.max_generation, |d| d.min(filter.max_generation)),
+            max_generation: to_depth
+                .map_or(filter.max_generation, |d| d.min(filter.max_generation)),
             ..filter.clone()
         };
         let segments = shown_segments(tree, extent, &filter);
-        let lit = if number == 0 { active.as_slice() } else { &[][..] };
+        let lit = if number == 0 {
+            active.as_slice()
+        } else {
+            &[][..]
+        };
         let look = Look {
             tree: Some(tree_look),
             ..Look::default()
         };
-        paint3d::draw_segments(painter, view, depth, &segments, number, lit, look, &mut drawn);
+        paint3d::draw_segments(
+            painter, view, depth, &segments, number, lit, look, &mut drawn,
+        );
     }
     drawn
 }

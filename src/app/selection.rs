@@ -5,7 +5,7 @@
 use eframe::egui;
 
 use super::messages::Messages;
-use super::picker::Picker;
+use super::tree_picks::Picker;
 use super::tree_view::TreeState;
 use crate::ray_tree::{RayTree, pixel_tree};
 use crate::scene_view::TreeLook;
@@ -133,7 +133,11 @@ impl TreeSelection {
         messages: &mut Messages,
     ) {
         self.picker.last_rect = Some(([x0, y0], [x1, y1]));
-        let per_side = self.picker.grid.per_side.clamp(1, super::picker::MAX_GRID_SIDE);
+        let per_side = self
+            .picker
+            .grid
+            .per_side
+            .clamp(1, super::tree_picks::MAX_GRID_SIDE);
         let axis = |a: u32, b: u32| -> Vec<u32> {
             let n = (b - a + 1).min(per_side);
             let mut v: Vec<u32> = (0..n)
@@ -238,7 +242,11 @@ impl TreeSelection {
             .map(|e| e.pixel)
             .collect();
         self.extra_trees.retain(|t| !gridded.contains(&t.pixel));
-        if self.tree.as_ref().is_some_and(|t| gridded.contains(&t.pixel)) {
+        if self
+            .tree
+            .as_ref()
+            .is_some_and(|t| gridded.contains(&t.pixel))
+        {
             self.tree = None;
         }
         self.sync();

@@ -581,7 +581,10 @@ mod tests {
         for (i, &t) in TREE_TINTS.iter().enumerate() {
             assert!(kinds.iter().all(|&k| !near(t, kind_rgb(k))), "tint {i}");
             assert!(!near(t, HIGHLIGHT_RGB), "tint {i}");
-            assert!(TREE_TINTS[..i].iter().all(|&u| !near(t, u)), "tint {i} twice");
+            assert!(
+                TREE_TINTS[..i].iter().all(|&u| !near(t, u)),
+                "tint {i} twice"
+            );
         }
         assert_eq!(tree_tint(TREE_TINTS.len() + 1), TREE_TINTS[1]);
         let style = Style::Ray(RayKind::Reflected);
