@@ -378,7 +378,9 @@ fn shift_click_adds_a_tree_and_a_plain_click_starts_over() {
     click(&mut h, c, egui::Modifiers::SHIFT);
     let pixels: Vec<[u32; 2]> = h.state().selection.trees().map(|t| t.pixel).collect();
     assert_eq!(pixels, vec![[60, 69], [99, 53], [20, 100]]);
-    click(&mut h, b, egui::Modifiers::NONE);
+    // A plain click away from the drawn rays (a click on one selects it instead).
+    let d = pixel_pos(&h, 150, 5);
+    click(&mut h, d, egui::Modifiers::NONE);
     assert_eq!(h.state().selection.trees().count(), 1);
 }
 
@@ -479,6 +481,8 @@ fn speed_vs_accuracy_window_runs_the_sweep_and_a_point_applies() {
 fn ctrl_drag_traces_a_sparse_grid_of_the_rectangle() {
     let mut h = harness(small("default"));
     settle(&mut h);
+    // The densest grid (the picker's default is 4 × 4), which fills the trees.
+    h.state_mut().selection.picker.grid.per_side = 8;
     let (from, to) = (pixel_pos(&h, 10, 10), pixel_pos(&h, 150, 110));
     drag(&mut h, from, to - from, egui::Modifiers::COMMAND);
     let n = h.state().selection.trees().count();

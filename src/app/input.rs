@@ -14,7 +14,7 @@ use super::selection::TreeSelection;
 use super::undo::WorkingCopy;
 use super::viewport::{DisplayCallback, DisplayId};
 use super::workspace::{Prefs, Workspace};
-use super::{Command, gesture, legend, scene_pane};
+use super::{Command, gesture, legend, paint3d, picker, scene_pane};
 use crate::scene::{Camera, CameraFrame};
 use crate::scene_view::Filter;
 
@@ -140,6 +140,9 @@ pub(super) fn render_pane(
         ));
     // The trees' rays over the image, by the scene view's rules and widths, seen from the
     // render camera; parts behind surfaces (the render's own depth) dimmed.
+    selection.sync();
+    picker::step_keys(ui.ctx(), selection);
+    let mut drawn = Vec::new();
     if selection.tree.is_some() || !selection.extra_trees.is_empty() {
         let (sw, sh) = (scene.render.width, scene.render.height);
         let view = ScreenView {
@@ -154,9 +157,9 @@ pub(super) fn render_pane(
         };
         let depth = render.film.depth();
         let painter = ui.painter_at(rect);
-        let drawn = scene_pane::draw_trees(selection, &scene, &painter, &view, &depth, &filter);
+        drawn = scene_pane::draw_trees(selection, &scene, &painter, &view, &depth, &filter);
+        pixel_rings(selection, &painter, rect, scale);
         legend::ray_key(&painter, rect);
-        scene_pane::pick_and_hover_only(selection, &response, &drawn);
     }
     let to_pixel = |p: egui::Pos2| {
         let x = ((p.x - rect.min.x) / scale).floor();
@@ -165,8 +168,18 @@ pub(super) fn render_pane(
     };
     selection.hover = response.hover_pos().and_then(to_pixel);
     let modifiers = ui.input(|i| i.modifiers);
+    // A plain click near a drawn ray selects that ray's node (every tree stays); elsewhere it
+    // picks the pixel. Shift-click always adds a pixel.
+    let at = response.interact_pointer_pos();
+    let on_ray = !modifiers.shift && at.is_some_and(|p| paint3d::pick(&drawn, p).is_some());
+    if on_ray {
+        scene_pane::pick_and_hover(selection, &response, &drawn);
+    } else {
+        scene_pane::pick_and_hover_only(selection, &response, &drawn);
+    }
     if response.clicked()
-        && let Some((x, y)) = response.interact_pointer_pos().and_then(to_pixel)
+        && !on_ray
+        && let Some((x, y)) = at.and_then(to_pixel)
     {
         pending.push(if modifiers.shift {
             Command::PickMore(x, y)
@@ -220,5 +233,25 @@ pub(super) fn render_pane(
             camera.zoom((-scroll * 0.002).exp());
             pending.push(Command::MoveCamera);
         }
+    }
+}
+
+/// A ring in its tree's tint around each picked pixel (the selected one larger), so the
+/// picker's rows are found on the image; `scale` is screen points per image pixel.
+fn pixel_rings(selection: &TreeSelection, painter: &egui::Painter, rect: egui::Rect, scale: f32) {
+    let current = selection.tree.as_ref().map(|t| t.pixel);
+    for e in &selection.picker.entries {
+        let at = rect.min + egui::vec2(e.pixel[0] as f32 + 0.5, e.pixel[1] as f32 + 0.5) * scale;
+        let [r, g, b] = crate::scene_view::tree_tint(e.tint);
+        let (radius, width) = if current == Some(e.pixel) {
+            (7.0, 2.5)
+        } else {
+            (4.5, 1.5)
+        };
+        painter.circle_stroke(
+            at,
+            radius,
+            egui::Stroke::new(width, egui::Color32::from_rgb(r, g, b)),
+        );
     }
 }

@@ -10,7 +10,7 @@ use glam::Vec3;
 
 use crate::scene::CameraFrame;
 use crate::scene_view::occlusion::{DepthImage, visible_pieces};
-use crate::scene_view::{HIGHLIGHT_RGB, NodePath, Segment, Style, style_rgba};
+use crate::scene_view::{HIGHLIGHT_RGB, NodePath, Segment, Style, TreeLook, style_rgba};
 
 /// Width of a ray on screen, in logical pixels.
 pub const WIDTH: f32 = 2.5;
@@ -56,6 +56,8 @@ pub struct Look {
     pub alpha: f32,
     /// Dashed lines (the pinned tree).
     pub dashed: bool,
+    /// The tree's tint and strength among several (`None`: the styles' own colours).
+    pub tree: Option<TreeLook>,
 }
 
 impl Default for Look {
@@ -63,6 +65,7 @@ impl Default for Look {
         Self {
             alpha: 1.0,
             dashed: false,
+            tree: None,
         }
     }
 }
@@ -110,9 +113,14 @@ pub fn draw_segments<'a>(
             let [r, g, b] = HIGHLIGHT_RGB;
             [r, g, b, 255]
         } else {
-            style_rgba(s.style)
+            look.tree
+                .map_or_else(|| style_rgba(s.style), |t| t.rgba(s.style))
         };
-        let width = if highlighted { SELECTED_WIDTH } else { WIDTH };
+        if rgba[3] == 0 {
+            continue;
+        }
+        let width =
+            look.tree.map_or(1.0, |t| t.width()) * if highlighted { SELECTED_WIDTH } else { WIDTH };
         for piece in visible_pieces(s.a, s.b, &view.frame, depth) {
             let (Some(a), Some(b)) = (view.screen_pos(piece.a), view.screen_pos(piece.b)) else {
                 continue;

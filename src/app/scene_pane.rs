@@ -516,46 +516,47 @@ pub(super) fn draw_trees(
         .into_iter()
         .flatten()
         .collect();
-    // Back to front: the pinned tree (dashed, fainter, not pickable), the extra trees
-    // (numbered 1..), the current tree (0) with its hovered and selected nodes.
+    // Back to front: the pinned tree (dashed, fainter, not pickable), the other trees faint
+    // in their tints (numbered 1..), the current tree (0) strong with its hovered and selected
+    // nodes.
     let pinned = Look {
         alpha: 0.55,
         dashed: true,
+        tree: None,
     };
-    let extra = Look {
-        alpha: 0.7,
-        dashed: false,
-    };
-    let layers = state
-        .pinned
-        .iter()
-        .map(|t| (t, None, pinned))
-        .chain(
-            selection
-                .extra_trees
-                .iter()
-                .enumerate()
-                .map(|(i, t)| (t, Some(i + 1), extra)),
-        )
-        .chain(selection.tree.iter().map(|t| (t, Some(0), Look::default())));
     let mut drawn = Vec::new();
-    let mut unpickable = Vec::new();
-    for (tree, number, look) in layers {
+    if let Some(tree) = &state.pinned {
         let segments = shown_segments(tree, extent, filter);
-        let (out, lit) = match number {
-            Some(0) => (&mut drawn, active.as_slice()),
-            Some(_) => (&mut drawn, &[][..]),
-            None => (&mut unpickable, &[][..]),
-        };
+        let out = &mut Vec::new();
         paint3d::draw_segments(
             painter,
             view,
             depth,
             &segments,
-            number.unwrap_or(usize::MAX),
-            lit,
-            look,
+            usize::MAX,
+            &[],
+            pinned,
             out,
+        );
+    }
+    for (tree, number, tree_look, to_depth) in selection.layers() {
+        let filter = Filter {
+            max_generation: to_depth
+                .map_or(filter.max_generation, |d| d.min(filter.max_generation)),
+            ..filter.clone()
+        };
+        let segments = shown_segments(tree, extent, &filter);
+        let lit = if number == 0 {
+            active.as_slice()
+        } else {
+            &[][..]
+        };
+        let look = Look {
+            tree: Some(tree_look),
+            ..Look::default()
+        };
+        paint3d::draw_segments(
+            painter, view, depth, &segments, number, lit, look, &mut drawn,
         );
     }
     drawn

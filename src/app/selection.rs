@@ -5,8 +5,10 @@
 use eframe::egui;
 
 use super::messages::Messages;
+use super::tree_picks::Picker;
 use super::tree_view::TreeState;
 use crate::ray_tree::{RayTree, pixel_tree};
+use crate::scene_view::TreeLook;
 use crate::trace::Tracer;
 
 /// The most trees shown at once (the current one and the extra ones).
@@ -21,6 +23,8 @@ pub struct TreeSelection {
     pub extra_trees: Vec<RayTree>,
     /// Selection, hover and the pinned tree, shared by the tree's views.
     pub tree_state: TreeState,
+    /// The trees in picking order with their tints, and the rectangle grid's settings.
+    pub picker: Picker,
     /// The render's pixel under the pointer.
     pub hover: Option<(u32, u32)>,
     /// The rectangle being dragged over the render with Ctrl or Alt (screen points).
@@ -65,7 +69,10 @@ impl TreeSelection {
     /// material its primary ray hit is selected.
     pub fn pick(&mut self, tracer: &Tracer, x: u32, y: u32) {
         self.extra_trees.clear();
+        self.picker.entries.clear();
+        self.picker.last_rect = None;
         self.tree = pixel_tree(tracer, x, y);
+        self.sync();
         self.tree_state.selected = Some(Vec::new());
         if let Some(hit) = self.tree.as_ref().and_then(|t| t.root.hit.as_ref()) {
             self.selected_material = tracer
@@ -79,6 +86,19 @@ impl TreeSelection {
     /// Adds the tree of pixel (`x`, `y`) to the trees shown, unless it is there or the trees
     /// are full (then says so). Returns false when full.
     pub fn add(&mut self, tracer: &Tracer, x: u32, y: u32, messages: &mut Messages) -> bool {
+        self.add_as(tracer, x, y, messages, false)
+    }
+
+    /// [`Self::add`], the entry marked as a grid's (`from_grid`).
+    fn add_as(
+        &mut self,
+        tracer: &Tracer,
+        x: u32,
+        y: u32,
+        messages: &mut Messages,
+        from_grid: bool,
+    ) -> bool {
+        self.sync();
         if self.trees().any(|t| t.pixel == [x, y]) {
             return true;
         }
@@ -98,11 +118,13 @@ impl TreeSelection {
             }
             Some(_) => self.extra_trees.push(tree),
         }
+        self.picker.push([x, y], from_grid);
         true
     }
 
-    /// Adds the trees of a sparse grid of the pixels in `x0..=x1 × y0..=y1` (at most 8 × 8
-    /// spread over the rectangle), until the trees are full.
+    /// Adds the trees of a sparse grid of the pixels in `x0..=x1 × y0..=y1` (at most the
+    /// picker's grid density across and down, spread over the rectangle), until the trees are
+    /// full.
     pub fn add_rect(
         &mut self,
         tracer: &Tracer,
@@ -110,8 +132,14 @@ impl TreeSelection {
         [x1, y1]: [u32; 2],
         messages: &mut Messages,
     ) {
+        self.picker.last_rect = Some(([x0, y0], [x1, y1]));
+        let per_side = self
+            .picker
+            .grid
+            .per_side
+            .clamp(1, super::tree_picks::MAX_GRID_SIDE);
         let axis = |a: u32, b: u32| -> Vec<u32> {
-            let n = (b - a + 1).min(8);
+            let n = (b - a + 1).min(per_side);
             let mut v: Vec<u32> = (0..n)
                 .map(|i| a + ((b - a) as u64 * (2 * i as u64 + 1) / (2 * n as u64)) as u32)
                 .collect();
@@ -120,7 +148,7 @@ impl TreeSelection {
         };
         for y in axis(y0.min(y1), y0.max(y1)) {
             for x in axis(x0.min(x1), x0.max(x1)) {
-                if !self.add(tracer, x, y, messages) {
+                if !self.add_as(tracer, x, y, messages, true) {
                     return;
                 }
             }
@@ -135,6 +163,10 @@ impl TreeSelection {
             for t in self.tree.iter_mut().chain(self.extra_trees.iter_mut()) {
                 t.pixel = remap_pixel(t.pixel, old, new);
             }
+            for e in &mut self.picker.entries {
+                e.pixel = remap_pixel(e.pixel, old, new);
+            }
+            self.picker.last_rect = None;
             self.hover = None;
         }
         if let Some(tree) = &self.tree {
@@ -146,17 +178,98 @@ impl TreeSelection {
             .iter()
             .filter_map(|t| pixel_tree(tracer, t.pixel[0], t.pixel[1]))
             .collect();
+        self.sync();
     }
 
     /// Another scene was opened: nothing of the old one stays picked (the pointer's pixel and
     /// drag stay: they are the render pane's).
     pub fn clear(&mut self) {
         let (hover, rect_select) = (self.hover, self.rect_select);
+        let grid = self.picker.grid;
         *self = Self {
             hover,
             rect_select,
             ..Self::default()
         };
+        self.picker.grid = grid;
+    }
+
+    /// The picker follows the trees shown (a tree closed or re-traced away drops its entry),
+    /// and when the current tree was closed the first other one in the picker's order becomes
+    /// current.
+    pub fn sync(&mut self) {
+        let pixels: Vec<[u32; 2]> = self.trees().map(|t| t.pixel).collect();
+        self.picker.follow(&pixels);
+        if self.tree.is_none()
+            && let Some(first) = self.picker.entries.first()
+        {
+            let pixel = first.pixel;
+            self.select_pixel(pixel);
+        }
+    }
+
+    /// Makes the tree of `pixel` the current one, its root selected.
+    pub fn select_pixel(&mut self, pixel: [u32; 2]) {
+        if self.tree.as_ref().is_some_and(|t| t.pixel == pixel) {
+            return;
+        }
+        if let Some(i) = self.extra_trees.iter().position(|t| t.pixel == pixel) {
+            self.make_current(i);
+            self.tree_state.selected = Some(Vec::new());
+            self.tree_state.hovered = None;
+        }
+    }
+
+    /// Selects the tree `delta` places on in the picker's order (held at its ends).
+    pub fn step(&mut self, delta: isize) {
+        self.sync();
+        let Some(current) = self.tree.as_ref().map(|t| t.pixel) else {
+            return;
+        };
+        if let Some(pixel) = self.picker.step(current, delta) {
+            self.select_pixel(pixel);
+        }
+    }
+
+    /// The grid of `a..=b` again at the picker's density: the grid trees go, the others and the
+    /// current one stay (unless it was a grid tree), then the new grid's trees are added.
+    pub fn regrid(&mut self, tracer: &Tracer, a: [u32; 2], b: [u32; 2]) {
+        let gridded: Vec<[u32; 2]> = self
+            .picker
+            .entries
+            .iter()
+            .filter(|e| e.from_grid)
+            .map(|e| e.pixel)
+            .collect();
+        self.extra_trees.retain(|t| !gridded.contains(&t.pixel));
+        if self
+            .tree
+            .as_ref()
+            .is_some_and(|t| gridded.contains(&t.pixel))
+        {
+            self.tree = None;
+        }
+        self.sync();
+        let mut quiet = Messages::default();
+        self.add_rect(tracer, a, b, &mut quiet);
+        self.sync();
+    }
+
+    /// The trees to draw, back to front, each with its number (0 the current tree, `i + 1`
+    /// extra tree `i`), its look and the generation it is drawn down to (`None`: as the filter
+    /// says).
+    pub fn layers(&self) -> Vec<(&RayTree, usize, TreeLook, Option<u32>)> {
+        let current = self.tree.as_ref().map(|t| t.pixel);
+        self.extra_trees
+            .iter()
+            .enumerate()
+            .map(|(i, t)| (t, i + 1))
+            .chain(self.tree.iter().map(|t| (t, 0)))
+            .map(|(t, n)| {
+                let (look, depth) = self.picker.look(t.pixel, current);
+                (t, n, look, depth)
+            })
+            .collect()
     }
 }
 

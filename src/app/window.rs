@@ -200,7 +200,7 @@ fn pane_ui(app: &mut ViewerApp, ui: &mut egui::Ui, pane: workspace::Pane) {
             &app.workspace.prefs,
             &mut app.pending,
         ),
-        Pane::Diagram => match app.selection.tree.clone() {
+        Pane::Diagram => match super::picker::strip(ui, &mut app.selection, &app.render.tracer) {
             Some(tree) => {
                 if tree_view::diagram(ui, &tree, &mut app.selection.tree_state) {
                     let name = format!("tree-{}-{}.svg", tree.pixel[0], tree.pixel[1]);
@@ -212,6 +212,7 @@ fn pane_ui(app: &mut ViewerApp, ui: &mut egui::Ui, pane: workspace::Pane) {
             }
         },
         Pane::TreeList => {
+            super::picker::strip(ui, &mut app.selection, &app.render.tracer);
             if app.selection.tree.is_some() {
                 panels::tree_panel(
                     ui,

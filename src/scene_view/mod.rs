@@ -88,6 +88,78 @@ pub fn kind_rgb(kind: RayKind) -> [u8; 3] {
 /// The hovered or selected node, drawn over its style.
 pub const HIGHLIGHT_RGB: [u8; 3] = [255, 120, 255];
 
+/// The tints that tell several trees apart (sRGB), one per tree in picking order, repeating
+/// after the last: none of them a ray kind's colour (white, blue, green, yellow) or the
+/// highlight's pink, so a tinted tree never reads as a kind of ray.
+pub const TREE_TINTS: [[u8; 3]; 8] = [
+    [255, 140, 0],
+    [0, 200, 200],
+    [190, 120, 255],
+    [255, 90, 130],
+    [150, 200, 40],
+    [200, 150, 100],
+    [110, 110, 255],
+    [240, 240, 120],
+];
+
+/// Tint number `i` (any number: the palette repeats).
+pub fn tree_tint(i: usize) -> [u8; 3] {
+    TREE_TINTS[i % TREE_TINTS.len()]
+}
+
+/// How strongly a tree is drawn among several.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Strength {
+    /// The selected tree: its rays in their kinds' colours, full width.
+    Strong,
+    /// Another tree: thin, in its tint, faint, without normals, so many trees leave the image
+    /// readable and the selected one stands out.
+    Faint,
+}
+
+/// Opacity kept by a faint tree's rays.
+pub const FAINT_ALPHA: f32 = 0.55;
+/// Width of a faint tree's rays, as a share of a strong tree's.
+pub const FAINT_WIDTH: f32 = 0.6;
+
+/// How one tree among several is drawn: its tint and strength.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TreeLook {
+    pub tint: [u8; 3],
+    pub strength: Strength,
+}
+
+impl TreeLook {
+    /// The colour and opacity of a segment of `style` of this tree (opacity 0: not drawn).
+    pub fn rgba(&self, style: Style) -> [u8; 4] {
+        let own = style_rgba(style);
+        match (self.strength, style) {
+            (Strength::Strong, _) => own,
+            (Strength::Faint, Style::Normal) => [0, 0, 0, 0],
+            (
+                Strength::Faint,
+                Style::Ray(_)
+                | Style::NotTraced(_)
+                | Style::ShadowLit
+                | Style::ShadowBlocked
+                | Style::ShadowPastBlocker,
+            ) => {
+                let [r, g, b] = self.tint;
+                [r, g, b, (own[3] as f32 * FAINT_ALPHA) as u8]
+            }
+            (Strength::Faint, _) => own,
+        }
+    }
+
+    /// The width of this tree's rays as a share of a strong tree's.
+    pub fn width(&self) -> f32 {
+        match self.strength {
+            Strength::Strong => 1.0,
+            Strength::Faint => FAINT_WIDTH,
+        }
+    }
+}
+
 /// One straight piece to draw, in world space.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Segment {
@@ -490,6 +562,50 @@ mod tests {
                     Style::ShadowLit | Style::ShadowBlocked | Style::ShadowPastBlocker
                 ))
         );
+    }
+
+    #[test]
+    fn tints_are_distinct_from_the_ray_kinds_and_faint_trees_wear_them() {
+        let kinds = [
+            RayKind::Primary,
+            RayKind::Reflected,
+            RayKind::Refracted,
+            RayKind::Shadow,
+        ];
+        let near = |a: [u8; 3], b: [u8; 3]| {
+            a.iter()
+                .zip(b)
+                .map(|(x, y)| (*x as i32 - y as i32).abs())
+                .sum::<i32>()
+                < 60
+        };
+        for (i, &t) in TREE_TINTS.iter().enumerate() {
+            assert!(kinds.iter().all(|&k| !near(t, kind_rgb(k))), "tint {i}");
+            assert!(!near(t, HIGHLIGHT_RGB), "tint {i}");
+            assert!(
+                TREE_TINTS[..i].iter().all(|&u| !near(t, u)),
+                "tint {i} twice"
+            );
+        }
+        assert_eq!(tree_tint(TREE_TINTS.len() + 1), TREE_TINTS[1]);
+        let style = Style::Ray(RayKind::Reflected);
+        let strong = TreeLook {
+            tint: TREE_TINTS[2],
+            strength: Strength::Strong,
+        };
+        assert_eq!(strong.rgba(style), style_rgba(style));
+        assert_eq!(strong.width(), 1.0);
+        let faint = TreeLook {
+            strength: Strength::Faint,
+            ..strong
+        };
+        let [r, g, b, a] = faint.rgba(style);
+        assert_eq!([r, g, b], TREE_TINTS[2]);
+        assert!(a < 255 && a > 0);
+        assert!(faint.width() < 1.0);
+        // Faint trees drop their normals; the camera keeps its colours.
+        assert_eq!(faint.rgba(Style::Normal)[3], 0);
+        assert_eq!(faint.rgba(Style::Frustum), style_rgba(Style::Frustum));
     }
 
     #[test]
