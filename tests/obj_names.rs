@@ -135,3 +135,52 @@ fn trees_name_the_part_a_ray_met() {
         ["parts", "parts: Cabinet_3", "parts: Door", "parts: Shelf"]
     );
 }
+
+/// A shadow ray blocked by a named part names it as the tree's hits do.
+#[test]
+fn blockers_are_named_by_their_part() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    for file in ["parts.obj", "parts.mtl"] {
+        std::fs::copy(
+            Path::new("tests/fixtures/models").join(file),
+            dir.path().join(file),
+        )
+        .expect("copy");
+    }
+    // The camera looks through the gap at x 7..8 onto a floor; the light's segment from there
+    // crosses the door (x 8..9) at z = 0.
+    let scene = r#"
+[render]
+width = 101
+height = 101
+
+[camera]
+position = [7.5, 0.5, 10]
+look_at = [7.5, 0.5, -2]
+up = [0, 1, 0]
+fov_y = 10
+
+[[light]]
+name = "side"
+position = [9.5, 0.5, 2]
+color = 1
+
+[[mesh]]
+name = "shelves"
+file = "parts.obj"
+
+[[triangle]]
+name = "floor"
+vertices = [[-50, -50, -2], [50, -50, -2], [0, 50, -2]]
+"#;
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, scene).expect("write");
+    let scene = Arc::new(load(&path));
+    let tracer = Tracer::new(scene, TraceSettings::default());
+    let tree = pixel_tree(&tracer, 50, 50).expect("inside");
+    let hit = tree.root.hit.as_ref().expect("the floor");
+    assert_eq!(hit.object, "floor");
+    let shadow = &tree.root.shadow_rays[0];
+    assert_eq!(shadow.blocked_by.as_deref(), Some("shelves: Door"));
+    assert!(tree_text(&tree).contains("blocked by shelves: Door"));
+}

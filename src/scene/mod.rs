@@ -3,7 +3,8 @@
 //! coordinates, and textures. Nothing here reads a file: scene files are read by [`toml`], OBJ
 //! meshes and their MTL materials by [`obj`], textures decoded by [`texture`], files found by
 //! [`files`] and [`resolve`]; [`builtin`] holds the scenes compiled into the binary and
-//! [`save`] writes a scene back as a file. The file format: docs/design.md, "Scene files".
+//! [`save`] writes a scene back as a file; [`names`] says what the materials panel calls a
+//! material. The file format: docs/design.md, "Scene files".
 
 pub mod budget;
 pub mod builtin;
@@ -11,6 +12,7 @@ pub mod camera;
 pub mod diag;
 pub mod files;
 pub mod first_look;
+pub mod names;
 pub mod obj;
 pub mod procedural;
 pub mod resolve;
