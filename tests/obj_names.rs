@@ -184,3 +184,24 @@ vertices = [[-50, -50, -2], [50, -50, -2], [0, 50, -2]]
     assert_eq!(shadow.blocked_by.as_deref(), Some("shelves: Door"));
     assert!(tree_text(&tree).contains("blocked by shelves: Door"));
 }
+
+/// A part named as its mesh adds nothing to the name ("Door", not "Door: Door").
+#[test]
+fn a_part_named_as_its_mesh_names_nothing_more() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    for file in ["parts.obj", "parts.mtl"] {
+        std::fs::copy(
+            Path::new("tests/fixtures/models").join(file),
+            dir.path().join(file),
+        )
+        .expect("copy");
+    }
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, "[[mesh]]\nname = \"Door\"\nfile = \"parts.obj\"\n").expect("write");
+    let scene = load(&path);
+    let names: Vec<&str> = scene.parts.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(names, ["Shelf", "Cabinet_3", "Cabinet_3"]);
+    let door = scene.hit_name(scene.triangles[8].object, Some(8));
+    assert_eq!(door, "Door");
+    assert_eq!(scene.hit_name(scene.triangles[4].object, Some(4)), "Door: Cabinet_3");
+}

@@ -315,7 +315,8 @@ pub enum ObjectSource {
 
 /// A named part of a mesh: the faces after an OBJ `o` or `g` statement (the last one before
 /// them, as tobj names its models) that share a material, a contiguous run of
-/// [`Scene::triangles`]. One name per run, not per triangle, keeps memory small.
+/// [`Scene::triangles`]. One name per run, not per triangle, keeps memory small. Faces before
+/// any name, or under the mesh's own name, belong to no part.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MeshPart {
     /// Index in [`Scene::triangles`] of the run's first triangle.

@@ -44,10 +44,12 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
 
 /// Names the triangles a model added from `start` on after its `o` or `g` (tobj's model name):
 /// one [`MeshPart`] per run, the previous one grown when the run continues it (same object,
-/// name and material). A model without a name, or whose faces were all dropped, names nothing.
+/// name and material). A model without a name, named as the mesh, or whose faces were all
+/// dropped, names nothing.
 fn add_part(scene: &mut Scene, req: &MeshRequest, name: &str, start: usize) {
     let end = scene.triangles.len();
-    if name == UNNAMED || end == start {
+    // A part named as its mesh ("torus" in torus.obj) would say the name twice.
+    if name == UNNAMED || name == req.object_name || end == start {
         return;
     }
     let material = scene.triangles[start].material;
