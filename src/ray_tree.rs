@@ -23,6 +23,8 @@ pub struct HitRecord {
     /// Unit shading normal (turned like the geometric one, towards the incoming ray's side):
     /// what the local model and R/T use.
     pub normal: Vec3,
+    /// The object's name; for a face of a named OBJ object or group (`o`, `g`), that name
+    /// after a colon: "kitchen: Cabinet_3".
     pub object: String,
     pub material: String,
     pub front_face: bool,
@@ -63,7 +65,8 @@ pub struct ShadowRecord {
     /// `L`, unit vector from the hit point to the light's centre.
     pub to_light: Vec3,
     pub distance: f32,
-    /// The first object on the segment to the light, or `None` when lit (or facing away).
+    /// The first object on the segment to the light, or `None` when lit (or facing away),
+    /// named as [`HitRecord::object`].
     pub blocked_by: Option<String>,
     /// Distance from the hit point to the blocker along `to_light`.
     #[serde(default)]
@@ -151,6 +154,8 @@ pub struct RayTree {
 /// Builds [`Node`]s from the trace's callbacks with a stack.
 struct TreeRecorder<'a> {
     scene: &'a Scene,
+    /// The primitive of the hit about to be recorded, which names its mesh part.
+    primitive: Option<u32>,
     stack: Vec<Node>,
     /// Depth of unrecorded nesting below the cap.
     skipped: u32,
@@ -222,14 +227,19 @@ impl Recorder for TreeRecorder<'_> {
         }
     }
 
+    fn hit_primitive(&mut self, primitive: u32) {
+        self.primitive = Some(primitive);
+    }
+
     fn hit(&mut self, hit: &SurfaceHit, view: Vec3) {
         let scene = self.scene;
+        let primitive = self.primitive.take();
         if let Some(node) = self.top() {
             node.hit = Some(HitRecord {
                 t: hit.t,
                 point: hit.point,
                 normal: hit.normal,
-                object: scene.object(hit.object).name.clone(),
+                object: scene.hit_name(hit.object, primitive),
                 material: scene.material(hit.material).name.clone(),
                 front_face: hit.front_face,
                 barycentric: hit.barycentric,
@@ -257,7 +267,7 @@ impl Recorder for TreeRecorder<'_> {
                 light: scene.lights[test.light].name.clone(),
                 to_light: test.to_light,
                 distance: test.distance,
-                blocked_by: test.blocked_by.map(|o| scene.object(o).name.clone()),
+                blocked_by: test.blocked_by.map(|o| scene.hit_name(o, test.blocker)),
                 blocked_at: test.blocked_at,
                 facing_away: test.terms.n_dot_l.is_nan() || test.terms.n_dot_l <= 0.0,
                 contributes_nothing: !test.traced
@@ -327,6 +337,7 @@ pub fn pixel_tree(tracer: &Tracer, x: u32, y: u32) -> Option<RayTree> {
     let ray = primary_ray(&frame, x, y, 0);
     let mut rec = TreeRecorder {
         scene,
+        primitive: None,
         stack: Vec::new(),
         skipped: 0,
         nodes: 0,

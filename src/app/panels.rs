@@ -17,7 +17,7 @@ use super::viewport::Tonemap;
 use super::workspace::{self, Prefs, Workspace};
 use super::{Command, tree_view};
 use crate::choice::Choice;
-use crate::scene::{Light, Material, builtin, rules};
+use crate::scene::{Light, Material, builtin, names, rules};
 use crate::trace::Tracer;
 
 // ---- what each setting does, in the lecture's words ---------------------------------------
@@ -567,12 +567,14 @@ pub fn side_panel(
         .default_open(true)
         .show(ui, |ui| {
             ui.small("click an object in the image to select its material");
+            let titles = names::material_titles(edit);
             for (i, m) in edit.materials.iter_mut().enumerate() {
                 let selected = selection.selected_material == Some(i);
+                let named = titles.get(i).cloned().unwrap_or_default();
                 let title = if selected {
-                    RichText::new(format!("> {}", m.name)).strong()
+                    RichText::new(format!("> {}", named.title)).strong()
                 } else {
-                    RichText::new(&m.name)
+                    RichText::new(named.title)
                 };
                 let header = egui::CollapsingHeader::new(title).id_salt(("material", i));
                 let header = if selected {
@@ -580,7 +582,12 @@ pub fn side_panel(
                 } else {
                     header
                 };
-                header.show(ui, |ui| restart |= material_editor(ui, m));
+                header.show(ui, |ui| {
+                    if named.users.len() > names::NAMED_USERS {
+                        ui.small(format!("used by {}", named.users.join(", ")));
+                    }
+                    restart |= material_editor(ui, m)
+                });
             }
         });
     egui::CollapsingHeader::new("Scene")

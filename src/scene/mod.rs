@@ -3,7 +3,8 @@
 //! coordinates, and textures. Nothing here reads a file: scene files are read by [`toml`], OBJ
 //! meshes and their MTL materials by [`obj`], textures decoded by [`texture`], files found by
 //! [`files`] and [`resolve`]; [`builtin`] holds the scenes compiled into the binary and
-//! [`save`] writes a scene back as a file. The file format: docs/design.md, "Scene files".
+//! [`save`] writes a scene back as a file; [`names`] says what the materials panel calls a
+//! material. The file format: docs/design.md, "Scene files".
 
 pub mod budget;
 pub mod builtin;
@@ -11,6 +12,7 @@ pub mod camera;
 pub mod diag;
 pub mod files;
 pub mod first_look;
+pub mod names;
 pub mod obj;
 pub mod procedural;
 pub mod resolve;
@@ -311,6 +313,22 @@ pub enum ObjectSource {
     },
 }
 
+/// A named part of a mesh: the faces after an OBJ `o` or `g` statement (the last one before
+/// them, as tobj names its models) that share a material, a contiguous run of
+/// [`Scene::triangles`]. One name per run, not per triangle, keeps memory small. Faces before
+/// any name, or under the mesh's own name, belong to no part.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshPart {
+    /// Index in [`Scene::triangles`] of the run's first triangle.
+    pub first_triangle: u32,
+    pub triangle_count: u32,
+    /// The mesh the run belongs to.
+    pub object: ObjectId,
+    pub material: MaterialId,
+    /// The `o` or `g` name.
+    pub name: String,
+}
+
 /// A named thing in the scene: one sphere, one triangle or one mesh.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Object {
@@ -335,6 +353,9 @@ pub struct Scene {
     /// Vertex normals and texture coordinates of the meshes that have them, in the order of
     /// their triangles (so a triangle's are found by binary search).
     pub attributes: Vec<Arc<MeshAttributes>>,
+    /// The named parts (`o`, `g`) of the meshes, in the order of their triangles; faces
+    /// before any name belong to none. Shared like the triangles.
+    pub parts: Arc<Vec<MeshPart>>,
     /// The textures materials use, each loaded once.
     pub textures: Vec<Arc<Texture>>,
     /// Non-fatal findings of the loader (dropped degenerate triangles, MTL fallbacks), one
@@ -383,6 +404,30 @@ impl Scene {
         let a = &**self.attributes.get(i.checked_sub(1)?)?;
         let local = index - a.first_triangle as usize;
         (local < a.triangle_count as usize).then_some((a, local))
+    }
+
+    /// The named mesh part triangle `index` (into [`Scene::triangles`]) belongs to, if any.
+    pub fn part_of(&self, index: usize) -> Option<&MeshPart> {
+        let i = self
+            .parts
+            .partition_point(|p| (p.first_triangle as usize) <= index);
+        let p = self.parts.get(i.checked_sub(1)?)?;
+        (index - (p.first_triangle as usize) < p.triangle_count as usize).then_some(p)
+    }
+
+    /// The name the ray tree gives what a ray met: the object's name, and for a face of a
+    /// named mesh part the part's after a colon ("kitchen: Cabinet_3"). `primitive` counts
+    /// the spheres first, then the triangles, as the accelerators do.
+    pub fn hit_name(&self, object: ObjectId, primitive: Option<u32>) -> String {
+        let name = &self.object(object).name;
+        let part = primitive
+            .and_then(|p| (p as usize).checked_sub(self.spheres.len()))
+            .and_then(|t| self.part_of(t))
+            .filter(|p| p.object == object);
+        match part {
+            Some(p) => format!("{name}: {}", p.name),
+            None => name.clone(),
+        }
     }
 
     pub fn texture(&self, id: TextureId) -> Option<&Texture> {

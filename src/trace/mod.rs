@@ -172,6 +172,8 @@ pub struct ShadowTest {
     /// The first object on the segment to the light, if any. `None` also when the light is
     /// behind the surface (`N·L ≤ 0`), where no shadow ray is needed.
     pub blocked_by: Option<ObjectId>,
+    /// The blocker's primitive (spheres first, then triangles), to name its mesh part.
+    pub blocker: Option<u32>,
     /// Distance along the shadow ray (from its offset origin) to the blocker.
     pub blocked_at: Option<f32>,
     /// Whether the shadow ray was cast: not when the light is behind the surface (`N·L ≤ 0`)
@@ -195,6 +197,9 @@ pub trait Recorder {
     fn end(&mut self, _reason: EndReason) {}
     /// The ray ended on visible light `light` at distance `t`.
     fn light(&mut self, _light: usize, _t: f32) {}
+    /// The primitive (spheres first, then triangles) the surface of the next `hit` belongs to,
+    /// for names finer than its object's (an OBJ's `o` and `g`).
+    fn hit_primitive(&mut self, _primitive: u32) {}
     fn hit(&mut self, _hit: &SurfaceHit, _view: Vec3) {}
     fn shadow(&mut self, _test: &ShadowTest) {}
     fn local(&mut self, _ambient: Vec3, _diffuse: Vec3, _specular: Vec3) {}
@@ -517,6 +522,7 @@ impl Tracer {
         };
         let (p, n, ng) = (surface.point, surface.normal, surface.geometric_normal);
         let v = -ray.dir;
+        s.rec.hit_primitive(hit.prim);
         s.rec.hit(surface, v);
         if b.depth == 0 {
             s.info.normal = n;
@@ -551,6 +557,7 @@ impl Tracer {
                 ),
             };
             let mut blocked_by = None;
+            let mut blocker_prim = None;
             let mut blocked_at = None;
             if let Some((shadow_ray, length)) = cast {
                 s.counts.count(RayKind::Shadow);
@@ -560,6 +567,7 @@ impl Tracer {
                         .accel
                         .closest_hit(self.methods(), &shadow_ray, 0.0, length);
                     blocked_by = blocker.map(|b| self.object_of(b.prim));
+                    blocker_prim = blocker.map(|b| b.prim);
                     blocked_at = blocker.map(|b| b.t);
                     blocker.is_some()
                 } else {
@@ -582,6 +590,7 @@ impl Tracer {
                     to_light: l,
                     distance,
                     blocked_by,
+                    blocker: blocker_prim,
                     blocked_at,
                     traced: cast.is_some(),
                     behind_surface,

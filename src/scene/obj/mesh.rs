@@ -16,7 +16,10 @@ use super::mtl::{Libraries, mtl_material, warn_unknown_usemtl};
 use super::parse::Facts;
 use super::read::{ObjProblem, read_models, scan};
 use super::request::MeshRequest;
-use crate::scene::{MaterialId, MeshAttributes, NormalsMode, Scene};
+use crate::scene::{MaterialId, MeshAttributes, MeshPart, NormalsMode, Scene};
+
+/// The name tobj gives the faces before any `o` or `g` (and an `o` or `g` without a name).
+const UNNAMED: &str = "unnamed_object";
 
 /// Adds the OBJ's triangles (placed, degenerate ones dropped) and the MTL materials they use
 /// to `scene`; returns how many triangles were added.
@@ -32,9 +35,39 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
 
     let mut build = MeshBuild::new(scene, req, &models, &face_corners, &mtl_materials, warnings);
     for model in &models {
+        let start = scene.triangles.len();
         build.add_model(scene, &model.mesh, &mtl_texts);
+        add_part(scene, req, &model.name, start);
     }
     Ok(build.finish(scene, &face_corners))
+}
+
+/// Names the triangles a model added from `start` on after its `o` or `g` (tobj's model name):
+/// one [`MeshPart`] per run, the previous one grown when the run continues it (same object,
+/// name and material). A model without a name, named as the mesh, or whose faces were all
+/// dropped, names nothing.
+fn add_part(scene: &mut Scene, req: &MeshRequest, name: &str, start: usize) {
+    let end = scene.triangles.len();
+    // A part named as its mesh ("torus" in torus.obj) would say the name twice.
+    if name == UNNAMED || name == req.object_name || end == start {
+        return;
+    }
+    let material = scene.triangles[start].material;
+    let parts = Arc::make_mut(&mut scene.parts);
+    if let Some(last) = parts.last_mut()
+        && (last.first_triangle + last.triangle_count) as usize == start
+        && (last.object, last.material, last.name.as_str()) == (req.object, material, name)
+    {
+        last.triangle_count += (end - start) as u32;
+        return;
+    }
+    parts.push(MeshPart {
+        first_triangle: start as u32,
+        triangle_count: (end - start) as u32,
+        object: req.object,
+        material,
+        name: name.to_string(),
+    });
 }
 
 /// Which faces give `vn`/`vt` at every corner (tobj fills the others from a neighbour): the
