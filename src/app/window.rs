@@ -90,6 +90,7 @@ impl eframe::App for ViewerApp {
         );
         // Hover is transient: the views set it again while the pointer stays on a node.
         self.selection.tree_state.hovered = None;
+        self.selection.tree_state.drawn = Default::default();
         scene_pane::advance_playback(&mut self.scene_view, &mut self.selection, &ctx);
         self.workspace
             .settle_settings_panel(ctx.content_rect().width(), &mut self.messages);
