@@ -19,9 +19,14 @@ fn follow_pane(h: &mut Window) {
     let deadline = Instant::now() + Duration::from_secs(30);
     loop {
         h.step();
+        let image = h.get_by_label("render viewport").rect();
         let (w, hh) = h.state().render_size();
         let app = h.state();
-        if app.render.pane_seen(&app.workspace.prefs) == Some((w, hh)) {
+        // The pane's pixels are the render's, and the image fills it 1:1.
+        if app.render.pane_seen(&app.workspace.prefs) == Some((w, hh))
+            && (image.width() - w as f32).abs() <= 1.0
+            && (image.height() - hh as f32).abs() <= 1.0
+        {
             return;
         }
         assert!(Instant::now() < deadline, "the render never followed its pane");
@@ -83,4 +88,50 @@ fn the_diagram_and_the_list_are_readable_at_common_sizes() {
             assert!(c.readable(), "{size:?}: a list cell is cut: {c:?}");
         }
     }
+}
+
+fn layout_json(h: &Window) -> String {
+    serde_json::to_string(&h.state().workspace.prefs.layout).expect("the layout serialises")
+}
+
+#[test]
+fn focus_gives_the_tree_most_of_the_window_and_leaving_restores_the_layout() {
+    let mut h = window(small("default"), [1024.0, 640.0]);
+    follow_pane(&mut h);
+    click_glass(&mut h);
+    show_tab(&mut h, "Ray tree diagram");
+    let before = layout_json(&h);
+    let render_before = h.get_by_label("render viewport").rect();
+    // The tree follows the render to its new size: the same point, maybe another pixel.
+    let label = "ray tree diagram of (";
+    let diagram_before = h.get_by_label_contains(label).rect();
+    h.key_press(egui::Key::F);
+    h.run_steps(4);
+    assert!(h.state().workspace.focused(), "F turns focus on");
+    let diagram = h.get_by_label_contains(label).rect();
+    let window_area = h.ctx.content_rect().area();
+    // The diagram and the list (beside it) hold most of the window.
+    assert!(
+        diagram.area() > diagram_before.area() * 1.5,
+        "{diagram_before:?} -> {diagram:?}"
+    );
+    assert!(
+        diagram.area() > 0.3 * window_area,
+        "the diagram has {:.2} of the window",
+        diagram.area() / window_area
+    );
+    let render = h.get_by_label("render viewport").rect();
+    assert!(render.width() < 0.3 * h.ctx.content_rect().width());
+    h.key_press(egui::Key::F);
+    h.run_steps(4);
+    assert!(!h.state().workspace.focused());
+    assert_eq!(layout_json(&h), before, "the layout is given back exactly");
+    // The render follows its pane back to its old size.
+    follow_pane(&mut h);
+    let render_after = h.get_by_label("render viewport").rect();
+    assert_eq!(render_before, render_after, "the render is back in its place");
+    // The button does the same.
+    h.get_by_role_and_label(Role::Button, "Focus").click();
+    h.run_steps(3);
+    assert!(h.state().workspace.focused(), "the Focus button turns focus on");
 }

@@ -327,9 +327,14 @@ fn rect_loop(r: Rect) -> [Pos2; 5] {
 /// drag, or the overview in the corner) instead of shrunk. Fits the pane when a tree arrives
 /// (and on "Fit"); Ctrl+wheel zooms about the pointer; a double-click folds a node's subtree
 /// into "+N". Generations deeper than [`TreeState::reveal`] are hidden. Returns whether
-/// "Export SVG" was clicked.
-pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
-    diagram_with(ui, tree, state, None, "diagram view")
+/// "Export SVG" was clicked. `tools` adds the window's buttons to the toolbar.
+pub fn diagram(
+    ui: &mut Ui,
+    tree: &RayTree,
+    state: &mut TreeState,
+    tools: &mut dyn FnMut(&mut Ui),
+) -> bool {
+    diagram_with(ui, tree, state, None, "diagram view", tools)
 }
 
 /// [`diagram`], the nodes that differ from `other`'s at the same place outlined in the
@@ -340,6 +345,7 @@ pub fn diagram_with(
     state: &mut TreeState,
     other: Option<&RayTree>,
     salt: &str,
+    tools: &mut dyn FnMut(&mut Ui),
 ) -> bool {
     state.folds_for(tree);
     let options = diagram::Options {
@@ -362,6 +368,7 @@ pub fn diagram_with(
     // Wrapped: a toolbar wider than a narrow pane must not widen the pane's space, or the
     // fitted tree would be centred in a part of it that is not shown.
     ui.horizontal_wrapped(|ui| {
+        tools(ui);
         if ui
             .button("Fit")
             .on_hover_text("show as much of the tree as fits with readable labels")
