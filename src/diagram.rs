@@ -506,6 +506,64 @@ pub fn layout_folded(tree: &RayTree, options: &Options, folded: &[NodePath]) -> 
     }
 }
 
+/// One value that differs between two trees, named: "max depth 3 \u{2192} 5", "kr of glass
+/// (0.10, 0.10, 0.10) \u{2192} (0.30, 0.30, 0.30)". The values are those the trees record: their
+/// settings and the weights (kr, kt) each material gave its rays.
+pub fn changes(before: &RayTree, after: &RayTree) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut note = |name: &str, a: String, b: String| {
+        if a != b {
+            out.push(format!("{name} {a} \u{2192} {b}"));
+        }
+    };
+    let (s, t) = (&before.settings, &after.settings);
+    note("pixel", format!("{:?}", before.pixel), format!("{:?}", after.pixel));
+    note("max depth", s.max_depth.to_string(), t.max_depth.to_string());
+    note("shading", s.shading.name().into(), t.shading.name().into());
+    note("cutoff", s.trace.cutoff.to_string(), t.trace.cutoff.to_string());
+    note("accel", s.trace.accel.name().into(), t.trace.accel.name().into());
+    if s.trace.methods != t.trace.methods {
+        out.push("tracing methods changed".into());
+    }
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    weights(&before.root, &mut a);
+    weights(&after.root, &mut b);
+    let mut seen: Vec<(&str, &str)> = Vec::new();
+    for (material, name, wa) in &a {
+        if seen.contains(&(material.as_str(), name)) {
+            continue;
+        }
+        seen.push((material.as_str(), name));
+        let Some((_, _, wb)) = b.iter().find(|(m, n, _)| m == material && n == name) else {
+            continue;
+        };
+        let v = |w: &glam::Vec3| format!("({:.2}, {:.2}, {:.2})", w.x, w.y, w.z);
+        if (*wa - *wb).abs().max_element() > 1e-6 {
+            out.push(format!("{name} of {material} {} \u{2192} {}", v(wa), v(wb)));
+        }
+    }
+    if before.nodes != after.nodes {
+        out.push(format!("nodes {} \u{2192} {}", before.nodes, after.nodes));
+    }
+    out
+}
+
+/// (material, "kr" or "kt", weight) of every node that recorded one.
+fn weights(node: &Node, out: &mut Vec<(String, &'static str, glam::Vec3)>) {
+    // On total internal reflection kr holds kt too: not the material's own value.
+    if let Some(hit) = node.hit.as_ref().filter(|_| !node.total_internal_reflection) {
+        if let Some(kr) = node.kr {
+            out.push((hit.material.clone(), "kr", kr));
+        }
+        if let Some(kt) = node.kt {
+            out.push((hit.material.clone(), "kt", kt));
+        }
+    }
+    for child in &node.children {
+        weights(child, out);
+    }
+}
+
 // ---- SVG ------------------------------------------------------------------------------------
 
 /// `text` with XML's special characters escaped, for element text and attribute values.
@@ -873,6 +931,53 @@ mod tests {
         };
         assert!(text(Glyph::NoContribution).contains("contributes nothing"));
         assert!(!text(Glyph::FacingAway).contains("contributes nothing"));
+    }
+
+    /// The glass sphere's tree in the 160×120 default scene.
+    fn glass_tree() -> RayTree {
+        let mut scene = crate::scene::builtin::load_builtin("default").expect("built in");
+        (scene.render.width, scene.render.height) = (160, 120);
+        let tracer = crate::trace::Tracer::new(
+            std::sync::Arc::new(scene),
+            crate::trace::TraceSettings::default(),
+        );
+        crate::ray_tree::pixel_tree(&tracer, 60, 69).expect("inside the image")
+    }
+
+    #[test]
+    fn changes_name_the_settings_and_weights_that_differ() {
+        let before = glass_tree();
+        assert!(changes(&before, &before).is_empty());
+        let mut after = before.clone();
+        after.settings.max_depth = before.settings.max_depth + 2;
+        fn bump(node: &mut Node, first: &mut Option<String>) {
+            // Every node of one material, as an edit of that material would.
+            if let (Some(hit), Some(kr)) = (&node.hit, node.kr.as_mut())
+                && !node.total_internal_reflection
+                && first.get_or_insert(hit.material.clone()) == &hit.material
+            {
+                *kr += glam::Vec3::splat(0.25);
+            }
+            for child in &mut node.children {
+                bump(child, first);
+            }
+        }
+        let mut first = None;
+        bump(&mut after.root, &mut first);
+        let material = first.expect("a node with kr");
+        let found = changes(&before, &after);
+        let depth = format!(
+            "max depth {} \u{2192} {}",
+            before.settings.max_depth, after.settings.max_depth
+        );
+        assert!(found.contains(&depth), "{found:?}");
+        assert!(
+            found
+                .iter()
+                .any(|c| c.starts_with(&format!("kr of {material} ("))),
+            "{found:?}"
+        );
+        assert_eq!(found.len(), 2, "{found:?}");
     }
 
     #[test]

@@ -347,7 +347,10 @@ pub fn diagram_with(
     salt: &str,
     tools: &mut dyn FnMut(&mut Ui),
 ) -> bool {
-    state.folds_for(tree);
+    // Two trees compared share the folds of the current one.
+    if other.is_none() {
+        state.folds_for(tree);
+    }
     let options = diagram::Options {
         max_generation: state.reveal.unwrap_or(u32::MAX),
     };
@@ -659,6 +662,53 @@ pub fn diagram_with(
         overview(ui, &painter, &lay, area, rect.min, &mut view, id);
     }
     ui.data_mut(|d| d.insert_temp(id, view));
+    export
+}
+
+/// The pinned tree and the current one side by side, the nodes that differ outlined, above
+/// them what changed between the two ([`diagram::changes`]). Returns whether "Export SVG"
+/// was clicked (it exports the current tree).
+pub fn compare(
+    ui: &mut Ui,
+    tree: &RayTree,
+    pinned: &RayTree,
+    state: &mut TreeState,
+    tools: &mut dyn FnMut(&mut Ui),
+) -> bool {
+    let changes = diagram::changes(pinned, tree);
+    let mut export = false;
+    ui.horizontal_wrapped(|ui| {
+        tools(ui);
+        if ui
+            .button("Unpin")
+            .on_hover_text("stop comparing: the current tree alone")
+            .clicked()
+        {
+            state.pinned = None;
+        }
+        if ui.button("Export SVG...").clicked() {
+            export = true;
+        }
+    });
+    let text = if changes.is_empty() {
+        "no change between the pinned tree and the current one".to_string()
+    } else {
+        format!("changed: {}", changes.join("; "))
+    };
+    ui.add(egui::Label::new(egui::RichText::new(text).color(CHANGED)).wrap());
+    let mut none = |_: &mut Ui| {};
+    ui.columns(2, |cols| {
+        cols[0].label(format!(
+            "pinned: ({}, {}) · {} nodes",
+            pinned.pixel[0], pinned.pixel[1], pinned.nodes
+        ));
+        diagram_with(&mut cols[0], pinned, state, Some(tree), "pinned diagram", &mut none);
+        cols[1].label(format!(
+            "current: ({}, {}) · {} nodes",
+            tree.pixel[0], tree.pixel[1], tree.nodes
+        ));
+        diagram_with(&mut cols[1], tree, state, Some(pinned), "current diagram", &mut none);
+    });
     export
 }
 

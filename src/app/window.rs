@@ -297,7 +297,12 @@ fn pane_ui(app: &mut ViewerApp, ui: &mut egui::Ui, pane: workspace::Pane) {
                 let (mut focus, mut pop) = (false, false);
                 let focused = app.workspace.focused();
                 let mut tools = |ui: &mut egui::Ui| tree_tools(ui, focused, &mut focus, &mut pop);
-                if tree_view::diagram(ui, &tree, &mut app.selection.tree_state, &mut tools) {
+                let state = &mut app.selection.tree_state;
+                let export = match state.pinned.clone() {
+                    Some(pinned) => tree_view::compare(ui, &tree, &pinned, state, &mut tools),
+                    None => tree_view::diagram(ui, &tree, state, &mut tools),
+                };
+                if export {
                     let name = format!("tree-{}-{}.svg", tree.pixel[0], tree.pixel[1]);
                     app.workspace.browse(BrowseFor::ExportDiagram, &name);
                 }
