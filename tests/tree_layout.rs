@@ -122,6 +122,10 @@ fn focus_gives_the_tree_most_of_the_window_and_leaving_restores_the_layout() {
     );
     let render = h.get_by_label("render viewport").rect();
     assert!(render.width() < 0.3 * h.ctx.content_rect().width());
+    if let Ok(path) = std::env::var("RAYTREE_FOCUS_PNG") {
+        h.run_steps(20);
+        h.render().expect("render").save(path).expect("saved");
+    }
     h.key_press(egui::Key::F);
     h.run_steps(4);
     assert!(!h.state().workspace.focused());
