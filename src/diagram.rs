@@ -517,11 +517,27 @@ pub fn changes(before: &RayTree, after: &RayTree) -> Vec<String> {
         }
     };
     let (s, t) = (&before.settings, &after.settings);
-    note("pixel", format!("{:?}", before.pixel), format!("{:?}", after.pixel));
-    note("max depth", s.max_depth.to_string(), t.max_depth.to_string());
+    note(
+        "pixel",
+        format!("{:?}", before.pixel),
+        format!("{:?}", after.pixel),
+    );
+    note(
+        "max depth",
+        s.max_depth.to_string(),
+        t.max_depth.to_string(),
+    );
     note("shading", s.shading.name().into(), t.shading.name().into());
-    note("cutoff", s.trace.cutoff.to_string(), t.trace.cutoff.to_string());
-    note("accel", s.trace.accel.name().into(), t.trace.accel.name().into());
+    note(
+        "cutoff",
+        s.trace.cutoff.to_string(),
+        t.trace.cutoff.to_string(),
+    );
+    note(
+        "accel",
+        s.trace.accel.name().into(),
+        t.trace.accel.name().into(),
+    );
     if s.trace.methods != t.trace.methods {
         out.push("tracing methods changed".into());
     }
@@ -551,7 +567,11 @@ pub fn changes(before: &RayTree, after: &RayTree) -> Vec<String> {
 /// (material, "kr" or "kt", weight) of every node that recorded one.
 fn weights(node: &Node, out: &mut Vec<(String, &'static str, glam::Vec3)>) {
     // On total internal reflection kr holds kt too: not the material's own value.
-    if let Some(hit) = node.hit.as_ref().filter(|_| !node.total_internal_reflection) {
+    if let Some(hit) = node
+        .hit
+        .as_ref()
+        .filter(|_| !node.total_internal_reflection)
+    {
         if let Some(kr) = node.kr {
             out.push((hit.material.clone(), "kr", kr));
         }

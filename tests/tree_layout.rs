@@ -29,7 +29,10 @@ fn follow_pane(h: &mut Window) {
         {
             return;
         }
-        assert!(Instant::now() < deadline, "the render never followed its pane");
+        assert!(
+            Instant::now() < deadline,
+            "the render never followed its pane"
+        );
         std::thread::sleep(Duration::from_millis(50));
     }
 }
@@ -83,7 +86,11 @@ fn the_diagram_and_the_list_are_readable_at_common_sizes() {
 
         show_tab(&mut h, "Ray tree");
         let cells = h.state().selection.tree_state.drawn.cells.clone();
-        assert!(cells.len() >= 3, "{size:?}: {} list cells drawn", cells.len());
+        assert!(
+            cells.len() >= 3,
+            "{size:?}: {} list cells drawn",
+            cells.len()
+        );
         for c in &cells {
             assert!(c.readable(), "{size:?}: a list cell is cut: {c:?}");
         }
@@ -133,9 +140,15 @@ fn focus_gives_the_tree_most_of_the_window_and_leaving_restores_the_layout() {
     // The render follows its pane back to its old size.
     follow_pane(&mut h);
     let render_after = h.get_by_label("render viewport").rect();
-    assert_eq!(render_before, render_after, "the render is back in its place");
+    assert_eq!(
+        render_before, render_after,
+        "the render is back in its place"
+    );
     // The button does the same.
     h.get_by_role_and_label(Role::Button, "Focus").click();
     h.run_steps(3);
-    assert!(h.state().workspace.focused(), "the Focus button turns focus on");
+    assert!(
+        h.state().workspace.focused(),
+        "the Focus button turns focus on"
+    );
 }

@@ -27,7 +27,6 @@ pub mod scene_files;
 pub mod scene_pane;
 pub mod selection;
 pub mod sweep;
-mod tree_table;
 pub mod tree_view;
 pub mod undo;
 pub mod viewport;

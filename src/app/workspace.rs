@@ -412,7 +412,10 @@ pub fn pane_toggles(ws: &mut Workspace, messages: &mut Messages, ui: &mut Ui) {
         ws.toggle_settings_panel(messages);
     }
     let mut focus = ws.focused();
-    if ui.checkbox(&mut focus, "Focus on the ray tree (F)").changed() {
+    if ui
+        .checkbox(&mut focus, "Focus on the ray tree (F)")
+        .changed()
+    {
         ws.toggle_focus();
     }
     if ui.button("Reset layout").clicked() {
@@ -490,13 +493,19 @@ mod tests {
         assert!(saved.settings_panel);
         ws.toggle_focus();
         assert!(!ws.focused());
-        assert_eq!(serde_json::to_string(&ws.prefs.layout).expect("json"), before);
+        assert_eq!(
+            serde_json::to_string(&ws.prefs.layout).expect("json"),
+            before
+        );
         assert!(ws.prefs.settings_panel);
         // Popping the panes out ends focus.
         ws.toggle_focus();
         ws.set_popped_out(true);
         assert!(!ws.focused() && ws.popped_out);
-        assert_eq!(serde_json::to_string(&ws.prefs.layout).expect("json"), before);
+        assert_eq!(
+            serde_json::to_string(&ws.prefs.layout).expect("json"),
+            before
+        );
     }
 
     #[test]
