@@ -22,6 +22,11 @@ pub const GAP: f32 = 14.0;
 /// it, so that a label fits its box in any sans-serif font.
 pub const FONT: f32 = 12.0;
 pub const CHAR_W: f32 = 7.0;
+/// The smallest text (points) the viewer's diagram draws: it never zooms out further than
+/// [`FONT`] at this size, and a tree larger than its pane is scrolled instead.
+pub const MIN_LABEL_PX: f32 = 11.0;
+/// The least zoom of the viewer's diagram: the one at which node labels are [`MIN_LABEL_PX`].
+pub const MIN_ZOOM: f32 = MIN_LABEL_PX / FONT;
 /// Side of the colour swatch in a node box, and the padding around the box's content.
 pub const SWATCH: f32 = 12.0;
 pub const PAD: f32 = 6.0;
@@ -30,6 +35,9 @@ pub const GLYPH_PITCH: f32 = 12.0;
 /// Grey of a light behind the surface (`N·L ≤ 0`): no shadow ray is traced, so the 3D views
 /// draw nothing for it and the palette has no style for it.
 pub const FACING_AWAY_RGB: [u8; 3] = [140, 140, 140];
+/// Ring of a light that was not traced because it contributes nothing (its `kd` and `ks` give
+/// zero): hollow, so it never reads as the filled grey dot of a light behind the surface.
+pub const NOT_TRACED_RGB: [u8; 3] = [170, 170, 200];
 /// The dark ground the palette is made for (the viewer's), also the SVG's background.
 pub const BACKGROUND_RGB: [u8; 3] = [27, 27, 27];
 /// Text on [`BACKGROUND_RGB`].
@@ -61,14 +69,24 @@ pub enum Glyph {
     FacingAway,
     /// An object is in the way: a red cross.
     Blocked,
+    /// The light would add nothing here (zero `kd` and `ks`), so its shadow ray was not
+    /// traced: a hollow ring.
+    NoContribution,
 }
 
 impl Glyph {
-    pub const ALL: [Glyph; 3] = [Glyph::Lit, Glyph::FacingAway, Glyph::Blocked];
+    pub const ALL: [Glyph; 4] = [
+        Glyph::Lit,
+        Glyph::FacingAway,
+        Glyph::Blocked,
+        Glyph::NoContribution,
+    ];
 
     pub fn of(s: &ShadowRecord) -> Glyph {
-        if s.facing_away || s.contributes_nothing {
+        if s.facing_away {
             Glyph::FacingAway
+        } else if s.contributes_nothing {
+            Glyph::NoContribution
         } else if s.blocked_by.is_some() {
             Glyph::Blocked
         } else {
@@ -84,6 +102,10 @@ impl Glyph {
                 [r, g, b, 255]
             }
             Glyph::Blocked => style_rgba(Style::ShadowBlocked),
+            Glyph::NoContribution => {
+                let [r, g, b] = NOT_TRACED_RGB;
+                [r, g, b, 255]
+            }
         }
     }
 }
@@ -115,7 +137,8 @@ pub struct LaidNode {
     pub not_traced: bool,
     pub total_internal_reflection: bool,
     pub glyphs: Vec<ShadowGlyph>,
-    /// Children left out by [`Options::max_generation`].
+    /// Nodes below this one left out: by [`Options::max_generation`] or because the subtree
+    /// is folded (drawn as "+N").
     pub hidden_children: usize,
 }
 
@@ -213,6 +236,11 @@ pub fn legend() -> Vec<LegendEntry> {
             mark: Mark::Glyph(Glyph::FacingAway),
             rgba: Glyph::FacingAway.rgba(),
             text: "light behind the surface (N\u{b7}L \u{2264} 0): no shadow ray",
+        },
+        LegendEntry {
+            mark: Mark::Glyph(Glyph::NoContribution),
+            rgba: Glyph::NoContribution.rgba(),
+            text: "not traced: the light contributes nothing (kd, ks zero)",
         },
         LegendEntry {
             mark: Mark::Swatch,
@@ -318,7 +346,7 @@ fn place<'a>(
     node: &'a Node,
     path: &mut NodePath,
     parent: Option<usize>,
-    options: &Options,
+    shown: &dyn Fn(&Node, &NodePath) -> bool,
     out: &mut Vec<Placed<'a>>,
 ) -> Contour {
     let me = out.len();
@@ -332,11 +360,11 @@ fn place<'a>(
     });
     let mut children: Vec<(usize, f32)> = Vec::new();
     let mut merged: Contour = Vec::new();
-    if node.depth < options.max_generation {
+    if shown(node, path) {
         for (i, child) in node.children.iter().enumerate() {
             path.push(i);
             let index = out.len();
-            let contour = place(child, path, Some(me), options, out);
+            let contour = place(child, path, Some(me), shown, out);
             path.pop();
             // How far right this subtree must go to clear everything left of it.
             let shift = if children.is_empty() {
@@ -374,10 +402,24 @@ fn count(node: &Node) -> usize {
     1 + node.children.iter().map(count).sum::<usize>()
 }
 
+/// How many nodes lie below `node` (what a folded node's "+N" says).
+pub fn descendants(node: &Node) -> usize {
+    count(node) - 1
+}
+
 /// Lays out `tree` for drawing: see [`Layout`].
 pub fn layout(tree: &RayTree, options: &Options) -> Layout {
+    layout_folded(tree, options, &[])
+}
+
+/// [`layout`] with the subtrees below the nodes at `folded` left out, each counted in its
+/// node's [`LaidNode::hidden_children`].
+pub fn layout_folded(tree: &RayTree, options: &Options, folded: &[NodePath]) -> Layout {
+    let shown = |node: &Node, path: &NodePath| {
+        node.depth < options.max_generation && !folded.contains(path)
+    };
     let mut placed = Vec::new();
-    place(&tree.root, &mut Vec::new(), None, options, &mut placed);
+    place(&tree.root, &mut Vec::new(), None, &shown, &mut placed);
     // Absolute x: parents come before their children.
     let mut xs = vec![0.0_f32; placed.len()];
     for i in 0..placed.len() {
@@ -396,10 +438,10 @@ pub fn layout(tree: &RayTree, options: &Options) -> Layout {
             x - left,
             node.depth as f32 * ROW + NODE_H / 2.0 - tree.root.depth as f32 * ROW,
         ];
-        let hidden_children = if node.depth < options.max_generation {
+        let hidden_children = if shown(node, &p.path) {
             0
         } else {
-            node.children.iter().map(count).sum()
+            descendants(node)
         };
         hidden += hidden_children;
         let glyph_y = center[1] + NODE_H / 4.0;
@@ -412,9 +454,7 @@ pub fn layout(tree: &RayTree, options: &Options) -> Layout {
                 let glyph = Glyph::of(s);
                 let verdict = match (glyph, &s.blocked_by) {
                     (Glyph::Blocked, Some(b)) => format!("blocked by {b}"),
-                    (Glyph::FacingAway, _) if s.contributes_nothing => {
-                        "not traced: contributes nothing".to_string()
-                    }
+                    (Glyph::NoContribution, _) => "not traced: contributes nothing".to_string(),
                     (Glyph::FacingAway, _) => "facing away".to_string(),
                     _ => "lit".to_string(),
                 };
@@ -463,6 +503,84 @@ pub fn layout(tree: &RayTree, options: &Options) -> Layout {
         edges,
         size: [width, height],
         hidden,
+    }
+}
+
+/// One value that differs between two trees, named: "max depth 3 \u{2192} 5", "kr of glass
+/// (0.10, 0.10, 0.10) \u{2192} (0.30, 0.30, 0.30)". The values are those the trees record: their
+/// settings and the weights (kr, kt) each material gave its rays.
+pub fn changes(before: &RayTree, after: &RayTree) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut note = |name: &str, a: String, b: String| {
+        if a != b {
+            out.push(format!("{name} {a} \u{2192} {b}"));
+        }
+    };
+    let (s, t) = (&before.settings, &after.settings);
+    note(
+        "pixel",
+        format!("{:?}", before.pixel),
+        format!("{:?}", after.pixel),
+    );
+    note(
+        "max depth",
+        s.max_depth.to_string(),
+        t.max_depth.to_string(),
+    );
+    note("shading", s.shading.name().into(), t.shading.name().into());
+    note(
+        "cutoff",
+        s.trace.cutoff.to_string(),
+        t.trace.cutoff.to_string(),
+    );
+    note(
+        "accel",
+        s.trace.accel.name().into(),
+        t.trace.accel.name().into(),
+    );
+    if s.trace.methods != t.trace.methods {
+        out.push("tracing methods changed".into());
+    }
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    weights(&before.root, &mut a);
+    weights(&after.root, &mut b);
+    let mut seen: Vec<(&str, &str)> = Vec::new();
+    for (material, name, wa) in &a {
+        if seen.contains(&(material.as_str(), name)) {
+            continue;
+        }
+        seen.push((material.as_str(), name));
+        let Some((_, _, wb)) = b.iter().find(|(m, n, _)| m == material && n == name) else {
+            continue;
+        };
+        let v = |w: &glam::Vec3| format!("({:.2}, {:.2}, {:.2})", w.x, w.y, w.z);
+        if (*wa - *wb).abs().max_element() > 1e-6 {
+            out.push(format!("{name} of {material} {} \u{2192} {}", v(wa), v(wb)));
+        }
+    }
+    if before.nodes != after.nodes {
+        out.push(format!("nodes {} \u{2192} {}", before.nodes, after.nodes));
+    }
+    out
+}
+
+/// (material, "kr" or "kt", weight) of every node that recorded one.
+fn weights(node: &Node, out: &mut Vec<(String, &'static str, glam::Vec3)>) {
+    // On total internal reflection kr holds kt too: not the material's own value.
+    if let Some(hit) = node
+        .hit
+        .as_ref()
+        .filter(|_| !node.total_internal_reflection)
+    {
+        if let Some(kr) = node.kr {
+            out.push((hit.material.clone(), "kr", kr));
+        }
+        if let Some(kt) = node.kt {
+            out.push((hit.material.clone(), "kt", kt));
+        }
+    }
+    for child in &node.children {
+        weights(child, out);
     }
 }
 
@@ -531,6 +649,13 @@ fn svg_glyph(out: &mut String, glyph: Glyph, [x, y]: [f32; 2], note: &str) {
                 out,
                 "<circle cx=\"{x:.1}\" cy=\"{y:.1}\" r=\"4\" {}/>",
                 paint("fill", c)
+            );
+        }
+        Glyph::NoContribution => {
+            let _ = write!(
+                out,
+                "<circle cx=\"{x:.1}\" cy=\"{y:.1}\" r=\"3.5\" fill=\"none\" stroke-width=\"1.5\" {}/>",
+                paint("stroke", c)
             );
         }
         Glyph::Blocked => {
@@ -698,7 +823,7 @@ pub fn svg(tree: &RayTree, options: &Options) -> String {
         if n.hidden_children > 0 {
             let _ = write!(
                 out,
-                "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"10\" text-anchor=\"middle\" fill=\"{}\">+{} deeper</text>",
+                "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"10\" text-anchor=\"middle\" fill=\"{}\">+{} below</text>",
                 n.center[0],
                 y0 + NODE_H + 14.0,
                 hex(TEXT_RGB),
@@ -784,6 +909,95 @@ mod tests {
             escape("a<b>&\"c'\u{1}"),
             "a&lt;b&gt;&amp;&quot;c&apos;\u{fffd}"
         );
+    }
+
+    fn shadow(facing_away: bool, contributes_nothing: bool, blocked: bool) -> ShadowRecord {
+        use glam::Vec3;
+        ShadowRecord {
+            light: "key".into(),
+            to_light: Vec3::Y,
+            distance: 1.0,
+            blocked_by: blocked.then(|| "floor".to_string()),
+            blocked_at: None,
+            facing_away,
+            contributes_nothing,
+            behind_surface: false,
+            n_dot_l: 0.5,
+            n_dot_h: 0.5,
+            r_dot_v: 0.5,
+            halfway: Vec3::Y,
+            mirror: Vec3::Y,
+            diffuse: Vec3::ZERO,
+            specular: Vec3::ZERO,
+        }
+    }
+
+    #[test]
+    fn a_light_that_contributes_nothing_has_its_own_glyph_and_legend_entry() {
+        let nothing = Glyph::of(&shadow(false, true, false));
+        let behind = Glyph::of(&shadow(true, false, false));
+        assert_eq!(nothing, Glyph::NoContribution);
+        assert_eq!(behind, Glyph::FacingAway);
+        assert_ne!(nothing.rgba(), behind.rgba());
+        assert_eq!(Glyph::of(&shadow(false, false, true)), Glyph::Blocked);
+        assert_eq!(Glyph::of(&shadow(false, false, false)), Glyph::Lit);
+        let entries = legend();
+        let text = |g| {
+            entries
+                .iter()
+                .find(|e| e.mark == Mark::Glyph(g))
+                .map(|e| e.text)
+                .expect("an entry")
+        };
+        assert!(text(Glyph::NoContribution).contains("contributes nothing"));
+        assert!(!text(Glyph::FacingAway).contains("contributes nothing"));
+    }
+
+    /// The glass sphere's tree in the 160×120 default scene.
+    fn glass_tree() -> RayTree {
+        let mut scene = crate::scene::builtin::load_builtin("default").expect("built in");
+        (scene.render.width, scene.render.height) = (160, 120);
+        let tracer = crate::trace::Tracer::new(
+            std::sync::Arc::new(scene),
+            crate::trace::TraceSettings::default(),
+        );
+        crate::ray_tree::pixel_tree(&tracer, 60, 69).expect("inside the image")
+    }
+
+    #[test]
+    fn changes_name_the_settings_and_weights_that_differ() {
+        let before = glass_tree();
+        assert!(changes(&before, &before).is_empty());
+        let mut after = before.clone();
+        after.settings.max_depth = before.settings.max_depth + 2;
+        fn bump(node: &mut Node, first: &mut Option<String>) {
+            // Every node of one material, as an edit of that material would.
+            if let (Some(hit), Some(kr)) = (&node.hit, node.kr.as_mut())
+                && !node.total_internal_reflection
+                && first.get_or_insert(hit.material.clone()) == &hit.material
+            {
+                *kr += glam::Vec3::splat(0.25);
+            }
+            for child in &mut node.children {
+                bump(child, first);
+            }
+        }
+        let mut first = None;
+        bump(&mut after.root, &mut first);
+        let material = first.expect("a node with kr");
+        let found = changes(&before, &after);
+        let depth = format!(
+            "max depth {} \u{2192} {}",
+            before.settings.max_depth, after.settings.max_depth
+        );
+        assert!(found.contains(&depth), "{found:?}");
+        assert!(
+            found
+                .iter()
+                .any(|c| c.starts_with(&format!("kr of {material} ("))),
+            "{found:?}"
+        );
+        assert_eq!(found.len(), 2, "{found:?}");
     }
 
     #[test]

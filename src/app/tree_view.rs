@@ -2,12 +2,16 @@
 //! lecture's "Ray Tracing Tree" figure, and ray segments over the image (see `viewport.rs`) —
 //! plus a detail pane with every number behind the selected node's colour, and a pinned tree
 //! to compare against. Hovering or selecting a node in one view highlights it in the others.
+//! The list and the detail are tables (egui_extras) with resizable columns whose text is
+//! elided with the full value on hover, never silently cut; the diagram's labels never go
+//! below a readable size, a large tree scrolls instead.
 
-use eframe::egui::{self, Color32, Pos2, Rect, RichText, Sense, Stroke, Ui, Vec2};
+use eframe::egui::{self, Color32, Pos2, Rect, Response, RichText, Sense, Stroke, Ui, Vec2};
+use egui_extras::{Column, TableBuilder};
 use glam::Vec3;
 
 pub use crate::diagram::end_text as end_label;
-use crate::diagram::{self, Glyph, Mark};
+use crate::diagram::{self, Glyph, Mark, descendants, end_text};
 use crate::ray_tree::{Node, RayTree};
 use crate::scene::Shading;
 use crate::scene_view::{NodePath, Style, kind_rgb, node_at, style_rgba};
@@ -21,12 +25,62 @@ pub struct TreeState {
     pub pinned: Option<RayTree>,
     /// The step-through: show generations `0..=n` only (`None`: all).
     pub reveal: Option<u32>,
+    /// Nodes whose subtrees are folded in the list and the diagram (each shows "+N").
+    pub folded: Vec<NodePath>,
+    /// The tree `folded` belongs to (pixel, nodes): another tree starts unfolded.
+    folded_for: Option<([u32; 2], usize)>,
+    /// What the views drew last frame, for the layout tests.
+    pub drawn: Drawn,
 }
 
-/// The sRGB colour of `style`, without its opacity.
-fn rgb(style: Style) -> [u8; 3] {
-    let [r, g, b, _] = style_rgba(style);
-    [r, g, b]
+/// Sizes the tree's views drew in the last frame: the least text size of the diagram's labels
+/// and each list or detail cell's text against its column.
+#[derive(Clone, Debug, Default)]
+pub struct Drawn {
+    /// Points of the diagram's node labels (`None`: no diagram drawn).
+    pub diagram_label: Option<f32>,
+    /// Every table cell drawn: text width unelided, width shown, the column's width, whether
+    /// it was elided (the full text then shows on hover).
+    pub cells: Vec<Cell>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cell {
+    pub full: f32,
+    pub shown: f32,
+    pub column: f32,
+    pub elided: bool,
+}
+
+impl Cell {
+    /// The text fits its column, or is elided with its full value on hover: never cut.
+    pub fn readable(&self) -> bool {
+        self.shown <= self.column + 1.0 && (self.full <= self.column + 1.0 || self.elided)
+    }
+}
+
+impl TreeState {
+    /// Forgets the folds of another tree.
+    pub fn folds_for(&mut self, tree: &RayTree) {
+        let key = Some((tree.pixel, tree.nodes));
+        if self.folded_for != key {
+            self.folded_for = key;
+            self.folded.clear();
+        }
+    }
+
+    pub fn is_folded(&self, path: &[usize]) -> bool {
+        self.folded.iter().any(|p| p.as_slice() == path)
+    }
+
+    /// Folds the subtree at `path`, or unfolds it.
+    pub fn toggle_fold(&mut self, path: &[usize]) {
+        if self.is_folded(path) {
+            self.folded.retain(|p| p.as_slice() != path);
+        } else {
+            self.folded.push(path.to_vec());
+        }
+    }
 }
 
 fn color(rgb: [u8; 3]) -> Color32 {
@@ -78,88 +132,6 @@ pub fn node_differs(a: &Node, b: &Node) -> bool {
             .iter()
             .map(|s| s.blocked_by.as_deref())
             .ne(b.shadow_rays.iter().map(|s| s.blocked_by.as_deref()))
-}
-
-// ---- the list -----------------------------------------------------------------------------
-
-/// The tree as collapsible rows; `other` marks the rows that differ from another tree.
-pub fn tree_list(
-    ui: &mut Ui,
-    tree: &RayTree,
-    state: &mut TreeState,
-    other: Option<&RayTree>,
-    salt: &str,
-) {
-    let mut path = Vec::new();
-    let compare = other.is_some();
-    list_node(
-        ui,
-        &tree.root,
-        other.map(|o| &o.root),
-        compare,
-        &mut path,
-        state,
-        salt,
-    );
-}
-
-fn list_node(
-    ui: &mut Ui,
-    node: &Node,
-    other: Option<&Node>,
-    compare: bool,
-    path: &mut NodePath,
-    state: &mut TreeState,
-    salt: &str,
-) {
-    let differs = match other {
-        Some(o) => node_differs(node, o),
-        // A node the other tree does not have at all.
-        None => compare,
-    };
-    let selected = state.selected.as_deref() == Some(path.as_slice());
-    let hovered = state.hovered.as_deref() == Some(path.as_slice());
-    let mut text = RichText::new(format!(
-        "{}{}",
-        if differs { "* " } else { "" },
-        node_summary(node)
-    ))
-    .color(if differs {
-        Color32::from_rgb(255, 150, 50)
-    } else {
-        kind_color(node.kind)
-    });
-    if selected || hovered {
-        text = text.strong().background_color(Color32::from_gray(60));
-    }
-    let id = ui.make_persistent_id((salt, path.clone()));
-    let header = egui::collapsing_header::CollapsingState::load_with_default_open(
-        ui.ctx(),
-        id,
-        node.depth < 3,
-    );
-    let (_, header_response, _) = header
-        .show_header(ui, |ui| {
-            let label = egui::Label::new(text).sense(Sense::click());
-            // Side by side, rows are cut to their column rather than overlapping.
-            let label = if compare { label.truncate() } else { label };
-            let r = ui.add(label).on_hover_text(node_summary(node));
-            if r.hovered() {
-                state.hovered = Some(path.clone());
-            }
-            if r.clicked() {
-                state.selected = Some(path.clone());
-            }
-        })
-        .body(|ui| {
-            for (i, child) in node.children.iter().enumerate() {
-                path.push(i);
-                let other_child = other.and_then(|o| o.children.get(i));
-                list_node(ui, child, other_child, compare, path, state, salt);
-                path.pop();
-            }
-        });
-    let _ = header_response;
 }
 
 // ---- the diagram --------------------------------------------------------------------------
@@ -230,6 +202,9 @@ fn paint_glyph(painter: &egui::Painter, glyph: Glyph, at: Pos2, s: f32) {
     match glyph {
         Glyph::Lit | Glyph::FacingAway => {
             painter.circle_filled(at, s * 0.5, c);
+        }
+        Glyph::NoContribution => {
+            painter.circle_stroke(at, s * 0.4, Stroke::new((s * 0.2).max(1.0), c));
         }
         Glyph::Blocked => {
             let d = s * 0.5;
@@ -348,17 +323,42 @@ fn rect_loop(r: Rect) -> [Pos2; 5] {
     ]
 }
 
-/// The lecture's "Ray Tracing Tree" drawn from the core's layout ([`diagram::layout`]): boxes
-/// with the node's colour and what its ray met, R and T edges, shadow glyphs per light, the
-/// rays not traced dashed, and a collapsible legend. Fits the pane when a tree arrives (and on
-/// "Fit"); Ctrl+wheel zooms about the pointer, wheel and drag pan. Generations deeper than
-/// [`TreeState::reveal`] are hidden. Returns whether "Export SVG" was clicked.
-pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
+/// The lecture's "Ray Tracing Tree" drawn from the core's layout ([`diagram::layout_folded`]):
+/// boxes with the node's colour and what its ray met, R and T edges, shadow glyphs per light,
+/// the rays not traced dashed, and a collapsible legend. Labels are never smaller than
+/// [`diagram::MIN_LABEL_PX`]: a tree larger than the pane at that size is scrolled (wheel,
+/// drag, or the overview in the corner) instead of shrunk. Fits the pane when a tree arrives
+/// (and on "Fit"); Ctrl+wheel zooms about the pointer; a double-click folds a node's subtree
+/// into "+N". Generations deeper than [`TreeState::reveal`] are hidden. Returns whether
+/// "Export SVG" was clicked. `tools` adds the window's buttons to the toolbar.
+pub fn diagram(
+    ui: &mut Ui,
+    tree: &RayTree,
+    state: &mut TreeState,
+    tools: &mut dyn FnMut(&mut Ui),
+) -> bool {
+    diagram_with(ui, tree, state, None, "diagram view", tools)
+}
+
+/// [`diagram`], the nodes that differ from `other`'s at the same place outlined in the
+/// compare colour; `salt` keeps two diagrams' views apart.
+pub fn diagram_with(
+    ui: &mut Ui,
+    tree: &RayTree,
+    state: &mut TreeState,
+    other: Option<&RayTree>,
+    salt: &str,
+    tools: &mut dyn FnMut(&mut Ui),
+) -> bool {
+    // Two trees compared share the folds of the current one.
+    if other.is_none() {
+        state.folds_for(tree);
+    }
     let options = diagram::Options {
         max_generation: state.reveal.unwrap_or(u32::MAX),
     };
-    let lay = diagram::layout(tree, &options);
-    let id = ui.make_persistent_id("diagram view");
+    let lay = diagram::layout_folded(tree, &options, &state.folded);
+    let id = ui.make_persistent_id(salt);
     let mut view: DiagramView = ui.data(|d| d.get_temp(id)).unwrap_or_default();
     let key = (
         tree.pixel,
@@ -374,9 +374,10 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
     // Wrapped: a toolbar wider than a narrow pane must not widen the pane's space, or the
     // fitted tree would be centred in a part of it that is not shown.
     ui.horizontal_wrapped(|ui| {
+        tools(ui);
         if ui
             .button("Fit")
-            .on_hover_text("show the whole tree in the pane")
+            .on_hover_text("show as much of the tree as fits with readable labels")
             .clicked()
         {
             view.fit = true;
@@ -389,18 +390,19 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
                 Legend::Hidden
             };
         }
-        if ui
-            .button("Export SVG...")
-            .on_hover_text("the figure for slides, with its legend")
-            .clicked()
+        if other.is_none()
+            && ui
+                .button("Export SVG...")
+                .on_hover_text("the figure for slides, with its legend")
+                .clicked()
         {
             export = true;
         }
         ui.label(format!("{:.0}%", view.zoom * 100.0));
         if lay.hidden > 0 {
-            ui.label(format!("{} deeper nodes hidden", lay.hidden));
+            ui.label(format!("{} nodes folded or hidden", lay.hidden));
         }
-        ui.weak("Ctrl+wheel zooms, drag pans");
+        ui.weak("drag or wheel pans, Ctrl+wheel zooms, double-click folds");
     });
     // The space left that is shown (never wider than the pane's clip rectangle).
     let shown = ui.available_rect_before_wrap().intersect(ui.clip_rect());
@@ -433,8 +435,22 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
         let room = area.size() - Vec2::splat(2.0 * FIT_MARGIN);
         view.zoom = (room.x / w.max(1.0))
             .min(room.y / h.max(1.0))
-            .clamp(0.01, FIT_MAX_ZOOM);
-        view.offset = area.center() - rect.min - Vec2::new(w, h) * view.zoom * 0.5;
+            .clamp(diagram::MIN_ZOOM, FIT_MAX_ZOOM);
+        let figure = Vec2::new(w, h) * view.zoom;
+        // What does not fit starts at the root: centred over it, from the top.
+        let root_x = lay.nodes.first().map_or(w / 2.0, |n| n.center[0]) * view.zoom;
+        view.offset = Vec2::new(
+            if figure.x <= room.x {
+                area.center().x - rect.min.x - figure.x * 0.5
+            } else {
+                area.center().x - rect.min.x - root_x
+            },
+            if figure.y <= room.y {
+                area.center().y - rect.min.y - figure.y * 0.5
+            } else {
+                area.min.y - rect.min.y + FIT_MARGIN
+            },
+        );
     }
     if response.dragged() {
         view.offset += response.drag_delta();
@@ -448,7 +464,7 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
         if zoom != 1.0 {
             // The layout point under the pointer stays under it.
             let under = (p - rect.min - view.offset) / view.zoom;
-            view.zoom = (view.zoom * zoom).clamp(0.01, 8.0);
+            view.zoom = (view.zoom * zoom).clamp(diagram::MIN_ZOOM, 8.0);
             view.offset = p - rect.min - under * view.zoom;
             view.fit = false;
         } else if scroll != Vec2::ZERO {
@@ -456,13 +472,19 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
             view.fit = false;
         }
     }
+    view.offset = keep_in_view(view.offset, Vec2::new(w, h) * view.zoom, area, rect.min);
     let (zoom, origin) = (view.zoom, rect.min + view.offset);
     let at = |[x, y]: [f32; 2]| origin + Vec2::new(x, y) * zoom;
     let painter = ui.painter_at(rect);
     painter.rect_filled(rect, 0.0, color(diagram::BACKGROUND_RGB));
-    // Text too small to read is left out; boxes and glyphs stay.
     let font = diagram::FONT * zoom;
-    let readable = font >= 5.0;
+    let small = (10.0 * zoom).max(diagram::MIN_LABEL_PX);
+    state.drawn.diagram_label = Some(
+        state
+            .drawn
+            .diagram_label
+            .map_or(font.min(small), |f| f.min(font).min(small)),
+    );
     let line = (2.0 * zoom).clamp(1.0, 3.0);
     for e in &lay.edges {
         let style = if e.not_traced {
@@ -482,22 +504,20 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
         } else {
             painter.line_segment([a, b], Stroke::new(line, c));
         }
-        if readable {
-            // The label sits on its own edge over a patch of background: it crosses no line.
-            let mid = at(e.label_at);
-            painter.rect_filled(
-                Rect::from_center_size(mid, Vec2::new(14.0, 16.0) * zoom),
-                3.0 * zoom,
-                color(diagram::BACKGROUND_RGB),
-            );
-            painter.text(
-                mid,
-                egui::Align2::CENTER_CENTER,
-                e.label,
-                egui::FontId::proportional(font),
-                c,
-            );
-        }
+        // The label sits on its own edge over a patch of background: it crosses no line.
+        let mid = at(e.label_at);
+        painter.rect_filled(
+            Rect::from_center_size(mid, Vec2::new(14.0, 16.0) * zoom),
+            3.0 * zoom,
+            color(diagram::BACKGROUND_RGB),
+        );
+        painter.text(
+            mid,
+            egui::Align2::CENTER_CENTER,
+            e.label,
+            egui::FontId::proportional(font),
+            c,
+        );
     }
     for n in &lay.nodes {
         let [x0, y0, x1, y1] = n.rect();
@@ -505,7 +525,18 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
         let Some(node) = node_at(&tree.root, &n.path) else {
             continue;
         };
-        let r = ui.interact(node_rect, id.with(("node", &n.path)), Sense::click());
+        let differs = other.map(|o| match node_at(&o.root, &n.path) {
+            Some(theirs) => node_differs(node, theirs),
+            None => true,
+        }) == Some(true);
+        if !node_rect.intersects(rect) {
+            continue;
+        }
+        let r = ui.interact(
+            node_rect.intersect(area),
+            id.with(("node", &n.path)),
+            Sense::click(),
+        );
         r.widget_info(|| {
             egui::WidgetInfo::labeled(
                 egui::Role::Button,
@@ -519,10 +550,19 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
         if r.clicked() {
             state.selected = Some(n.path.clone());
         }
+        if r.double_clicked() && !node.children.is_empty() {
+            state.toggle_fold(&n.path);
+        }
         let r = r.on_hover_ui(|ui| {
             ui.label(node_summary(node));
             for g in &n.glyphs {
                 ui.label(&g.note);
+            }
+            if n.hidden_children > 0 {
+                ui.label(format!(
+                    "{} nodes below are folded (double-click unfolds)",
+                    n.hidden_children
+                ));
             }
         });
         let _ = r;
@@ -544,6 +584,13 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
                     if selected { 4.0 } else { 2.5 },
                     color(crate::scene_view::HIGHLIGHT_RGB),
                 ),
+                egui::StrokeKind::Outside,
+            );
+        } else if differs {
+            painter.rect_stroke(
+                node_rect.expand(1.0),
+                5.0 * zoom,
+                Stroke::new(3.0, CHANGED),
                 egui::StrokeKind::Outside,
             );
         } else if n.not_traced {
@@ -578,128 +625,452 @@ pub fn diagram(ui: &mut Ui, tree: &RayTree, state: &mut TreeState) -> bool {
         for g in &n.glyphs {
             paint_glyph(&painter, g.glyph, at(g.at), 8.0 * zoom);
         }
-        if readable {
-            // Clipped to the box, so a label never reaches an edge or a neighbour.
-            painter.with_clip_rect(node_rect.intersect(rect)).text(
-                Pos2::new(node_rect.min.x + 2.0 * pad + swatch, line1),
+        // Clipped to the box, so a label never reaches an edge or a neighbour.
+        painter.with_clip_rect(node_rect.intersect(rect)).text(
+            Pos2::new(node_rect.min.x + 2.0 * pad + swatch, line1),
+            egui::Align2::LEFT_CENTER,
+            &n.label,
+            egui::FontId::proportional(font),
+            if n.not_traced {
+                rgba32(style_rgba(outline))
+            } else {
+                color(diagram::TEXT_RGB)
+            },
+        );
+        let line2 = node_rect.min.y + node_rect.height() * 0.75;
+        if n.total_internal_reflection {
+            painter.text(
+                Pos2::new(
+                    node_rect.min.x
+                        + pad
+                        + (n.glyphs.len() as f32 * diagram::GLYPH_PITCH + diagram::PAD) * zoom,
+                    line2,
+                ),
                 egui::Align2::LEFT_CENTER,
-                &n.label,
-                egui::FontId::proportional(font),
-                if n.not_traced {
-                    rgba32(style_rgba(outline))
-                } else {
-                    color(diagram::TEXT_RGB)
-                },
+                "TIR",
+                egui::FontId::proportional(small),
+                color(diagram::TIR_RGB),
             );
-            let line2 = node_rect.min.y + node_rect.height() * 0.75;
-            if n.total_internal_reflection {
-                painter.text(
-                    Pos2::new(
-                        node_rect.min.x
-                            + pad
-                            + (n.glyphs.len() as f32 * diagram::GLYPH_PITCH + diagram::PAD) * zoom,
-                        line2,
-                    ),
-                    egui::Align2::LEFT_CENTER,
-                    "TIR",
-                    egui::FontId::proportional(10.0 * zoom),
-                    color(diagram::TIR_RGB),
-                );
-            }
-            if n.hidden_children > 0 {
-                painter.text(
-                    Pos2::new(node_rect.center().x, node_rect.max.y + 10.0 * zoom),
-                    egui::Align2::CENTER_CENTER,
-                    format!("+{} deeper", n.hidden_children),
-                    egui::FontId::proportional(10.0 * zoom),
-                    color(diagram::TEXT_RGB),
-                );
-            }
+        }
+        if n.hidden_children > 0 {
+            painter.text(
+                Pos2::new(node_rect.center().x, node_rect.max.y + 4.0),
+                egui::Align2::CENTER_TOP,
+                format!("+{}", n.hidden_children),
+                egui::FontId::proportional(small),
+                color(diagram::TEXT_RGB),
+            );
         }
     }
     if legend_on {
         paint_legend(&painter, legend_rect, legend_rows);
     }
+    if w * zoom > area.width() + 1.0 || h * zoom > area.height() + 1.0 {
+        overview(ui, &painter, &lay, area, rect.min, &mut view, id);
+    }
     ui.data_mut(|d| d.insert_temp(id, view));
     export
 }
 
-// ---- the numbers --------------------------------------------------------------------------
-
-fn row(ui: &mut Ui, name: &str, value: String) {
-    ui.label(name);
-    ui.monospace(value);
-    ui.end_row();
+/// The pinned tree and the current one side by side, the nodes that differ outlined, above
+/// them what changed between the two ([`diagram::changes`]). Returns whether "Export SVG"
+/// was clicked (it exports the current tree).
+pub fn compare(
+    ui: &mut Ui,
+    tree: &RayTree,
+    pinned: &RayTree,
+    state: &mut TreeState,
+    tools: &mut dyn FnMut(&mut Ui),
+) -> bool {
+    let changes = diagram::changes(pinned, tree);
+    let mut export = false;
+    ui.horizontal_wrapped(|ui| {
+        tools(ui);
+        if ui
+            .button("Unpin")
+            .on_hover_text("stop comparing: the current tree alone")
+            .clicked()
+        {
+            state.pinned = None;
+        }
+        if ui.button("Export SVG...").clicked() {
+            export = true;
+        }
+    });
+    let text = if changes.is_empty() {
+        "no change between the pinned tree and the current one".to_string()
+    } else {
+        format!("changed: {}", changes.join("; "))
+    };
+    ui.add(egui::Label::new(egui::RichText::new(text).color(CHANGED)).wrap());
+    let mut none = |_: &mut Ui| {};
+    ui.columns(2, |cols| {
+        cols[0].label(format!(
+            "pinned: ({}, {}) · {} nodes",
+            pinned.pixel[0], pinned.pixel[1], pinned.nodes
+        ));
+        diagram_with(
+            &mut cols[0],
+            pinned,
+            state,
+            Some(tree),
+            "pinned diagram",
+            &mut none,
+        );
+        cols[1].label(format!(
+            "current: ({}, {}) · {} nodes",
+            tree.pixel[0], tree.pixel[1], tree.nodes
+        ));
+        diagram_with(
+            &mut cols[1],
+            tree,
+            state,
+            Some(pinned),
+            "current diagram",
+            &mut none,
+        );
+    });
+    export
 }
 
-/// Every number behind the selected node's colour.
-pub fn detail(ui: &mut Ui, tree: &RayTree, path: &[usize]) {
-    let Some(node) = node_at(&tree.root, path) else {
-        return;
-    };
-    let phong = tree.settings.shading == Shading::Phong;
-    ui.label(
-        RichText::new(node_summary(node))
-            .strong()
-            .color(kind_color(node.kind)),
+/// Outline of the nodes that differ from the other tree's.
+const CHANGED: Color32 = Color32::from_rgb(255, 150, 50);
+
+/// `offset` moved the least so that at least a corner of a figure of `size` stays in `area`
+/// (the canvas starts at `min`): the tree cannot be panned out of sight.
+fn keep_in_view(offset: Vec2, size: Vec2, area: Rect, min: Pos2) -> Vec2 {
+    let keep = 48.0_f32;
+    let lo = area.min - min - size + Vec2::splat(keep.min(size.min_elem()));
+    let hi = area.max - min - Vec2::splat(keep);
+    Vec2::new(
+        offset.x.clamp(lo.x.min(hi.x), hi.x.max(lo.x)),
+        offset.y.clamp(lo.y.min(hi.y), hi.y.max(lo.y)),
+    )
+}
+
+/// Largest size of the overview in the diagram's corner.
+const OVERVIEW: Vec2 = Vec2::new(170.0, 110.0);
+
+/// The whole tree in small, in the bottom-left corner of `area`, with the part the pane shows
+/// outlined; a click or drag on it moves the view there.
+fn overview(
+    ui: &mut Ui,
+    painter: &egui::Painter,
+    lay: &diagram::Layout,
+    area: Rect,
+    min: Pos2,
+    view: &mut DiagramView,
+    id: egui::Id,
+) {
+    let [w, h] = lay.size;
+    let scale = (OVERVIEW.x / w.max(1.0)).min(OVERVIEW.y / h.max(1.0));
+    let size = Vec2::new(w, h) * scale;
+    let frame = Rect::from_min_size(Pos2::new(area.min.x + 8.0, area.max.y - size.y - 8.0), size)
+        .expand(4.0);
+    if frame.width() * 2.0 > area.width() || frame.height() * 2.0 > area.height() {
+        return; // a pane this small is all view
+    }
+    let inner = frame.shrink(4.0);
+    painter.rect_filled(frame, 4.0, Color32::from_rgba_unmultiplied(20, 20, 20, 230));
+    painter.rect_stroke(
+        frame,
+        4.0,
+        Stroke::new(1.0, Color32::from_gray(110)),
+        egui::StrokeKind::Inside,
     );
-    egui::Grid::new(("detail", path.to_vec()))
-        .num_columns(2)
+    let map = |[x, y]: [f32; 2]| inner.min + Vec2::new(x, y) * scale;
+    for e in &lay.edges {
+        painter.line_segment(
+            [map(e.from), map(e.to)],
+            Stroke::new(1.0, rgba32(style_rgba(Style::Ray(e.kind)))),
+        );
+    }
+    for n in &lay.nodes {
+        let [x0, y0, x1, y1] = n.rect();
+        painter.rect_filled(
+            Rect::from_min_max(map([x0, y0]), map([x1, y1])),
+            0.0,
+            kind_color(n.kind),
+        );
+    }
+    // The part shown, in layout coordinates.
+    let to_layout = |p: Pos2| (p - min - view.offset) / view.zoom;
+    let a = to_layout(area.min);
+    let b = to_layout(area.max);
+    let shown = Rect::from_min_max(map([a.x, a.y]), map([b.x, b.y])).intersect(inner);
+    painter.rect_stroke(
+        shown,
+        0.0,
+        Stroke::new(1.5, color(crate::scene_view::HIGHLIGHT_RGB)),
+        egui::StrokeKind::Middle,
+    );
+    let r = ui.interact(frame, id.with("overview"), Sense::click_and_drag());
+    r.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Image, true, "ray tree overview"));
+    if let Some(p) = r.interact_pointer_pos()
+        && (r.clicked() || r.dragged())
+    {
+        // The point under the pointer becomes the centre of the view.
+        let target = (p - inner.min) / scale;
+        view.offset = area.center() - min - target * view.zoom;
+        view.fit = false;
+    }
+    let _ = r.on_hover_text("the whole tree: the outline is the part shown; click or drag to move");
+}
+
+// ---- the numbers --------------------------------------------------------------------------
+
+/// Every number behind the selected node's colour (a table of names and values).
+pub fn detail(ui: &mut Ui, tree: &RayTree, path: &[usize]) {
+    detail_table(ui, tree, path);
+}
+
+// ---- the tables ---------------------------------------------------------------------------
+
+/// Height of a table row: one line of body text.
+const ROW_H: f32 = 20.0;
+/// Points a row is indented per generation in the list's first column.
+const INDENT: f32 = 10.0;
+/// The colour of rows and values that differ from the other tree.
+const LIST_CHANGED: Color32 = Color32::from_rgb(255, 150, 50);
+
+fn kind_name(kind: RayKind) -> &'static str {
+    match kind {
+        RayKind::Primary => "primary",
+        RayKind::Reflected => "R",
+        RayKind::Refracted => "T",
+        RayKind::Shadow => "S",
+    }
+}
+
+/// One cell's text, elided to its column with the full text on hover; recorded in `cells`.
+fn cell(ui: &mut Ui, text: RichText, cells: &mut Vec<Cell>) -> Response {
+    let column = ui.available_width();
+    let full = egui::WidgetText::from(text.clone())
+        .into_galley(
+            ui,
+            Some(egui::TextWrapMode::Extend),
+            f32::INFINITY,
+            egui::TextStyle::Body,
+        )
+        .size()
+        .x;
+    let r = ui.add(egui::Label::new(text).truncate().selectable(false));
+    cells.push(Cell {
+        full,
+        shown: r.rect.width(),
+        column,
+        elided: full > column,
+    });
+    r
+}
+
+/// The rows the list shows: every node in pre-order, below a folded one left out.
+fn rows<'a>(
+    node: &'a Node,
+    path: &mut NodePath,
+    state: &TreeState,
+    out: &mut Vec<(NodePath, &'a Node)>,
+) {
+    out.push((path.clone(), node));
+    if state.is_folded(path) {
+        return;
+    }
+    for (i, child) in node.children.iter().enumerate() {
+        path.push(i);
+        rows(child, path, state, out);
+        path.pop();
+    }
+}
+
+/// What a node's ray met, for the list's second column.
+fn met(node: &Node) -> String {
+    match (&node.end, &node.hit) {
+        (Some(end), _) => end_text(*end).to_string(),
+        (None, Some(hit)) => format!("{} ({})", hit.object, hit.material),
+        _ => String::new(),
+    }
+}
+
+/// The tree as a table of rows (ray, what it met, colour); `other` marks the rows that differ
+/// from another tree. A row's toggle folds its subtree, here and in the diagram.
+pub fn tree_list(
+    ui: &mut Ui,
+    tree: &RayTree,
+    state: &mut TreeState,
+    other: Option<&RayTree>,
+    salt: &str,
+) {
+    state.folds_for(tree);
+    let mut list = Vec::new();
+    rows(&tree.root, &mut Vec::new(), state, &mut list);
+    let mut cells = Vec::new();
+    let mut fold = None;
+    let mut select = None;
+    let mut hover = None;
+    TableBuilder::new(ui)
+        .id_salt(("tree list", salt))
         .striped(true)
-        .show(ui, |ui| {
-            row(ui, "weight", fmt3(node.weight));
-            row(ui, "origin", fmt3(node.origin));
-            row(ui, "direction", fmt3(node.direction));
-            if let Some(end) = node.end {
-                row(
-                    ui,
-                    "ended",
-                    format!("{} -> colour {}", end_label(end), fmt3(node.color)),
-                );
+        .resizable(true)
+        .vscroll(false)
+        .sense(Sense::click())
+        .cell_layout(egui::Layout::left_to_right(egui::Align::Center))
+        .column(Column::initial(110.0).at_least(50.0).clip(true))
+        .column(Column::initial(170.0).at_least(60.0).clip(true))
+        .column(Column::remainder().at_least(60.0).clip(true))
+        .header(ROW_H, |mut header| {
+            for name in ["ray", "met", "colour"] {
+                header.col(|ui| {
+                    ui.strong(name);
+                });
             }
-            if let Some(hit) = &node.hit {
-                row(ui, "object", format!("{} ({})", hit.object, hit.material));
-                row(ui, "t", format!("{:.6}", hit.t));
-                row(ui, "P", fmt3(hit.point));
-                row(
-                    ui,
-                    "N",
-                    format!(
-                        "{}{}",
-                        fmt3(hit.normal),
-                        if hit.front_face { "" } else { " (inside)" }
-                    ),
-                );
-                if let Some(b) = hit.barycentric {
-                    row(
-                        ui,
-                        "barycentric",
-                        format!("({:.4}, {:.4}, {:.4})", b[0], b[1], b[2]),
-                    );
-                }
-                if let Some(ng) = hit.geometric_normal {
-                    row(ui, "N geometric", fmt3(ng));
-                }
-                if let Some([u, v]) = hit.uv {
-                    row(ui, "UV", format!("({u:.4}, {v:.4})"));
-                }
-                if let Some(t) = hit.texel {
-                    row(ui, "texel (× kd)", fmt3(t));
-                }
-            }
-            if node.direction_corrected {
-                row(
-                    ui,
-                    "direction",
-                    "corrected: mirrored back across the geometric plane".into(),
-                );
-            }
-            if let Some(v) = node.view {
-                row(ui, "V", fmt3(v));
+        })
+        .body(|mut body| {
+            for (path, node) in &list {
+                let differs = other.map(|o| match node_at(&o.root, path) {
+                    Some(theirs) => node_differs(node, theirs),
+                    None => true,
+                }) == Some(true);
+                let tint = if differs {
+                    LIST_CHANGED
+                } else {
+                    kind_color(node.kind)
+                };
+                body.row(ROW_H, |mut row| {
+                    row.set_selected(state.selected.as_ref() == Some(path));
+                    row.set_hovered(state.hovered.as_ref() == Some(path));
+                    row.col(|ui| {
+                        ui.add_space(node.depth as f32 * INDENT);
+                        if node.children.is_empty() {
+                            ui.add_space(16.0);
+                        } else {
+                            let folded = state.is_folded(path);
+                            let toggle = ui
+                                .add(
+                                    egui::Button::new(if folded { "⏵" } else { "⏷" })
+                                        .small()
+                                        .frame(false),
+                                )
+                                .on_hover_text(if folded { "unfold" } else { "fold" });
+                            if toggle.clicked() {
+                                fold = Some(path.clone());
+                            }
+                        }
+                        let text = format!(
+                            "{}{} d{}",
+                            if differs { "* " } else { "" },
+                            kind_name(node.kind),
+                            node.depth
+                        );
+                        cell(ui, RichText::new(text).color(tint), &mut cells);
+                    });
+                    row.col(|ui| {
+                        let mut text = met(node);
+                        if state.is_folded(path) {
+                            text = format!("{text} · +{} below", descendants(node));
+                        }
+                        cell(ui, RichText::new(text).color(tint), &mut cells);
+                    });
+                    row.col(|ui| {
+                        cell(ui, RichText::new(fmt3(node.color)).monospace(), &mut cells);
+                    });
+                    let r = row.response();
+                    if r.hovered() {
+                        hover = Some(path.clone());
+                    }
+                    if r.clicked() {
+                        select = Some(path.clone());
+                    }
+                    let _ = r.on_hover_text(node_summary(node));
+                });
             }
         });
+    if let Some(path) = fold {
+        state.toggle_fold(&path);
+    }
+    if hover.is_some() {
+        state.hovered = hover;
+    }
+    if select.is_some() {
+        state.selected = select;
+    }
+    state.drawn.cells.extend(cells);
+}
+
+/// A row of the detail table: a name, its value and the value's colour.
+struct Row {
+    name: String,
+    value: String,
+    tint: Option<Color32>,
+}
+
+fn push(rows: &mut Vec<Row>, name: &str, value: String) {
+    rows.push(Row {
+        name: name.to_string(),
+        value,
+        tint: None,
+    });
+}
+
+fn style_color(style: Style) -> Color32 {
+    let [r, g, b, _] = style_rgba(style);
+    Color32::from_rgb(r, g, b)
+}
+
+/// The numbers of `node`, as rows.
+fn detail_rows(node: &Node, phong: bool) -> Vec<Row> {
+    let mut rows = Vec::new();
+    let r = &mut rows;
+    push(r, "weight", fmt3(node.weight));
+    push(r, "origin", fmt3(node.origin));
+    push(r, "direction", fmt3(node.direction));
+    if let Some(end) = node.end {
+        push(
+            r,
+            "ended",
+            format!("{} -> colour {}", end_text(end), fmt3(node.color)),
+        );
+    }
+    if let Some(hit) = &node.hit {
+        push(r, "object", format!("{} ({})", hit.object, hit.material));
+        push(r, "t", format!("{:.6}", hit.t));
+        push(r, "P", fmt3(hit.point));
+        push(
+            r,
+            "N",
+            format!(
+                "{}{}",
+                fmt3(hit.normal),
+                if hit.front_face { "" } else { " (inside)" }
+            ),
+        );
+        if let Some(b) = hit.barycentric {
+            push(
+                r,
+                "barycentric",
+                format!("({:.4}, {:.4}, {:.4})", b[0], b[1], b[2]),
+            );
+        }
+        if let Some(ng) = hit.geometric_normal {
+            push(r, "N geometric", fmt3(ng));
+        }
+        if let Some([u, v]) = hit.uv {
+            push(r, "UV", format!("({u:.4}, {v:.4})"));
+        }
+        if let Some(t) = hit.texel {
+            push(r, "texel (× kd)", fmt3(t));
+        }
+    }
+    if node.direction_corrected {
+        push(
+            r,
+            "direction",
+            "corrected: mirrored back across the geometric plane".into(),
+        );
+    }
+    if let Some(v) = node.view {
+        push(r, "V", fmt3(v));
+    }
     for s in &node.shadow_rays {
-        ui.separator();
         let verdict = if s.facing_away {
             "facing away (N·L <= 0): adds nothing".to_string()
         } else if s.behind_surface {
@@ -716,79 +1087,107 @@ pub fn detail(ui: &mut Ui, tree: &RayTree, path: &[usize]) {
         } else {
             "lit".to_string()
         };
-        ui.label(
-            RichText::new(format!("light {}: {verdict}", s.light)).color(
-                if s.blocked_by.is_some() {
-                    color(rgb(Style::ShadowBlocked))
-                } else {
-                    color(kind_rgb(RayKind::Shadow))
-                },
-            ),
-        );
-        egui::Grid::new(("light", path.to_vec(), s.light.clone()))
-            .num_columns(2)
-            .striped(true)
-            .show(ui, |ui| {
-                row(ui, "L", fmt3(s.to_light));
-                row(ui, "distance", format!("{:.4}", s.distance));
-                row(ui, "N·L", format!("{:.6}", s.n_dot_l));
-                if phong {
-                    row(ui, "R (Phong)", fmt3(s.mirror));
-                    row(ui, "R·V", format!("{:.6}", s.r_dot_v));
-                } else {
-                    row(ui, "H (Blinn)", fmt3(s.halfway));
-                    row(ui, "N·H", format!("{:.6}", s.n_dot_h));
-                }
-                row(ui, "diffuse", fmt3(s.diffuse));
-                row(ui, "specular", fmt3(s.specular));
-            });
+        r.push(Row {
+            name: format!("light {}", s.light),
+            value: verdict,
+            tint: Some(if s.blocked_by.is_some() {
+                style_color(Style::ShadowBlocked)
+            } else {
+                let [cr, cg, cb] = kind_rgb(RayKind::Shadow);
+                Color32::from_rgb(cr, cg, cb)
+            }),
+        });
+        push(r, "  L", fmt3(s.to_light));
+        push(r, "  distance", format!("{:.4}", s.distance));
+        push(r, "  N·L", format!("{:.6}", s.n_dot_l));
+        if phong {
+            push(r, "  R (Phong)", fmt3(s.mirror));
+            push(r, "  R·V", format!("{:.6}", s.r_dot_v));
+        } else {
+            push(r, "  H (Blinn)", fmt3(s.halfway));
+            push(r, "  N·H", format!("{:.6}", s.n_dot_h));
+        }
+        push(r, "  diffuse", fmt3(s.diffuse));
+        push(r, "  specular", fmt3(s.specular));
     }
     if let Some(local) = &node.local {
-        ui.separator();
-        egui::Grid::new(("sum", path.to_vec()))
-            .num_columns(2)
-            .striped(true)
-            .show(ui, |ui| {
-                row(ui, "ambient ka·A", fmt3(local.ambient));
-                row(ui, "diffuse (all lights)", fmt3(local.diffuse));
-                row(ui, "specular (all lights)", fmt3(local.specular));
-                row(ui, "local", fmt3(local.total));
-                let mut sum = local.total;
-                for child in &node.children {
-                    let (name, w) = match child.kind {
-                        RayKind::Reflected => ("kr · reflected", node.kr.unwrap_or(Vec3::ZERO)),
-                        _ => ("kt · refracted", node.kt.unwrap_or(Vec3::ZERO)),
-                    };
-                    let term = w * child.color;
-                    sum += term;
-                    row(
-                        ui,
-                        name,
-                        format!("{} · {} = {}", fmt3(w), fmt3(child.color), fmt3(term)),
-                    );
+        push(r, "ambient ka·A", fmt3(local.ambient));
+        push(r, "diffuse (all lights)", fmt3(local.diffuse));
+        push(r, "specular (all lights)", fmt3(local.specular));
+        push(r, "local", fmt3(local.total));
+        let mut sum = local.total;
+        for child in &node.children {
+            let (name, w) = match child.kind {
+                RayKind::Reflected => ("kr · reflected", node.kr.unwrap_or(Vec3::ZERO)),
+                _ => ("kt · refracted", node.kt.unwrap_or(Vec3::ZERO)),
+            };
+            let term = w * child.color;
+            sum += term;
+            push(
+                r,
+                name,
+                format!("{} · {} = {}", fmt3(w), fmt3(child.color), fmt3(term)),
+            );
+        }
+        if node.total_internal_reflection {
+            push(r, "TIR", "total internal reflection: kt moved to R".into());
+        }
+        let ok = (sum - node.color).abs().max_element()
+            <= 1e-5 * node.color.abs().max_element().max(1.0);
+        push(
+            r,
+            "sum = colour",
+            format!(
+                "{} {}",
+                fmt3(sum),
+                if ok {
+                    "(equals the node colour)"
+                } else {
+                    "(DIFFERS from the node colour)"
                 }
-                if node.total_internal_reflection {
-                    row(
-                        ui,
-                        "",
-                        "total internal reflection: kt moved to R".to_string(),
-                    );
-                }
-                let ok = (sum - node.color).abs().max_element()
-                    <= 1e-5 * node.color.abs().max_element().max(1.0);
-                row(
-                    ui,
-                    "sum = colour",
-                    format!(
-                        "{} {}",
-                        fmt3(sum),
-                        if ok {
-                            "(equals the node colour)"
-                        } else {
-                            "(DIFFERS from the node colour)"
-                        }
-                    ),
-                );
-            });
+            ),
+        );
     }
+    rows
+}
+
+/// Every number behind the selected node's colour, as a table of names and values.
+fn detail_table(ui: &mut Ui, tree: &RayTree, path: &[usize]) {
+    let Some(node) = node_at(&tree.root, path) else {
+        return;
+    };
+    let mut cells = Vec::new();
+    cell(
+        ui,
+        RichText::new(node_summary(node))
+            .strong()
+            .color(kind_color(node.kind)),
+        &mut cells,
+    );
+    let rows = detail_rows(node, tree.settings.shading == Shading::Phong);
+    TableBuilder::new(ui)
+        .id_salt("tree detail table")
+        .striped(true)
+        .resizable(true)
+        .vscroll(false)
+        .cell_layout(egui::Layout::left_to_right(egui::Align::Center))
+        .column(Column::initial(140.0).at_least(50.0).clip(true))
+        .column(Column::remainder().at_least(80.0).clip(true))
+        .body(|mut body| {
+            for r in &rows {
+                body.row(ROW_H, |mut row| {
+                    row.col(|ui| {
+                        cell(ui, RichText::new(&r.name), &mut cells);
+                    });
+                    row.col(|ui| {
+                        let text = RichText::new(&r.value).monospace();
+                        let text = match r.tint {
+                            Some(c) => text.color(c),
+                            None => text,
+                        };
+                        cell(ui, text, &mut cells);
+                    });
+                });
+            }
+        });
 }

@@ -70,6 +70,17 @@ impl eframe::App for ViewerApp {
         if ctx.input_mut(|i| i.consume_shortcut(&toggle)) {
             self.workspace.toggle_settings_panel(&mut self.messages);
         }
+        // F: focus on the tree, unless a text field takes the key.
+        if !ctx.egui_wants_keyboard_input()
+            && ctx.input_mut(|i| i.consume_key(egui::Modifiers::NONE, egui::Key::F))
+        {
+            if self.selection.tree.is_some() || self.workspace.focused() {
+                self.workspace.toggle_focus();
+            } else {
+                self.messages
+                    .notice("focus shows a ray tree: click a pixel in the render first");
+            }
+        }
         panels::top_bar(
             ui,
             &mut self.workspace,
@@ -90,6 +101,7 @@ impl eframe::App for ViewerApp {
         );
         // Hover is transient: the views set it again while the pointer stays on a node.
         self.selection.tree_state.hovered = None;
+        self.selection.tree_state.drawn = Default::default();
         scene_pane::advance_playback(&mut self.scene_view, &mut self.selection, &ctx);
         self.workspace
             .settle_settings_panel(ctx.content_rect().width(), &mut self.messages);
@@ -143,6 +155,7 @@ impl eframe::App for ViewerApp {
         if let Some(command) = self.workspace.show_browser(&ctx) {
             self.pending.push(command);
         }
+        tree_window(self, &ctx);
         panels::help_window(&ctx, &mut self.workspace.show_help);
         let has_tree = self.selection.tree.is_some();
         panels::export_window(&ctx, &mut self.workspace, has_tree, &self.files.file_stem());
@@ -174,7 +187,86 @@ impl eframe::App for ViewerApp {
     }
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
-        eframe::set_value(storage, eframe::APP_KEY, &self.workspace.prefs);
+        eframe::set_value(storage, eframe::APP_KEY, &self.workspace.prefs_to_save());
+    }
+}
+
+/// The diagram toolbar's buttons that rearrange the window: focus mode and the pop-out.
+fn tree_tools(ui: &mut egui::Ui, focused: bool, focus: &mut bool, pop: &mut bool) {
+    let mut on = focused;
+    if ui
+        .toggle_value(&mut on, "Focus")
+        .on_hover_text("F: the tree's panes get most of the window; again to go back")
+        .changed()
+    {
+        *focus = true;
+    }
+    if ui
+        .button("Pop out")
+        .on_hover_text("the diagram and the list in their own window; close it to bring them back")
+        .clicked()
+    {
+        *pop = true;
+    }
+}
+
+/// The tree's diagram and list in their own native window (an egui viewport), while popped
+/// out; closing it (or "Dock back") puts them back in the workspace.
+fn tree_window(app: &mut ViewerApp, ctx: &egui::Context) {
+    if !app.workspace.popped_out {
+        return;
+    }
+    let builder = egui::ViewportBuilder::default()
+        .with_title("raytree: ray tree")
+        .with_inner_size([960.0, 640.0]);
+    let dock = ctx.show_viewport_immediate(
+        egui::ViewportId::from_hash_of("raytree tree window"),
+        builder,
+        |ui, _class| {
+            let mut dock = ui.ctx().input(|i| i.viewport().close_requested());
+            egui::CentralPanel::default().show(ui, |ui| {
+                let Some(tree) = app.selection.tree.clone() else {
+                    ui.weak("click a pixel in the render view for its ray tree");
+                    dock |= ui.button("Dock back").clicked();
+                    return;
+                };
+                let half = ui.available_width() * 0.55;
+                ui.horizontal_top(|ui| {
+                    ui.allocate_ui(egui::vec2(half, ui.available_height()), |ui| {
+                        ui.vertical(|ui| {
+                            let mut tools = |ui: &mut egui::Ui| {
+                                dock |= ui
+                                    .button("Dock back")
+                                    .on_hover_text("the panes back into the main window")
+                                    .clicked();
+                            };
+                            if tree_view::diagram(
+                                ui,
+                                &tree,
+                                &mut app.selection.tree_state,
+                                &mut tools,
+                            ) {
+                                let name = format!("tree-{}-{}.svg", tree.pixel[0], tree.pixel[1]);
+                                app.workspace.browse(BrowseFor::ExportDiagram, &name);
+                            }
+                        });
+                    });
+                    ui.separator();
+                    ui.vertical(|ui| {
+                        panels::tree_panel(
+                            ui,
+                            &mut app.selection,
+                            &mut app.workspace,
+                            &app.render.tracer,
+                        );
+                    });
+                });
+            });
+            dock
+        },
+    );
+    if dock {
+        app.workspace.set_popped_out(false);
     }
 }
 
@@ -202,9 +294,23 @@ fn pane_ui(app: &mut ViewerApp, ui: &mut egui::Ui, pane: workspace::Pane) {
         ),
         Pane::Diagram => match super::picker::strip(ui, &mut app.selection, &app.render.tracer) {
             Some(tree) => {
-                if tree_view::diagram(ui, &tree, &mut app.selection.tree_state) {
+                let (mut focus, mut pop) = (false, false);
+                let focused = app.workspace.focused();
+                let mut tools = |ui: &mut egui::Ui| tree_tools(ui, focused, &mut focus, &mut pop);
+                let state = &mut app.selection.tree_state;
+                let export = match state.pinned.clone() {
+                    Some(pinned) => tree_view::compare(ui, &tree, &pinned, state, &mut tools),
+                    None => tree_view::diagram(ui, &tree, state, &mut tools),
+                };
+                if export {
                     let name = format!("tree-{}-{}.svg", tree.pixel[0], tree.pixel[1]);
                     app.workspace.browse(BrowseFor::ExportDiagram, &name);
+                }
+                if focus {
+                    app.workspace.toggle_focus();
+                }
+                if pop {
+                    app.workspace.set_popped_out(true);
                 }
             }
             None => {

@@ -114,6 +114,18 @@ pub struct Workspace {
     pub(super) export_choice: bool,
     /// The "Speed vs accuracy" window and its background sweep.
     pub sweep: SweepWindow,
+    /// Focus on the tree: the arrangement to give back when it ends.
+    focus: Option<Arrangement>,
+    /// The tree's panes are in their own native window.
+    pub popped_out: bool,
+}
+
+/// What focus mode changes and gives back when it ends: the panes' layout and whether the
+/// settings panel is shown.
+#[derive(Clone, Debug)]
+struct Arrangement {
+    layout: Layout,
+    settings_panel: bool,
 }
 
 impl Workspace {
@@ -179,6 +191,51 @@ impl Workspace {
         if !self.prefs.settings_panel {
             messages.notice("settings hidden: Ctrl+B or View > Settings panel shows them");
         }
+    }
+
+    /// Whether focus mode is on: the tree's diagram and list have most of the window.
+    pub fn focused(&self) -> bool {
+        self.focus.is_some()
+    }
+
+    /// Turns focus mode on (the tree's panes get most of the window, the render and the
+    /// scene view share a strip at the left, the settings are hidden) or off (the layout and
+    /// settings panel are given back exactly as they were).
+    pub fn toggle_focus(&mut self) {
+        match self.focus.take() {
+            Some(saved) => {
+                self.prefs.layout = saved.layout;
+                self.prefs.settings_panel = saved.settings_panel;
+            }
+            None => {
+                self.focus = Some(Arrangement {
+                    layout: self.prefs.layout.clone(),
+                    settings_panel: self.prefs.settings_panel,
+                });
+                self.prefs.layout = focus_layout();
+                self.prefs.settings_panel = false;
+                // The tree's panes are shown in the window, not beside it.
+                self.popped_out = false;
+            }
+        }
+    }
+
+    /// The tree's panes in their own window, or back in the workspace.
+    pub fn set_popped_out(&mut self, out: bool) {
+        if out && self.focused() {
+            self.toggle_focus();
+        }
+        self.popped_out = out;
+    }
+
+    /// The preferences to keep between runs: those before focus mode when it is on.
+    pub fn prefs_to_save(&self) -> Prefs {
+        let mut prefs = self.prefs.clone();
+        if let Some(saved) = &self.focus {
+            prefs.layout = saved.layout.clone();
+            prefs.settings_panel = saved.settings_panel;
+        }
+        prefs
     }
 
     /// On the first frame of a first run, a window narrower than [`SETTINGS_MIN_WIDTH`]
@@ -254,6 +311,30 @@ pub fn default_layout() -> Layout {
     egui_tiles::Tree::new(egui::Id::unique("raytree workspace"), root, tiles)
 }
 
+/// The render's share of the width in focus mode: a strip beside the tree.
+pub const FOCUS_RENDER_SHARE: f32 = 0.24;
+
+/// The diagram's share of the width in focus mode (the list has the rest).
+pub const FOCUS_DIAGRAM_SHARE: f32 = 0.46;
+
+/// Focus mode's layout: the render with the scene view as its neighbouring tab in a strip at
+/// the left ([`FOCUS_RENDER_SHARE`]), then the diagram and the list side by side.
+pub fn focus_layout() -> Layout {
+    let mut tiles = egui_tiles::Tiles::default();
+    let render = tiles.insert_pane(Pane::Render);
+    let scene = tiles.insert_pane(Pane::SceneView);
+    let views = tiles.insert_tab_tile(vec![render, scene]);
+    let diagram = tabs(&mut tiles, Pane::Diagram);
+    let list = tabs(&mut tiles, Pane::TreeList);
+    let mut row = Linear::new(LinearDir::Horizontal, vec![views, diagram, list]);
+    row.shares.set_share(views, FOCUS_RENDER_SHARE);
+    row.shares.set_share(diagram, FOCUS_DIAGRAM_SHARE);
+    row.shares
+        .set_share(list, 1.0 - FOCUS_RENDER_SHARE - FOCUS_DIAGRAM_SHARE);
+    let root = tiles.insert_container(row);
+    egui_tiles::Tree::new(egui::Id::unique("raytree focus"), root, tiles)
+}
+
 /// Whether `layout` can be used: a root, and every pane exactly once.
 pub fn usable(layout: &Layout) -> bool {
     layout.root().is_some()
@@ -276,6 +357,8 @@ pub fn tile_of(layout: &Layout, pane: Pane) -> Option<TileId> {
 /// so that before any click the render and scene views share the whole workspace. Only the
 /// change is acted on: a pane hidden or shown from the View menu stays so meanwhile.
 fn follow_tree(ws: &mut Workspace, has_tree: bool) {
+    // Popped out, the tree's panes are in their own window.
+    let has_tree = has_tree && !ws.popped_out;
     let want = if has_tree {
         TreePanes::Open
     } else {
@@ -328,7 +411,15 @@ pub fn pane_toggles(ws: &mut Workspace, messages: &mut Messages, ui: &mut Ui) {
     {
         ws.toggle_settings_panel(messages);
     }
+    let mut focus = ws.focused();
+    if ui
+        .checkbox(&mut focus, "Focus on the ray tree (F)")
+        .changed()
+    {
+        ws.toggle_focus();
+    }
     if ui.button("Reset layout").clicked() {
+        ws.focus = None;
         ws.prefs.layout = default_layout();
         ws.prefs.settings_panel = true;
         ws.tree_panes = None;
@@ -385,6 +476,36 @@ mod tests {
         assert_eq!(prefs.tonemap, Tonemap::Aces);
         let json = serde_json::to_value(&prefs).expect("serialises");
         assert_eq!(json["tonemap"], 2);
+    }
+
+    #[test]
+    fn focus_gives_the_tree_the_window_and_gives_the_layout_back() {
+        let mut ws = Workspace::default();
+        ws.prefs.settings_panel = true;
+        let before = serde_json::to_string(&ws.prefs.layout).expect("serialises");
+        ws.toggle_focus();
+        assert!(ws.focused());
+        assert!(usable(&ws.prefs.layout));
+        assert!(!ws.prefs.settings_panel);
+        // What is saved meanwhile is the layout to come back to.
+        let saved = ws.prefs_to_save();
+        assert_eq!(serde_json::to_string(&saved.layout).expect("json"), before);
+        assert!(saved.settings_panel);
+        ws.toggle_focus();
+        assert!(!ws.focused());
+        assert_eq!(
+            serde_json::to_string(&ws.prefs.layout).expect("json"),
+            before
+        );
+        assert!(ws.prefs.settings_panel);
+        // Popping the panes out ends focus.
+        ws.toggle_focus();
+        ws.set_popped_out(true);
+        assert!(!ws.focused() && ws.popped_out);
+        assert_eq!(
+            serde_json::to_string(&ws.prefs.layout).expect("json"),
+            before
+        );
     }
 
     #[test]

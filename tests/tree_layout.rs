@@ -1,0 +1,154 @@
+//! The ray tree's panes stay readable at common window sizes, through the real viewer: the
+//! diagram's labels are never below the readable floor (a large tree scrolls instead), every
+//! list cell fits its column or is elided with its full text on hover, and focus mode gives the
+//! tree the window and gives the layout back exactly.
+
+#[path = "common/viewer.rs"]
+mod viewer;
+
+use std::time::{Duration, Instant};
+
+use eframe::egui;
+use egui::accesskit::Role;
+use egui_kittest::kittest::Queryable;
+use raytree::diagram::MIN_LABEL_PX;
+use viewer::{Window, small, window};
+
+/// Steps until the render follows its pane, so a click lands on the pixel under it.
+fn follow_pane(h: &mut Window) {
+    let deadline = Instant::now() + Duration::from_secs(30);
+    loop {
+        h.step();
+        let image = h.get_by_label("render viewport").rect();
+        let (w, hh) = h.state().render_size();
+        let app = h.state();
+        // The pane's pixels are the render's, and the image fills it 1:1.
+        if app.render.pane_seen(&app.workspace.prefs) == Some((w, hh))
+            && (image.width() - w as f32).abs() <= 1.0
+            && (image.height() - hh as f32).abs() <= 1.0
+        {
+            return;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "the render never followed its pane"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+/// Clicks the glass sphere of the default scene and lets the tree's panes open.
+fn click_glass(h: &mut Window) {
+    let image = h.get_by_label("render viewport").rect();
+    let at = image.lerp_inside(egui::vec2(0.378, 0.58));
+    h.hover_at(at);
+    for pressed in [true, false] {
+        h.event(egui::Event::PointerButton {
+            pos: at,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        });
+        h.step();
+    }
+    h.run_steps(3);
+    assert!(h.state().selection.tree.is_some(), "a tree after the click");
+}
+
+fn show_tab(h: &mut Window, title: &str) {
+    h.get_by_role_and_label(Role::Button, title).click();
+    h.run_steps(3);
+}
+
+#[test]
+fn the_diagram_and_the_list_are_readable_at_common_sizes() {
+    for size in [[1024.0, 640.0], [1600.0, 1000.0]] {
+        let mut h = window(small("default"), size);
+        follow_pane(&mut h);
+        click_glass(&mut h);
+        let tree = h.state().selection.tree.clone().expect("a tree");
+        show_tab(&mut h, "Ray tree diagram");
+        let label = h.state().selection.tree_state.drawn.diagram_label;
+        let label = label.expect("the diagram was drawn");
+        assert!(
+            label >= MIN_LABEL_PX,
+            "{size:?}: diagram labels at {label:.1} pt, below {MIN_LABEL_PX}"
+        );
+        // The root's box is in the pane, however large the tree.
+        let pane = h
+            .get_by_label(&format!(
+                "ray tree diagram of ({}, {})",
+                tree.pixel[0], tree.pixel[1]
+            ))
+            .rect();
+        let root = h.get_by_label_contains("tree node primary:").rect();
+        assert!(pane.intersects(root), "{size:?}: the root is out of view");
+
+        show_tab(&mut h, "Ray tree");
+        let cells = h.state().selection.tree_state.drawn.cells.clone();
+        assert!(
+            cells.len() >= 3,
+            "{size:?}: {} list cells drawn",
+            cells.len()
+        );
+        for c in &cells {
+            assert!(c.readable(), "{size:?}: a list cell is cut: {c:?}");
+        }
+    }
+}
+
+fn layout_json(h: &Window) -> String {
+    serde_json::to_string(&h.state().workspace.prefs.layout).expect("the layout serialises")
+}
+
+#[test]
+fn focus_gives_the_tree_most_of_the_window_and_leaving_restores_the_layout() {
+    let mut h = window(small("default"), [1024.0, 640.0]);
+    follow_pane(&mut h);
+    click_glass(&mut h);
+    show_tab(&mut h, "Ray tree diagram");
+    let before = layout_json(&h);
+    let render_before = h.get_by_label("render viewport").rect();
+    // The tree follows the render to its new size: the same point, maybe another pixel.
+    let label = "ray tree diagram of (";
+    let diagram_before = h.get_by_label_contains(label).rect();
+    h.key_press(egui::Key::F);
+    h.run_steps(4);
+    assert!(h.state().workspace.focused(), "F turns focus on");
+    let diagram = h.get_by_label_contains(label).rect();
+    let window_area = h.ctx.content_rect().area();
+    // The diagram and the list (beside it) hold most of the window.
+    assert!(
+        diagram.area() > diagram_before.area() * 1.5,
+        "{diagram_before:?} -> {diagram:?}"
+    );
+    assert!(
+        diagram.area() > 0.3 * window_area,
+        "the diagram has {:.2} of the window",
+        diagram.area() / window_area
+    );
+    let render = h.get_by_label("render viewport").rect();
+    assert!(render.width() < 0.3 * h.ctx.content_rect().width());
+    if let Ok(path) = std::env::var("RAYTREE_FOCUS_PNG") {
+        h.run_steps(20);
+        h.render().expect("render").save(path).expect("saved");
+    }
+    h.key_press(egui::Key::F);
+    h.run_steps(4);
+    assert!(!h.state().workspace.focused());
+    assert_eq!(layout_json(&h), before, "the layout is given back exactly");
+    // The render follows its pane back to its old size.
+    follow_pane(&mut h);
+    let render_after = h.get_by_label("render viewport").rect();
+    assert_eq!(
+        render_before, render_after,
+        "the render is back in its place"
+    );
+    // The button does the same.
+    h.get_by_role_and_label(Role::Button, "Focus").click();
+    h.run_steps(3);
+    assert!(
+        h.state().workspace.focused(),
+        "the Focus button turns focus on"
+    );
+}
