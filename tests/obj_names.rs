@@ -114,7 +114,12 @@ fn trees_name_the_part_a_ray_met() {
     for x in 0..w {
         let tree = pixel_tree(&tracer, x, h / 2).expect("inside");
         let Some(hit) = &tree.root.hit else { continue };
-        assert_eq!(hit.object, expected(hit.point.x), "pixel {x}: {:?}", hit.point);
+        assert_eq!(
+            hit.object,
+            expected(hit.point.x),
+            "pixel {x}: {:?}",
+            hit.point
+        );
         seen.insert(hit.object.clone());
         for node in all_nodes(&tree.root) {
             for s in &node.shadow_rays {
@@ -203,5 +208,8 @@ fn a_part_named_as_its_mesh_names_nothing_more() {
     assert_eq!(names, ["Shelf", "Cabinet_3", "Cabinet_3"]);
     let door = scene.hit_name(scene.triangles[8].object, Some(8));
     assert_eq!(door, "Door");
-    assert_eq!(scene.hit_name(scene.triangles[4].object, Some(4)), "Door: Cabinet_3");
+    assert_eq!(
+        scene.hit_name(scene.triangles[4].object, Some(4)),
+        "Door: Cabinet_3"
+    );
 }

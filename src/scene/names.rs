@@ -59,10 +59,12 @@ fn title(scene: &Scene, name: &str, users: &[(ObjectId, &str)]) -> MaterialTitle
     // A part of the material's own mesh by its name alone; of another mesh, with the mesh's.
     let users: Vec<String> = users
         .iter()
-        .map(|&(object, part)| match scene.objects.get(object.0 as usize) {
-            Some(o) if Some(object) != owner => format!("{}: {part}", o.name),
-            _ => part.to_string(),
-        })
+        .map(
+            |&(object, part)| match scene.objects.get(object.0 as usize) {
+                Some(o) if Some(object) != owner => format!("{}: {part}", o.name),
+                _ => part.to_string(),
+            },
+        )
         .collect();
     let named = users[..users.len().min(NAMED_USERS)].join(", ");
     let title = match users.len() {
@@ -117,9 +119,15 @@ mod tests {
     fn materials_are_named_by_file_and_the_objects_that_use_them() {
         let mut scene = Scene {
             objects: vec![mesh("kitchen"), mesh("room")],
-            materials: ["kitchen/White.001", "kitchen/Steel", "glass", "room/wall", "kitchen/"]
-                .map(material)
-                .to_vec(),
+            materials: [
+                "kitchen/White.001",
+                "kitchen/Steel",
+                "glass",
+                "room/wall",
+                "kitchen/",
+            ]
+            .map(material)
+            .to_vec(),
             ..Scene::default()
         };
         let mut parts = vec![part(0, 0, "Cabinet_3")];
