@@ -38,7 +38,7 @@ fn swatch(ui: &mut Ui, tint: usize) {
     ui.painter().rect_filled(rect, 2.0, tint_color(tint));
 }
 
-/// Up/Down (or [ and ]) select the previous or next tree of the picker, unless a text field
+/// Up/Down (or `[` and `]`) select the previous or next tree of the picker, unless a text field
 /// has the keyboard.
 pub fn step_keys(ctx: &egui::Context, selection: &mut TreeSelection) {
     use egui::{Key, Modifiers};

@@ -340,7 +340,7 @@ pub fn diagram(
     diagram_with(ui, tree, state, None, "diagram view", tools)
 }
 
-/// [`diagram`], the nodes that differ from `other`'s at the same place outlined in the
+/// [`diagram()`], the nodes that differ from `other`'s at the same place outlined in the
 /// compare colour; `salt` keeps two diagrams' views apart.
 pub fn diagram_with(
     ui: &mut Ui,
