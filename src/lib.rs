@@ -2,8 +2,8 @@
 //! docs/design.md), with the ray tracing tree of any pixel.
 //!
 //! Layers, bottom to top; a module imports only from the layers below it, never in a circle:
-//! 1. [`choice`], [`rng`], [`sync`] and [`geometry`]: named options; the seeded random numbers;
-//!    locks that outlive a panic; rays, hits, ray-origin offsets, the sphere
+//! 1. [`choice`], [`rng`], [`sync`], [`plural`] and [`geometry`]: named options; the seeded
+//!    random numbers; locks that outlive a panic; counted nouns in messages; rays, hits, ray-origin offsets, the sphere
 //!    and triangle intersection methods.
 //! 2. [`scene`]: plain scene data, the camera ([`scene::camera`]), the rules and limits every
 //!    input is held to ([`scene::rules`]), TOML and OBJ loading, built-in scenes.
@@ -31,6 +31,7 @@ pub mod diagram;
 pub mod experiments;
 pub mod export;
 pub mod geometry;
+pub mod plural;
 pub mod ray_tree;
 pub mod render;
 pub mod rng;

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 /// Bottom to top. A module may use those on lower rows, and those on its own row when that
 /// makes no circle.
 const LAYERS: &[&[&str]] = &[
-    &["choice", "rng", "sync", "geometry"],
+    &["choice", "rng", "sync", "plural", "geometry"],
     &["scene"],
     &["accel"],
     &["shade", "trace", "ray_tree"],

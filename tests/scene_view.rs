@@ -432,7 +432,7 @@ fn the_cut_away_shows_the_rays_inside_a_closed_room() {
         headless::scene_view_image(
             &scene,
             TraceSettings::default(),
-            &tree,
+            &[headless::Layer::alone(&tree)],
             &view,
             w,
             h,
@@ -497,4 +497,51 @@ fn the_exported_scene_view_of_a_closed_room_shows_its_rays() {
     ]);
     assert_eq!(code, Some(2));
     assert!(err.contains("auto, on or off"), "{err}");
+}
+
+/// The viewer's "render with rays" export draws each tree as the viewer does: a faint tree of
+/// several in its tint, the selected one in the rays' own colours.
+#[test]
+fn an_exported_overlay_draws_a_faint_tree_in_its_tint() {
+    use raytree::scene_view::{Strength, TreeLook, tree_tint};
+    let scene = raytree::scene::builtin::load_builtin("default").expect("built in");
+    let tracer = Tracer::new(Arc::new(scene.clone()), TraceSettings::default());
+    let (w, h) = (scene.render.width, scene.render.height);
+    // A pixel of the glass sphere: reflected and refracted rays, seen from the side.
+    let (x, y) = (w * 3 / 8, h * 23 / 40);
+    let tree = raytree::ray_tree::pixel_tree(&tracer, x, y).expect("inside");
+    assert!(tree.nodes > 3, "the pixel's tree branches ({} nodes)", tree.nodes);
+    // Over a black image every lit pixel is a ray's colour (or a light's disc).
+    let black = raytree::render::Image::new(w, h);
+    let tint = tree_tint(3);
+    let share_in_tint = |look: Option<TreeLook>| {
+        let layer = headless::Layer {
+            tree: &tree,
+            look,
+            depth: None,
+        };
+        let canvas =
+            headless::overlay_image(&tracer, &black, &[layer], &Filter::default()).expect("drawn");
+        let t = Vec3::new(tint[0] as f32, tint[1] as f32, tint[2] as f32).normalize();
+        let (mut lit, mut tinted) = (0, 0);
+        for p in canvas.rgba().chunks(4) {
+            let c = Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
+            if c.max_element() < 24.0 {
+                continue;
+            }
+            lit += 1;
+            if c.normalize().dot(t) > 0.995 {
+                tinted += 1;
+            }
+        }
+        assert!(lit > 50, "the tree is drawn ({lit} lit pixels)");
+        tinted as f32 / lit as f32
+    };
+    let faint = share_in_tint(Some(TreeLook {
+        tint,
+        strength: Strength::Faint,
+    }));
+    let own = share_in_tint(None);
+    assert!(faint > 0.8, "{:.0} % of the faint tree is in its tint", faint * 100.0);
+    assert!(own < 0.2, "{:.0} % of the tree alone is in the tint", own * 100.0);
 }

@@ -18,7 +18,7 @@ use eframe::egui;
 use egui::accesskit::Role;
 use egui_kittest::kittest::NodeT as _;
 use egui_kittest::kittest::Queryable;
-use raytree::app::messages::Message;
+use raytree::app::messages::{MAX_TOASTS, Message};
 use raytree::render::render;
 use raytree::scene::Scene;
 use raytree::trace::{TraceSettings, Tracer};
@@ -696,6 +696,7 @@ fn toasts_do_not_move_the_layout() {
     let before = h.get_by_label("render viewport").rect();
     let menu = h.get_by_label("Scene").rect();
     let shown = h.state().messages.toasts_shown();
+    let logged = h.state().messages.len();
     for i in 0..4 {
         let text = format!("message {i}");
         let message = if i % 2 == 0 {
@@ -706,7 +707,11 @@ fn toasts_do_not_move_the_layout() {
         h.state_mut().messages.push(message);
     }
     h.run_steps(3);
-    assert_eq!(h.state().messages.toasts_shown(), shown + 4);
+    // At most three at once, the newest; all four are in the log.
+    assert_eq!(h.state().messages.toasts_shown(), (shown + 4).min(MAX_TOASTS));
+    assert!(h.query_by_label_contains("message 3").is_some());
+    assert!(h.query_by_label_contains("message 0").is_none());
+    assert_eq!(h.state().messages.len(), logged + 4);
     assert_eq!(h.get_by_label("render viewport").rect(), before);
     assert_eq!(h.get_by_label("Scene").rect(), menu);
 }

@@ -10,6 +10,7 @@
 //! [`ViewerApp::apply`] carries them out once, at the end of the frame, where any edit restarts
 //! the progressive render with a new generation.
 
+mod changes;
 mod dialog;
 mod film;
 pub mod gesture;
@@ -158,8 +159,11 @@ impl ViewerApp {
             workspace,
             pending: Vec::new(),
         };
-        for w in app.render.scene().warnings.clone() {
-            app.messages.notice(w);
+        // A built-in scene without notes needs no word at start; a file gets its summary.
+        let scene = app.render.scene();
+        if scene.source.is_some() || !scene.warnings.is_empty() {
+            let first = open_scene::opened_message(scene, &app.files.label, None);
+            app.messages.push(first);
         }
         app.files.watch(&app.working.scene, &mut app.messages);
         app.restart(false, Reach::RenderAndSceneView);
@@ -379,6 +383,19 @@ impl ViewerApp {
         }
     }
 
+    /// Keeps the edits of the moment a tree was pinned, and names what changed since.
+    fn note_pin(&mut self) {
+        let state = &mut self.selection.tree_state;
+        if state.pinned.is_none() {
+            state.pinned_edits = None;
+            state.edited_since_pin.clear();
+            return;
+        }
+        let now = self.working.edits();
+        let before = state.pinned_edits.get_or_insert_with(|| now.clone());
+        state.edited_since_pin = changes::between(before, &now, &self.working.scene);
+    }
+
     /// Carries out the queued commands.
     pub fn apply(&mut self) {
         let commands = std::mem::take(&mut self.pending);
@@ -401,7 +418,7 @@ impl ViewerApp {
                     Ok(s) => {
                         // Built-in scenes are tiny: opened at once, superseding any open.
                         self.files.cancel();
-                        self.replace_scene(s, name);
+                        self.replace_scene(s, name, None);
                         self.files.unwatch();
                         rebuild = true;
                         restart = true;

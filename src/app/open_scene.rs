@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
+use super::messages::Message;
 use super::opening::{self, OpenKind};
 use super::render_view::Reach;
 use super::{ViewerApp, undo};
@@ -67,24 +68,21 @@ impl ViewerApp {
         } = opened;
         let reloaded = format!("reloaded {} after a save", path.display());
         if same_geometry {
-            for w in &edit.warnings {
-                self.messages.notice(w.clone());
-            }
+            let label = path.display().to_string();
+            self.messages
+                .push(opened_message(&edit, &label, Some(reloaded)));
             // The camera as it is now (it may have moved while the file was read), the
             // accelerator shown kept: rendered as any edit is.
             let camera = self.working.scene.camera.clone();
             self.working.scene = edit;
             self.working.scene.camera = camera;
-            self.messages.notice(reloaded);
             self.files.learn(timings);
             self.files.watch(&self.working.scene, &mut self.messages);
             self.restart(false, Reach::RenderAndSceneView);
             return;
         }
-        self.replace_scene(edit, path.display().to_string());
-        if kind == OpenKind::Reload {
-            self.messages.notice(reloaded);
-        }
+        let said = (kind == OpenKind::Reload).then_some(reloaded);
+        self.replace_scene(edit, path.display().to_string(), said);
         if let Some(message) = fit.message {
             self.messages.error(message);
         }
@@ -96,15 +94,38 @@ impl ViewerApp {
     }
 
     /// Makes `s` the working copy, named `label`: nothing of the old scene stays picked, the
-    /// scene view frames the new one, and the history starts over.
-    pub(super) fn replace_scene(&mut self, s: Scene, label: String) {
-        for w in &s.warnings {
-            self.messages.notice(w.clone());
-        }
+    /// scene view frames the new one, and the history starts over. One message says so
+    /// ([`opened_message`]; `said` is its sentence instead of the scene's summary).
+    pub(super) fn replace_scene(&mut self, s: Scene, label: String, said: Option<String>) {
+        self.messages.push(opened_message(&s, &label, said));
         self.working.scene = s;
         self.working.history = undo::History::default();
         self.files.label = label;
         self.selection.clear();
         self.scene_view.unframe();
     }
+}
+
+/// The one message of an open: "kitchen.obj: 57k triangles, 30 materials, 1 light; 5 notes",
+/// the loader's notes behind it as details. A scene without notes from a built-in name says
+/// nothing more than the window's title does, but still one line, so every open is logged.
+pub(super) fn opened_message(scene: &Scene, label: &str, said: Option<String>) -> Message {
+    use crate::plural::{count, count_short};
+    let name = std::path::Path::new(label)
+        .file_name()
+        .map_or(label.to_string(), |n| n.to_string_lossy().into_owned());
+    let mut parts = Vec::new();
+    if !scene.triangles.is_empty() {
+        parts.push(count_short(scene.triangles.len() as u64, "triangle"));
+    }
+    if !scene.spheres.is_empty() {
+        parts.push(count(scene.spheres.len() as u64, "sphere"));
+    }
+    parts.push(count(scene.materials.len() as u64, "material"));
+    parts.push(count(scene.lights.len() as u64, "light"));
+    let mut text = said.unwrap_or_else(|| format!("opened {name}: {}", parts.join(", ")));
+    if !scene.warnings.is_empty() {
+        text.push_str(&format!("; {}", count(scene.warnings.len() as u64, "note")));
+    }
+    Message::notice(text).with_details(scene.warnings.clone())
 }

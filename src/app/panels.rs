@@ -689,6 +689,7 @@ pub fn tree_panel(ui: &mut Ui, selection: &mut TreeSelection, ws: &mut Workspace
         .max_height(ui.available_height() * 0.5)
         .show(ui, |ui| match state.pinned.clone() {
             Some(pinned) => {
+                tree_view::say_changes(ui, state, &crate::diagram::changes(&pinned, &tree));
                 ui.label("changed nodes are marked *");
                 ui.columns(2, |cols| {
                     cols[0].label(format!(

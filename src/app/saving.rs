@@ -8,8 +8,8 @@ use std::sync::Arc;
 use super::ViewerApp;
 use super::messages::Message;
 use crate::export;
-use crate::ray_tree::RayTree;
 use crate::scene;
+use crate::scene_view::headless::Layer;
 use crate::trace::Tracer;
 
 /// A picture drawn with the trees.
@@ -145,7 +145,7 @@ impl ViewerApp {
 
     /// Writes `picture` as a stamped PNG, drawn by the headless scene view's rules.
     pub(super) fn export_drawn(&mut self, path: &Path, picture: Drawn) {
-        let Some(tree) = self.selection.tree.clone() else {
+        if self.selection.tree.is_none() {
             self.messages
                 .error("no ray tree to draw: click a pixel first");
             return;
@@ -155,12 +155,22 @@ impl ViewerApp {
             ..self.scene_view.filter.clone()
         };
         let scene = self.render.scene().clone();
+        let layers: Vec<Layer> = self
+            .selection
+            .layers()
+            .into_iter()
+            .map(|(tree, _, look, depth)| Layer {
+                tree,
+                look: Some(look),
+                depth,
+            })
+            .collect();
         let drawn = if picture == Drawn::SceneView {
             let (w, h) = self.render.scene_size;
             crate::scene_view::headless::scene_view_image(
                 &scene,
                 self.working.settings.trace,
-                &tree,
+                &layers,
                 &self.scene_view.camera,
                 w,
                 h,
@@ -168,11 +178,10 @@ impl ViewerApp {
                 self.scene_view.cutaway,
             )
         } else {
-            let trees: Vec<&RayTree> = self.selection.trees().collect();
             crate::scene_view::headless::overlay_image(
                 &self.render.tracer,
                 &self.render.image(),
-                &trees,
+                &layers,
                 &filter,
             )
         };

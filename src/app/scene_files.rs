@@ -20,6 +20,8 @@ pub struct SceneFiles {
     job: Option<OpenJob>,
     /// Called by background opens at each stage (the tests hold an open with it).
     hook: Option<Arc<OpenHook>>,
+    /// Wakes the UI when a watched file changes.
+    waker: Option<watch::Waker>,
     /// Rates of the stages of the last open, for the next one's progress estimate.
     rates: Rates,
     /// Times of the last open, for the record (benchmarks print them).
@@ -33,6 +35,7 @@ impl SceneFiles {
             watch: None,
             job: None,
             hook: None,
+            waker: None,
             rates: Rates::default(),
             last_open: None,
         }
@@ -44,7 +47,7 @@ impl SceneFiles {
         let Some(source) = scene.source.clone() else {
             return;
         };
-        match SceneWatch::new(&watch::scene_files(scene, &source)) {
+        match SceneWatch::new(&watch::scene_files(scene, &source), self.waker.clone()) {
             Ok(w) => self.watch = Some(w),
             Err(e) => messages.notice(e),
         }
@@ -59,9 +62,27 @@ impl SceneFiles {
         self.watch.is_some()
     }
 
-    /// True while a saved change waits for its reload (the UI keeps polling).
+    /// Sets what wakes the UI when a watched file changes (taking effect at the next watch;
+    /// the scene watched now is watched again with it).
+    pub fn wake_with(&mut self, waker: watch::Waker, scene: &Scene, messages: &mut Messages) {
+        self.waker = Some(waker);
+        if self.watch.is_some() {
+            self.watch(scene, messages);
+        }
+    }
+
+    pub fn has_waker(&self) -> bool {
+        self.waker.is_some()
+    }
+
+    /// True while a saved change waits for its reload.
     pub fn reload_pending(&self) -> bool {
-        self.watch.as_ref().is_some_and(SceneWatch::pending)
+        self.reload_in().is_some()
+    }
+
+    /// When the saved change waiting for its reload settles (`None`: none waits).
+    pub fn reload_in(&self) -> Option<std::time::Duration> {
+        self.watch.as_ref().and_then(SceneWatch::settles_in)
     }
 
     /// Whether the watched files were saved and have settled: time to reload.

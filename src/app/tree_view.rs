@@ -11,6 +11,7 @@ use egui_extras::{Column, TableBuilder};
 use glam::Vec3;
 
 pub use crate::diagram::end_text as end_label;
+use super::undo::Edits;
 use crate::diagram::{self, Glyph, Mark, descendants, end_text};
 use crate::ray_tree::{Node, RayTree};
 use crate::scene::Shading;
@@ -23,6 +24,10 @@ pub struct TreeState {
     pub selected: Option<NodePath>,
     pub hovered: Option<NodePath>,
     pub pinned: Option<RayTree>,
+    /// The viewer's edits when the tree was pinned, and what the user changed since, one
+    /// phrase each ([`super::changes::between`]): the cause the compare view names.
+    pub pinned_edits: Option<Edits>,
+    pub edited_since_pin: Vec<String>,
     /// The step-through: show generations `0..=n` only (`None`: all).
     pub reveal: Option<u32>,
     /// Nodes whose subtrees are folded in the list and the diagram (each shows "+N").
@@ -697,12 +702,7 @@ pub fn compare(
             export = true;
         }
     });
-    let text = if changes.is_empty() {
-        "no change between the pinned tree and the current one".to_string()
-    } else {
-        format!("changed: {}", changes.join("; "))
-    };
-    ui.add(egui::Label::new(egui::RichText::new(text).color(CHANGED)).wrap());
+    say_changes(ui, state, &changes);
     let mut none = |_: &mut Ui| {};
     ui.columns(2, |cols| {
         cols[0].label(format!(
@@ -731,6 +731,21 @@ pub fn compare(
         );
     });
     export
+}
+
+/// What the user changed since the pin (the cause), then what changed in the tree (the
+/// effect), each wrapped to the pane.
+pub fn say_changes(ui: &mut Ui, state: &TreeState, in_tree: &[String]) {
+    if !state.edited_since_pin.is_empty() {
+        let text = format!("you changed: {}", state.edited_since_pin.join("; "));
+        ui.add(egui::Label::new(egui::RichText::new(text).strong()).wrap());
+    }
+    let text = if in_tree.is_empty() {
+        "no change between the pinned tree and the current one".to_string()
+    } else {
+        format!("in the tree: {}", in_tree.join("; "))
+    };
+    ui.add(egui::Label::new(egui::RichText::new(text).color(CHANGED)).wrap());
 }
 
 /// Outline of the nodes that differ from the other tree's.

@@ -9,6 +9,7 @@
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::sync::mpsc::{Receiver, TryRecvError, channel};
 use std::time::{Duration, Instant};
 
@@ -24,13 +25,16 @@ pub const DEBOUNCE: Duration = Duration::from_millis(200);
 /// by name: the ones the scene uses are in its file list.
 const COMPANIONS: &[&str] = &["mtl"];
 
+/// Called by the watcher's thread on a relevant change, to wake the UI (which otherwise
+/// sleeps: an idle viewer requests no frame).
+pub type Waker = Arc<dyn Fn() + Send + Sync>;
+
 pub struct SceneWatch {
     _watcher: notify::RecommendedWatcher,
-    events: Receiver<notify::Result<notify::Event>>,
-    /// The scene file, its meshes and its textures, as the watcher reports them (absolute).
-    files: BTreeSet<PathBuf>,
-    /// Folders of the meshes, where material libraries count too.
-    mesh_folders: BTreeSet<PathBuf>,
+    /// The relevant changes, as the watcher's thread found them.
+    events: Receiver<()>,
+    /// The files watched, for the record.
+    files: Arc<Relevant>,
     /// The last relevant change not yet acted upon.
     changed: Option<Instant>,
 }
@@ -38,8 +42,35 @@ pub struct SceneWatch {
 impl std::fmt::Debug for SceneWatch {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("SceneWatch")
-            .field("files", &self.files)
+            .field("files", &self.files.files)
             .finish()
+    }
+}
+
+/// Which changed paths matter: the scene's files, and material libraries beside its meshes.
+struct Relevant {
+    /// The scene file, its meshes and its textures, as the watcher reports them (absolute).
+    files: BTreeSet<PathBuf>,
+    /// Folders of the meshes, where material libraries count too.
+    mesh_folders: BTreeSet<PathBuf>,
+}
+
+impl Relevant {
+    fn path(&self, path: &Path) -> bool {
+        if self.files.contains(path) || self.files.contains(&absolute(path)) {
+            return true;
+        }
+        let companion = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| COMPANIONS.iter().any(|c| e.eq_ignore_ascii_case(c)));
+        companion && path.parent().is_some_and(|p| self.mesh_folders.contains(p))
+    }
+
+    /// A write (not a mere read) of a relevant file.
+    fn event(&self, event: &notify::Event) -> bool {
+        !matches!(event.kind, notify::EventKind::Access(_))
+            && event.paths.iter().any(|p| self.path(p))
     }
 }
 
@@ -72,18 +103,29 @@ pub fn scene_files(scene: &Scene, source: &Path) -> Vec<PathBuf> {
 }
 
 impl SceneWatch {
-    /// Watches `files` (the first is the scene file) and the companions of the others.
-    pub fn new(files: &[PathBuf]) -> Result<Self, String> {
-        let (tx, events) = channel();
-        let mut watcher = notify::recommended_watcher(move |e| {
-            let _ = tx.send(e);
-        })
-        .map_err(|e| format!("cannot watch the scene for changes: {e}"))?;
+    /// Watches `files` (the first is the scene file) and the companions of the others; a
+    /// relevant change calls `wake` (from the watcher's thread), nothing else does.
+    pub fn new(files: &[PathBuf], wake: Option<Waker>) -> Result<Self, String> {
         let files: BTreeSet<PathBuf> = files.iter().map(|f| absolute(f)).collect();
         let folders: BTreeSet<PathBuf> = files
             .iter()
             .filter_map(|f| f.parent().map(Path::to_path_buf))
             .collect();
+        let relevant = Arc::new(Relevant {
+            files,
+            mesh_folders: folders.clone(),
+        });
+        let (tx, events) = channel();
+        let sees = relevant.clone();
+        let mut watcher = notify::recommended_watcher(move |e: notify::Result<notify::Event>| {
+            if e.is_ok_and(|e| sees.event(&e)) {
+                let _ = tx.send(());
+                if let Some(wake) = &wake {
+                    wake();
+                }
+            }
+        })
+        .map_err(|e| format!("cannot watch the scene for changes: {e}"))?;
         for folder in &folders {
             watcher
                 .watch(folder, RecursiveMode::NonRecursive)
@@ -92,21 +134,9 @@ impl SceneWatch {
         Ok(Self {
             _watcher: watcher,
             events,
-            mesh_folders: folders,
-            files,
+            files: relevant,
             changed: None,
         })
-    }
-
-    fn relevant(&self, path: &Path) -> bool {
-        if self.files.contains(path) || self.files.contains(&absolute(path)) {
-            return true;
-        }
-        let companion = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .is_some_and(|e| COMPANIONS.iter().any(|c| e.eq_ignore_ascii_case(c)));
-        companion && path.parent().is_some_and(|p| self.mesh_folders.contains(p))
     }
 
     /// Takes the changes reported so far; true once, when the last relevant one is
@@ -114,13 +144,7 @@ impl SceneWatch {
     pub fn poll(&mut self) -> bool {
         loop {
             match self.events.try_recv() {
-                Ok(Ok(event)) => {
-                    let writes = !matches!(event.kind, notify::EventKind::Access(_));
-                    if writes && event.paths.iter().any(|p| self.relevant(p)) {
-                        self.changed = Some(Instant::now());
-                    }
-                }
-                Ok(Err(_)) => {}
+                Ok(()) => self.changed = Some(Instant::now()),
                 Err(TryRecvError::Empty | TryRecvError::Disconnected) => break,
             }
         }
@@ -133,8 +157,10 @@ impl SceneWatch {
         }
     }
 
-    /// True while a change waits out its debounce (the UI keeps polling).
-    pub fn pending(&self) -> bool {
-        self.changed.is_some()
+    /// How long the last change still has to settle before its reload (`None`: no change
+    /// waiting): the UI asks for a frame then, and for none while nothing changes.
+    pub fn settles_in(&self) -> Option<Duration> {
+        self.changed
+            .map(|t| DEBOUNCE.saturating_sub(t.elapsed()))
     }
 }

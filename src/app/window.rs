@@ -58,6 +58,12 @@ pub fn run(scene_arg: Option<&str>) -> anyhow::Result<()> {
 impl eframe::App for ViewerApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
+        if !self.files.has_waker() {
+            let wake = ctx.clone();
+            let waker: watch::Waker = std::sync::Arc::new(move || wake.request_repaint());
+            self.files
+                .wake_with(waker, &self.working.scene, &mut self.messages);
+        }
         self.poll_session();
         self.render.poll_export(&mut self.messages);
         input::shortcuts(
@@ -172,17 +178,22 @@ impl eframe::App for ViewerApp {
             working.scene.render.samples = point.samples;
             working.settings.trace = point.trace;
             self.pending.push(Command::Rebuild);
+            // The sample count is the viewer's own target too: the image shown refines to it.
+            let pane_size = self.workspace.prefs.pane_size;
+            self.set_view(point.samples, pane_size);
         }
         self.messages.show(&ctx);
         self.apply();
         self.working.track(&ctx);
+        self.note_pin();
         self.render.follow_display_prefs(&self.workspace.prefs);
         if !self.is_finished() || !self.scene_view.is_finished() || self.render.export_job.is_some()
         {
             ctx.request_repaint();
-        } else if self.files.is_watched() {
-            // Idle: wake up now and then to see whether the scene was saved.
-            ctx.request_repaint_after(watch::DEBOUNCE);
+        } else if let Some(wait) = self.files.reload_in() {
+            // A save settles: one frame when it has, to reload. Otherwise an idle viewer asks
+            // for no frame at all; the watcher wakes it on a change of the scene's files.
+            ctx.request_repaint_after(wait);
         }
     }
 
@@ -225,7 +236,8 @@ fn tree_window(app: &mut ViewerApp, ctx: &egui::Context) {
         |ui, _class| {
             let mut dock = ui.ctx().input(|i| i.viewport().close_requested());
             egui::CentralPanel::default().show(ui, |ui| {
-                let Some(tree) = app.selection.tree.clone() else {
+                let Some(tree) = super::picker::strip(ui, &mut app.selection, &app.render.tracer)
+                else {
                     ui.weak("click a pixel in the render view for its ray tree");
                     dock |= ui.button("Dock back").clicked();
                     return;
@@ -240,12 +252,14 @@ fn tree_window(app: &mut ViewerApp, ctx: &egui::Context) {
                                     .on_hover_text("the panes back into the main window")
                                     .clicked();
                             };
-                            if tree_view::diagram(
-                                ui,
-                                &tree,
-                                &mut app.selection.tree_state,
-                                &mut tools,
-                            ) {
+                            let state = &mut app.selection.tree_state;
+                            let export = match state.pinned.clone() {
+                                Some(pinned) => {
+                                    tree_view::compare(ui, &tree, &pinned, state, &mut tools)
+                                }
+                                None => tree_view::diagram(ui, &tree, state, &mut tools),
+                            };
+                            if export {
                                 let name = format!("tree-{}-{}.svg", tree.pixel[0], tree.pixel[1]);
                                 app.workspace.browse(BrowseFor::ExportDiagram, &name);
                             }

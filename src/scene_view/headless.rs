@@ -7,12 +7,55 @@ use std::sync::Arc;
 use super::cutaway::{Cutaway, cut_triangles, with_cut};
 use super::occlusion::DepthImage;
 use super::raster::Canvas;
-use super::{Filter, Segment, camera_segments, extent, light_markers, tree_segments};
+use super::{Filter, Segment, TreeLook, camera_segments, extent, light_markers, tree_segments};
 use crate::export::srgb8_bytes;
 use crate::ray_tree::RayTree;
 use crate::render::{Image, RenderError, render};
 use crate::scene::{Camera, CameraFrame, Scene};
 use crate::trace::{TraceSettings, Tracer};
+
+/// One tree of an exported picture: how it is drawn among the others (`None`: alone, in the
+/// styles' own colours) and the generation it is drawn down to (`None`: as the filter says).
+#[derive(Clone, Copy, Debug)]
+pub struct Layer<'a> {
+    pub tree: &'a RayTree,
+    pub look: Option<TreeLook>,
+    pub depth: Option<u32>,
+}
+
+impl<'a> Layer<'a> {
+    /// A tree drawn alone.
+    pub fn alone(tree: &'a RayTree) -> Self {
+        Self {
+            tree,
+            look: None,
+            depth: None,
+        }
+    }
+}
+
+/// Draws `layers` back to front (the last is drawn on top), each tree's segments that `filter`
+/// (cut at the layer's depth) shows.
+fn draw_layers(
+    canvas: &mut Canvas,
+    frame: &CameraFrame,
+    depth: &DepthImage,
+    layers: &[Layer],
+    filter: &Filter,
+    extent: f32,
+) {
+    for layer in layers {
+        let filter = Filter {
+            max_generation: layer
+                .depth
+                .map_or(filter.max_generation, |d| d.min(filter.max_generation)),
+            ..filter.clone()
+        };
+        let segments = tree_segments(layer.tree, extent);
+        let shown: Vec<&Segment> = segments.iter().filter(|s| filter.shows(s)).collect();
+        canvas.draw_tree_segments(frame, depth, &shown, None, layer.look);
+    }
+}
 
 /// A scene view that could not be made.
 #[derive(Debug, thiserror::Error)]
@@ -43,8 +86,8 @@ pub fn image_plane_distance(scene: &Scene, tree: &RayTree) -> f32 {
 
 /// `scene` rendered from `view` at `width × height` with raytree's own 1-sample render (the
 /// scene's settings, `settings` for tracing), with the render camera of `scene` (frustum, image
-/// plane, the tree's pixel), its lights and the segments of `tree` that `filter` shows drawn
-/// over it; parts behind surfaces are dimmed. With `cutaway` active for the view's eye
+/// plane, the pixel of the last layer's tree), its lights and the segments of the `layers`'
+/// trees that `filter` shows drawn over it; parts behind surfaces are dimmed. With `cutaway` active for the view's eye
 /// ([`Cutaway::active`]) the walls between the eye and the render camera are left out of the
 /// render and of the depth the rays are hidden by ([`super::cutaway`]). The result is 8-bit
 /// sRGB, converted from the render as PNG export does.
@@ -52,7 +95,7 @@ pub fn image_plane_distance(scene: &Scene, tree: &RayTree) -> f32 {
 pub fn scene_view_image(
     scene: &Scene,
     settings: TraceSettings,
-    tree: &RayTree,
+    layers: &[Layer],
     view: &Camera,
     width: u32,
     height: u32,
@@ -74,21 +117,24 @@ pub fn scene_view_image(
     let mut canvas = Canvas::from_srgb8(width, height, &srgb8_bytes(&image))
         .ok_or(SceneViewError::Empty { width, height })?;
 
-    let mut segments = camera_segments(scene, image_plane_distance(scene, tree), Some(tree.pixel));
-    segments.extend(tree_segments(tree, extent(scene)));
-    let shown: Vec<&Segment> = segments.iter().filter(|s| filter.shows(s)).collect();
-    canvas.draw_segments(&frame, &depth, &shown, None);
+    if let Some(last) = layers.last() {
+        let plane = image_plane_distance(scene, last.tree);
+        let camera = camera_segments(scene, plane, Some(last.tree.pixel));
+        let shown: Vec<&Segment> = camera.iter().filter(|s| filter.shows(s)).collect();
+        canvas.draw_segments(&frame, &depth, &shown, None);
+    }
+    draw_layers(&mut canvas, &frame, &depth, layers, filter, extent(scene));
     canvas.draw_light_markers(&frame, &depth, &light_markers(scene));
     Ok(canvas)
 }
 
-/// The render `image` of `tracer`'s scene (its own camera and size) with `trees` drawn over it
-/// by the scene view's rules, parts behind surfaces dimmed: the viewer's "render with overlay"
-/// export, at full resolution.
+/// The render `image` of `tracer`'s scene (its own camera and size) with the `layers`' trees
+/// drawn over it by the scene view's rules, parts behind surfaces dimmed: the viewer's "render
+/// with overlay" export, at full resolution.
 pub fn overlay_image(
     tracer: &Tracer,
     image: &Image,
-    trees: &[&RayTree],
+    layers: &[Layer],
     filter: &Filter,
 ) -> Result<Canvas, SceneViewError> {
     let scene = &tracer.scene;
@@ -97,14 +143,7 @@ pub fn overlay_image(
     let depth = DepthImage::of(tracer, &frame, width, height);
     let mut canvas = Canvas::from_srgb8(width, height, &srgb8_bytes(image))
         .ok_or(SceneViewError::Empty { width, height })?;
-    let extent = extent(scene);
-    let segments: Vec<Segment> = trees
-        .iter()
-        .flat_map(|t| tree_segments(t, extent))
-        .filter(|s| filter.shows(s))
-        .collect();
-    let shown: Vec<&Segment> = segments.iter().collect();
-    canvas.draw_segments(&frame, &depth, &shown, None);
+    draw_layers(&mut canvas, &frame, &depth, layers, filter, extent(scene));
     canvas.draw_light_markers(&frame, &depth, &light_markers(scene));
     Ok(canvas)
 }

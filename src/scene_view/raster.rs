@@ -10,7 +10,7 @@ use glam::Vec2;
 use tiny_skia::{Color, FillRule, LineCap, Paint, PathBuilder, Pixmap, Stroke, Transform};
 
 use super::occlusion::{DepthImage, Piece, clip_to_rect, point_sight, visible_pieces};
-use super::{HIGHLIGHT_RGB, LightMarker, Segment, style_rgba};
+use super::{HIGHLIGHT_RGB, LightMarker, Segment, TreeLook, style_rgba};
 use crate::scene::CameraFrame;
 
 /// What a hidden piece keeps of its opacity.
@@ -128,7 +128,21 @@ impl Canvas {
         segments: &[&Segment],
         highlight: Option<&[usize]>,
     ) {
-        let width = line_width(self.height());
+        self.draw_tree_segments(frame, depth, segments, highlight, None);
+    }
+
+    /// [`Self::draw_segments`] for one tree among several: `look` gives its tint and strength
+    /// as the viewer draws it (a faint tree thinner, in its tint, without normals); `None`
+    /// draws the styles' own colours.
+    pub fn draw_tree_segments(
+        &mut self,
+        frame: &CameraFrame,
+        depth: &DepthImage,
+        segments: &[&Segment],
+        highlight: Option<&[usize]>,
+        look: Option<TreeLook>,
+    ) {
+        let width = line_width(self.height()) * look.map_or(1.0, |l| l.width());
         let split: Vec<(&Segment, Vec<Piece>)> = segments
             .iter()
             .map(|s| (*s, visible_pieces(s.a, s.b, frame, depth)))
@@ -144,7 +158,11 @@ impl Canvas {
                 let highlighted = highlight.is_some_and(|h| h == segment.path.as_slice());
                 for piece in pieces {
                     let Some((a, b)) = ends(piece) else { continue };
-                    let [r, g, bl, alpha] = style_rgba(segment.style);
+                    let [r, g, bl, alpha] =
+                        look.map_or_else(|| style_rgba(segment.style), |l| l.rgba(segment.style));
+                    if alpha == 0 {
+                        continue;
+                    }
                     let dim = |alpha: u8| (f32::from(alpha) * HIDDEN_OPACITY).round() as u8;
                     match pass {
                         Pass::Hidden if piece.hidden => {
