@@ -510,7 +510,11 @@ fn an_exported_overlay_draws_a_faint_tree_in_its_tint() {
     // A pixel of the glass sphere: reflected and refracted rays, seen from the side.
     let (x, y) = (w * 3 / 8, h * 23 / 40);
     let tree = raytree::ray_tree::pixel_tree(&tracer, x, y).expect("inside");
-    assert!(tree.nodes > 3, "the pixel's tree branches ({} nodes)", tree.nodes);
+    assert!(
+        tree.nodes > 3,
+        "the pixel's tree branches ({} nodes)",
+        tree.nodes
+    );
     // Over a black image every lit pixel is a ray's colour (or a light's disc).
     let black = raytree::render::Image::new(w, h);
     let tint = tree_tint(3);
@@ -542,6 +546,14 @@ fn an_exported_overlay_draws_a_faint_tree_in_its_tint() {
         strength: Strength::Faint,
     }));
     let own = share_in_tint(None);
-    assert!(faint > 0.8, "{:.0} % of the faint tree is in its tint", faint * 100.0);
-    assert!(own < 0.2, "{:.0} % of the tree alone is in the tint", own * 100.0);
+    assert!(
+        faint > 0.8,
+        "{:.0} % of the faint tree is in its tint",
+        faint * 100.0
+    );
+    assert!(
+        own < 0.2,
+        "{:.0} % of the tree alone is in the tint",
+        own * 100.0
+    );
 }

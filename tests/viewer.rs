@@ -708,7 +708,10 @@ fn toasts_do_not_move_the_layout() {
     }
     h.run_steps(3);
     // At most three at once, the newest; all four are in the log.
-    assert_eq!(h.state().messages.toasts_shown(), (shown + 4).min(MAX_TOASTS));
+    assert_eq!(
+        h.state().messages.toasts_shown(),
+        (shown + 4).min(MAX_TOASTS)
+    );
     assert!(h.query_by_label_contains("message 3").is_some());
     assert!(h.query_by_label_contains("message 0").is_none());
     assert_eq!(h.state().messages.len(), logged + 4);

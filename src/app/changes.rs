@@ -177,7 +177,10 @@ mod tests {
             said.contains(&format!("material {name}: ior {ior} \u{2192} 1.3")),
             "{said:?}"
         );
-        assert!(said.iter().any(|s| s.starts_with("camera: fov_y")), "{said:?}");
+        assert!(
+            said.iter().any(|s| s.starts_with("camera: fov_y")),
+            "{said:?}"
+        );
         assert_eq!(said.len(), 2, "{said:?}");
         assert!(between(&before, &before, &scene).is_empty());
     }

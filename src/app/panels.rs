@@ -235,6 +235,15 @@ pub fn top_bar(
                 }
                 ui.separator();
                 workspace::pane_toggles(ws, messages, ui);
+                ui.separator();
+                let n = crate::plural::count(messages.len(), "message");
+                if ui
+                    .button(format!("Messages ({n})"))
+                    .on_hover_text("every notice and error so far, with their details")
+                    .clicked()
+                {
+                    messages.window = true;
+                }
             });
             if ui.button("Speed vs accuracy").clicked() {
                 ws.sweep.open = true;

@@ -10,8 +10,8 @@ use eframe::egui::{self, Color32, Pos2, Rect, Response, RichText, Sense, Stroke,
 use egui_extras::{Column, TableBuilder};
 use glam::Vec3;
 
-pub use crate::diagram::end_text as end_label;
 use super::undo::Edits;
+pub use crate::diagram::end_text as end_label;
 use crate::diagram::{self, Glyph, Mark, descendants, end_text};
 use crate::ray_tree::{Node, RayTree};
 use crate::scene::Shading;

@@ -160,7 +160,6 @@ impl SceneWatch {
     /// How long the last change still has to settle before its reload (`None`: no change
     /// waiting): the UI asks for a frame then, and for none while nothing changes.
     pub fn settles_in(&self) -> Option<Duration> {
-        self.changed
-            .map(|t| DEBOUNCE.saturating_sub(t.elapsed()))
+        self.changed.map(|t| DEBOUNCE.saturating_sub(t.elapsed()))
     }
 }

@@ -183,6 +183,7 @@ impl eframe::App for ViewerApp {
             self.set_view(point.samples, pane_size);
         }
         self.messages.show(&ctx);
+        self.messages.log_window(&ctx);
         self.apply();
         self.working.track(&ctx);
         self.note_pin();

@@ -178,17 +178,16 @@ fn write_scene_view(
     let scene = &tracer.scene;
     let (w, h) = (scene.render.width, scene.render.height);
     let filter = Filter::default();
-    let canvas =
-        headless::scene_view_image(
-            scene,
-            tracer.settings,
-            &[headless::Layer::alone(tree)],
-            view,
-            w,
-            h,
-            &filter,
-            cutaway,
-        )?;
+    let canvas = headless::scene_view_image(
+        scene,
+        tracer.settings,
+        &[headless::Layer::alone(tree)],
+        view,
+        w,
+        h,
+        &filter,
+        cutaway,
+    )?;
     let text = export::stamp(
         label,
         1,
