@@ -12,7 +12,7 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use super::{
-    Control, Event, Goal, Lesson, LessonError, NodeRef, Quantity, Question, Step, Task, TaskKind,
+    Control, Event, Goal, Lesson, LessonError, NodeRef, Quantity, Question, Step, TaskKind,
     end_phrase, names_object, node_name,
 };
 use crate::choice::Choice;
@@ -164,7 +164,7 @@ pub fn evaluate(
                 question,
             },
             Answer::Choice(key),
-        ) => evaluate_choice(step, task, *pixel, node, question, key, scene, settings)?,
+        ) => evaluate_choice(step, *pixel, node, question, key, scene, settings)?,
         (kind, _) => {
             let wanted = match kind {
                 TaskKind::Pixel { .. } => "a pixel (--pixel X,Y)",
@@ -626,9 +626,12 @@ pub fn choice_options(question: &Question) -> Vec<ChoiceOption> {
             o("t", "a refracted ray T only"),
             o("rt", "both R and T"),
         ],
-        Question::Object { options } | Question::Fixed { options, .. } => {
-            options.iter().map(|s| o(s, s)).collect()
-        }
+        Question::Object { options } => options.iter().map(|s| o(s, s)).collect(),
+        Question::Fixed { options, .. } => options
+            .iter()
+            .enumerate()
+            .map(|(i, s)| o(&letter(i).to_string(), s))
+            .collect(),
     }
 }
 
@@ -699,8 +702,13 @@ fn right_key(question: &Question, node: &Node) -> Result<String, String> {
                     )
                 })?
         }
-        Question::Fixed { options, answer } => options[*answer].clone(),
+        Question::Fixed { answer, .. } => letter(*answer).to_string(),
     })
+}
+
+/// The letter of the option at place `i`: a, b, c, ...
+fn letter(i: usize) -> char {
+    (b'a' + (i % 26) as u8) as char
 }
 
 /// The option an answer names: its key (any case) or its letter.
@@ -722,7 +730,6 @@ fn pick<'o>(options: &'o [ChoiceOption], answer: &str) -> Option<&'o ChoiceOptio
 #[allow(clippy::too_many_arguments)]
 fn evaluate_choice(
     step: &Step,
-    task: &Task,
     pixel: [u32; 2],
     node: &NodeRef,
     question: &Question,
@@ -735,7 +742,7 @@ fn evaluate_choice(
         let listed: Vec<String> = options
             .iter()
             .enumerate()
-            .map(|(i, o)| format!("{} `{}`", (b'a' + i as u8) as char, o.key))
+            .map(|(i, o)| format!("{} `{}`", letter(i), o.key))
             .collect();
         return Err(err(
             step,
@@ -785,7 +792,6 @@ fn evaluate_choice(
             chosen.label, pixel[0], pixel[1]
         )
     };
-    let _ = task;
     Ok(Verdict {
         correct,
         message,
