@@ -39,7 +39,7 @@ enum LessonCommand {
 }
 
 #[derive(Args, Debug)]
-#[group(id = "answer", required = true, multiple = false, args = ["pixel", "value", "choice"])]
+#[command(group(clap::ArgGroup::new("answer").required(true).args(["pixel", "value", "choice"])))]
 pub struct AnswerArgs {
     /// Lesson file or name of a shipped lesson.
     #[arg(value_name = "FILE_OR_NAME")]
@@ -143,7 +143,10 @@ fn run_answer(a: &AnswerArgs) -> Result<bool> {
     out!("{}", verdict.message);
     if !verdict.correct {
         if let Some(hint) = &verdict.hint {
-            out!("hint: {}", hint.split_whitespace().collect::<Vec<_>>().join(" "));
+            out!(
+                "hint: {}",
+                hint.split_whitespace().collect::<Vec<_>>().join(" ")
+            );
         }
         if let (Some(node), Some([x, y])) = (&verdict.node, verdict.pixel) {
             out!("see: node {node} of the tree of pixel ({x}, {y})");

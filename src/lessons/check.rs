@@ -117,9 +117,14 @@ pub fn evaluate(
             let tree = tree_at(&step_tracer(step, scene, settings), step, *p)?;
             goal_verdict(goal, &tree, None)
         }
-        (TaskKind::Control { control, pixel, goal }, a) => {
-            evaluate_control(step, control, *pixel, goal, a, scene, settings)?
-        }
+        (
+            TaskKind::Control {
+                control,
+                pixel,
+                goal,
+            },
+            a,
+        ) => evaluate_control(step, control, *pixel, goal, a, scene, settings)?,
         (
             TaskKind::Value {
                 pixel,
@@ -134,8 +139,13 @@ pub fn evaluate(
             let tracer = step_tracer(step, scene, settings);
             let tree = tree_at(&tracer, step, *pixel)?;
             let (n, path) = find_node(step, node, &tree)?;
-            let x = quantity_at(n, *quantity, *channel, light.as_deref(), &tracer)
-                .map_err(|why| err(step, format!("{node} of pixel ({}, {}) {why}", pixel[0], pixel[1])))?;
+            let x =
+                quantity_at(n, *quantity, *channel, light.as_deref(), &tracer).map_err(|why| {
+                    err(
+                        step,
+                        format!("{node} of pixel ({}, {}) {why}", pixel[0], pixel[1]),
+                    )
+                })?;
             let correct = (v - x).abs() <= *tolerance;
             let message = if correct {
                 format!("Right: {} at {node} is {x:.4}.", quantity.phrase())
@@ -365,12 +375,7 @@ pub fn goal_met(goal: &Goal, tree: &RayTree) -> bool {
 /// The deepest node that passes the goal's filters (its ray kind and object), else the deepest
 /// node: where to look when the event is missing.
 fn nearest(goal: &Goal, root: &Node) -> Vec<usize> {
-    fn walk(
-        goal: &Goal,
-        node: &Node,
-        path: &mut Vec<usize>,
-        best: &mut (bool, usize, Vec<usize>),
-    ) {
+    fn walk(goal: &Goal, node: &Node, path: &mut Vec<usize>, best: &mut (bool, usize, Vec<usize>)) {
         let key = (filters_pass(goal, node), path.len());
         if key > (best.0, best.1) {
             *best = (key.0, key.1, path.clone());
@@ -416,7 +421,9 @@ fn summary(tree: &RayTree) -> String {
         .root
         .hit
         .as_ref()
-        .map_or("meets nothing".to_string(), |h| format!("hits \"{}\"", h.object));
+        .map_or("meets nothing".to_string(), |h| {
+            format!("hits \"{}\"", h.object)
+        });
     if found.is_empty() {
         format!("its primary ray {hit}")
     } else {
@@ -523,7 +530,10 @@ fn set_control(
     };
     let x = v as f32;
     if !v.is_finite() {
-        return Ok(Err(format!("{v} is not a number {} can take", control.name())));
+        return Ok(Err(format!(
+            "{v} is not a number {} can take",
+            control.name()
+        )));
     }
     match control {
         Control::MaxDepth => {
@@ -614,7 +624,10 @@ pub fn choice_options(question: &Question) -> Vec<ChoiceOption> {
         ],
         Question::Shadow { .. } => vec![
             o("lit", "lit: the shadow ray reaches the light"),
-            o("blocked", "blocked: an object lies between the point and the light"),
+            o(
+                "blocked",
+                "blocked: an object lies between the point and the light",
+            ),
             o(
                 "facing_away",
                 "facing away: the light is behind the surface (N·L ≤ 0)",
@@ -695,12 +708,7 @@ fn right_key(question: &Question, node: &Node) -> Result<String, String> {
                 .iter()
                 .find(|o| names_object(&hit.object, o))
                 .cloned()
-                .ok_or_else(|| {
-                    format!(
-                        "hits \"{}\", which is none of the options",
-                        hit.object
-                    )
-                })?
+                .ok_or_else(|| format!("hits \"{}\", which is none of the options", hit.object))?
         }
         Question::Fixed { answer, .. } => letter(*answer).to_string(),
     })
@@ -964,8 +972,9 @@ pub fn check_lesson(lesson: &Lesson) -> CheckReport {
                     .map_err(|e| e.0)
                     .and_then(|tree| {
                         let (n, _) = find_node(step, node, &tree).map_err(|e| e.0)?;
-                        quantity_at(n, *quantity, *channel, light.as_deref(), &tracer)
-                            .map_err(|why| format!("{node} of pixel ({}, {}) {why}", pixel[0], pixel[1]))
+                        quantity_at(n, *quantity, *channel, light.as_deref(), &tracer).map_err(
+                            |why| format!("{node} of pixel ({}, {}) {why}", pixel[0], pixel[1]),
+                        )
                     })
                     .and_then(|x| {
                         if x.is_finite() {
@@ -977,7 +986,10 @@ pub fn check_lesson(lesson: &Lesson) -> CheckReport {
                                 Err(e) => Err(e.0),
                             }
                         } else {
-                            Err(format!("{} at {node} is not a finite number", quantity.phrase()))
+                            Err(format!(
+                                "{} at {node} is not a finite number",
+                                quantity.phrase()
+                            ))
                         }
                     })
             }
@@ -1004,7 +1016,11 @@ pub fn check_lesson(lesson: &Lesson) -> CheckReport {
         };
         match found.and_then(|a| match evaluate(step, &a, &scene, &settings) {
             Ok(v) if v.correct => Ok(a),
-            Ok(v) => Err(format!("the answer found, {}, is refused: {}", answer_text(&a), v.message)),
+            Ok(v) => Err(format!(
+                "the answer found, {}, is refused: {}",
+                answer_text(&a),
+                v.message
+            )),
             Err(e) => Err(e.0),
         }) {
             Ok(a) => report

@@ -47,7 +47,10 @@ impl From<SceneError> for LessonError {
 /// The lessons shipped with raytree (`assets/lessons`), compiled in, in the lecture's order:
 /// name (the file's stem) and text.
 pub const SHIPPED: &[(&str, &str)] = &[
-    ("eye-rays", include_str!("../../assets/lessons/eye-rays.toml")),
+    (
+        "eye-rays",
+        include_str!("../../assets/lessons/eye-rays.toml"),
+    ),
     (
         "primary-rays",
         include_str!("../../assets/lessons/primary-rays.toml"),
@@ -70,6 +73,7 @@ pub const SHIPPED: &[(&str, &str)] = &[
         include_str!("../../assets/lessons/termination.toml"),
     ),
     ("tree", include_str!("../../assets/lessons/tree.toml")),
+    ("quiz", include_str!("../../assets/lessons/quiz.toml")),
     (
         "speed-accuracy",
         include_str!("../../assets/lessons/speed-accuracy.toml"),
@@ -678,7 +682,9 @@ const STEP_KEYS: &[&str] = &[
     "task",
 ];
 const TASK_KINDS: &[&str] = &["pixel", "control", "value", "choice"];
-const PIXEL_KEYS: &[&str] = &["kind", "prompt", "hint", "event", "object", "ray", "present"];
+const PIXEL_KEYS: &[&str] = &[
+    "kind", "prompt", "hint", "event", "object", "ray", "present",
+];
 const CONTROL_KEYS: &[&str] = &[
     "kind", "prompt", "hint", "control", "material", "pixel", "event", "object", "ray", "present",
 ];
@@ -824,7 +830,11 @@ fn parse_lesson(
         ));
     };
     if items.is_empty() {
-        return Err(s.error(&steps_value.span(), "step", "must have at least one [[step]]"));
+        return Err(s.error(
+            &steps_value.span(),
+            "step",
+            "must have at least one [[step]]",
+        ));
     }
     let mut steps = Vec::new();
     let mut setup = Setup::default();
@@ -857,11 +867,14 @@ fn scene_ref(
         let path = folder.join(text);
         if path.is_file() || !is_builtin {
             if !path.is_file() {
+                let hint = suggest(text, scene::builtin::NAMES.iter().copied())
+                    .map(|k| format!(" (did you mean \"{k}\"?)"))
+                    .unwrap_or_default();
                 return Err(s.error(
                     span,
                     "scene",
                     format!(
-                        "names \"{}\", which is neither a built-in scene ({}) nor a file at {}",
+                        "names \"{}\"{hint}, which is neither a built-in scene ({}) nor a file at {}",
                         short(text).escape_debug(),
                         quoted(scene::builtin::NAMES.iter()),
                         path.display()
@@ -896,12 +909,7 @@ fn first_sentence(text: &str) -> String {
     }
 }
 
-fn parse_step(
-    src: &Src,
-    value: &Value,
-    number: usize,
-    before: Setup,
-) -> Result<Step, SceneError> {
+fn parse_step(src: &Src, value: &Value, number: usize, before: Setup) -> Result<Step, SceneError> {
     let s = Section::new(src, format!("step {number}"), value, STEP_KEYS)?;
     let text = required_string(&s, "text", "what the student looks at or does")?;
     let view = one_of(&s, "view", &View::ALL.map(View::name))?
@@ -1026,12 +1034,7 @@ fn parse_task(src: &Src, value: &Value, number: usize, setup: &Setup) -> Result<
             }
         }
         "value" => {
-            let Some((q, _)) = one_of(
-                &s,
-                "quantity",
-                &Quantity::ALL.map(Quantity::name),
-            )?
-            else {
+            let Some((q, _)) = one_of(&s, "quantity", &Quantity::ALL.map(Quantity::name))? else {
                 return Err(s.missing(
                     "quantity",
                     &format!("one of {}", quoted(Quantity::ALL.map(Quantity::name))),
@@ -1075,11 +1078,7 @@ fn parse_task(src: &Src, value: &Value, number: usize, setup: &Setup) -> Result<
             let tolerance = s.f32("tolerance", 0.01)?;
             if !(tolerance.is_finite() && tolerance > 0.0) {
                 let span = s.get("tolerance").map_or(s.span.clone(), |v| v.span());
-                return Err(s.error(
-                    &span,
-                    "tolerance",
-                    "must be a number greater than 0",
-                ));
+                return Err(s.error(&span, "tolerance", "must be a number greater than 0"));
             }
             TaskKind::Value {
                 pixel: task_pixel(&s)?,
@@ -1120,10 +1119,9 @@ fn parse_task(src: &Src, value: &Value, number: usize, setup: &Setup) -> Result<
                         Question::Object { options }
                     } else {
                         let Some(_) = answer else {
-                            return Err(s.missing(
-                                "answer",
-                                "the number (1, 2, ...) of the right option",
-                            ));
+                            return Err(
+                                s.missing("answer", "the number (1, 2, ...) of the right option")
+                            );
                         };
                         let n = options.len() as u32;
                         let answer = s.uint("answer", 1, &(1..=n))? as usize - 1;
@@ -1152,7 +1150,10 @@ fn parse_task(src: &Src, value: &Value, number: usize, setup: &Setup) -> Result<
                 }
             };
             let (pixel, node) = if matches!(question, Question::Fixed { .. }) {
-                (pixel(&s, "pixel")?.or(setup.select).unwrap_or([0, 0]), node(&s)?)
+                (
+                    pixel(&s, "pixel")?.or(setup.select).unwrap_or([0, 0]),
+                    node(&s)?,
+                )
             } else {
                 (task_pixel(&s)?, node(&s)?)
             };
@@ -1177,7 +1178,9 @@ fn string_list(s: &Section, key: &str) -> Result<Option<Vec<String>>, SceneError
     for item in items.iter() {
         match item.get_ref() {
             DeValue::String(t) if !t.trim().is_empty() => out.push(t.to_string()),
-            DeValue::String(_) => return Err(s.error(&item.span(), key, "must not hold an empty string")),
+            DeValue::String(_) => {
+                return Err(s.error(&item.span(), key, "must not hold an empty string"));
+            }
             _ => return Err(s.type_error(key, item, "a string")),
         }
     }

@@ -48,7 +48,11 @@ pub const LINES: &[Line] = &[
         "if (status == no_intersection) return background_color; // termination: no intersection",
     ),
     line("normal", 1, "n = normal(q);"),
-    line("reflect_dir", 1, "r = reflect(d, n);                // R = d − 2(d·N)N"),
+    line(
+        "reflect_dir",
+        1,
+        "r = reflect(d, n);                // R = d − 2(d·N)N",
+    ),
     line(
         "refract_dir",
         1,
