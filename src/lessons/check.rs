@@ -391,20 +391,34 @@ fn nearest(goal: &Goal, root: &Node) -> Vec<usize> {
     best.2
 }
 
-/// "a blocked shadow ray on a refracted ray at \"floor\"".
+/// The goal in words: "a blocked shadow ray where the primary ray hits \"floor\"", "a
+/// refracted ray that hits \"floor\"".
 pub fn goal_phrase(goal: &Goal) -> String {
-    let mut s = goal.event.phrase().to_string();
-    if let Some(r) = goal.ray {
-        s += match r {
-            RayKind::Primary => " on the primary ray",
-            RayKind::Reflected => " on a reflected ray",
-            _ => " on a refracted ray",
-        };
+    let ray = goal.ray.map(|r| match r {
+        RayKind::Primary => "the primary ray",
+        RayKind::Reflected => "a reflected ray",
+        _ => "a refracted ray",
+    });
+    let object = goal.object.as_ref().map(|o| format!("\"{o}\""));
+    match goal.event {
+        Event::Hit => format!(
+            "{} that hits {}",
+            ray.unwrap_or("a ray"),
+            object.as_deref().unwrap_or("a surface")
+        ),
+        Event::Reflected | Event::Refracted if object.is_some() && goal.ray.is_none() => {
+            format!(
+                "{} that hits {}",
+                goal.event.phrase(),
+                object.as_deref().unwrap_or_default()
+            )
+        }
+        e => match (ray, object) {
+            (None, None) => e.phrase().to_string(),
+            (Some(r), None) => format!("{} on {r}", e.phrase()),
+            (r, Some(o)) => format!("{} where {} hits {o}", e.phrase(), r.unwrap_or("a ray")),
+        },
     }
-    if let Some(o) = &goal.object {
-        s += &format!(" at \"{o}\"");
-    }
-    s
 }
 
 /// What the tree does have, for a wrong answer: the events met anywhere in it.
@@ -444,7 +458,10 @@ fn goal_verdict(goal: &Goal, tree: &RayTree, with: Option<&str>) -> Verdict {
         None => ("The".to_string(), "the".to_string()),
     };
     let phrase = goal_phrase(goal);
-    let bare = phrase.trim_start_matches("a ").trim_start_matches("an ");
+    let bare = phrase
+        .trim_start_matches("a ")
+        .trim_start_matches("an ")
+        .trim_start_matches("the ");
     let (message, path) = match (&found, goal.present) {
         (Some(p), true) => (
             format!(
