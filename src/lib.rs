@@ -11,7 +11,8 @@
 //! 4. [`shade`], [`trace`], [`ray_tree`]: the local model, the one recursive trace, the tree.
 //! 5. [`render`] (tiles, film, the viewer's worker session, statistics), [`export`],
 //!    [`scene_view`] (the ray tree in 3D as segments every view draws alike) and [`diagram`]
-//!    (the tree as the lecture's figure: layout, legend, SVG).
+//!    (the tree as the lecture's figure: layout, legend, SVG), [`lessons`] (the lecture as
+//!    guided steps checked against the trace, and its pseudocode beside a tree).
 //! 6. `experiments` (feature `lab`: sweeps, charts, image metrics) and `app` (feature `viewer`:
 //!    the egui window; the only module that uses egui, eframe or wgpu).
 //! 7. The `raytree` command (`src/main.rs`).
@@ -31,6 +32,7 @@ pub mod diagram;
 pub mod experiments;
 pub mod export;
 pub mod geometry;
+pub mod lessons;
 pub mod plural;
 pub mod ray_tree;
 pub mod render;

@@ -1,5 +1,5 @@
 //! The `raytree` command: parse, call the library, print one-line errors, set the exit code.
-//! The subcommands live in [`cli`]: `render`, `merge`, `tree`, `scenes`, and with the `lab` feature
+//! The subcommands live in [`cli`]: `render`, `merge`, `tree`, `scenes`, `lessons`, `lesson`, and with the `lab` feature
 //! `bench` and `stability`; without a subcommand, the viewer (feature `viewer`).
 
 #[macro_use]
@@ -13,6 +13,7 @@ use anyhow::bail;
 use clap::{Parser, Subcommand};
 #[cfg(feature = "lab")]
 use cli::lab::{BenchArgs, StabilityArgs, run_bench, run_stability};
+use cli::lesson::{LessonArgs, run_lesson, run_lessons};
 use cli::merge::{MergeArgs, run_merge};
 use cli::render::{RenderArgs, run_render};
 use cli::tree::{TreeArgs, run_tree};
@@ -51,6 +52,10 @@ enum Command {
     Stability(StabilityArgs),
     /// List the built-in scenes.
     Scenes,
+    /// List the shipped lessons: the lecture as guided steps with checked tasks.
+    Lessons,
+    /// Check a lesson file, answer one of its tasks, or print it (docs/lessons.md).
+    Lesson(LessonArgs),
 }
 
 fn run(cli: Cli) -> Result<()> {
@@ -62,6 +67,9 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::Bench(args)) => run_bench(&args),
         #[cfg(feature = "lab")]
         Some(Command::Stability(args)) => run_stability(&args),
+        Some(Command::Lessons) => run_lessons(),
+        // Has exit codes of its own (0 right, 1 wrong, 2 not evaluated): handled in `main`.
+        Some(Command::Lesson(_)) => Ok(()),
         Some(Command::Scenes) => {
             for name in scene::builtin::NAMES {
                 out!("{name}");
@@ -111,6 +119,9 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(code) => return code,
     };
+    if let Some(Command::Lesson(args)) = &cli.command {
+        return run_lesson(args);
+    }
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -17,7 +17,7 @@ const LAYERS: &[&[&str]] = &[
     &["scene"],
     &["accel"],
     &["shade", "trace", "ray_tree"],
-    &["render", "export", "scene_view", "diagram"],
+    &["render", "export", "scene_view", "diagram", "lessons"],
     &["experiments", "app"],
     // The `raytree` binary's subcommands (src/main.rs and src/cli/ are the binary crate; they
     // use the library as `raytree::`).

@@ -21,6 +21,7 @@ macro_rules! out {
 
 #[cfg(feature = "lab")]
 pub mod lab;
+pub mod lesson;
 pub mod merge;
 pub mod render;
 pub mod tree;

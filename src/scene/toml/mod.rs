@@ -5,7 +5,7 @@
 mod build;
 pub mod keys;
 mod names;
-mod reader;
+pub(crate) mod reader;
 mod sections;
 
 pub use build::{load_scene_str_with, load_scene_str_with_files};
