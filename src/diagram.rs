@@ -627,11 +627,11 @@ pub fn title(tree: &RayTree) -> String {
     let [r, g, b] = tree.color.to_array();
     let s = &tree.settings;
     format!(
-        "Ray tracing tree of pixel ({}, {}): colour ({r:.3}, {g:.3}, {b:.3}); {} nodes{}; \
+        "Ray tracing tree of pixel ({}, {}): colour ({r:.3}, {g:.3}, {b:.3}); {}{}; \
          max depth {}, {} shading, cutoff {}, accel {}",
         tree.pixel[0],
         tree.pixel[1],
-        tree.nodes,
+        crate::plural::count(tree.nodes, "node"),
         if tree.truncated { " (truncated)" } else { "" },
         s.max_depth,
         s.shading.name(),

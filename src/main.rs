@@ -10,7 +10,7 @@ use std::process::ExitCode;
 use anyhow::Result;
 #[cfg(not(feature = "viewer"))]
 use anyhow::bail;
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 #[cfg(feature = "lab")]
 use cli::lab::{BenchArgs, StabilityArgs, run_bench, run_stability};
 use cli::lesson::{LessonArgs, run_lesson, run_lessons};
@@ -21,8 +21,8 @@ use raytree::scene;
 
 /// raytree: recursive (Whitted) ray tracing with the ray tracing tree of every pixel.
 ///
-/// SCENE is a scene file (.toml), a bare OBJ file (.obj), or the name of a built-in scene:
-/// default, quiz, glass, box, acne, cracks.
+/// SCENE is a scene file (.toml), a bare OBJ file (.obj), or the name of a built-in scene
+/// (listed below and by `raytree scenes`).
 #[derive(Parser, Debug)]
 #[command(version, about, long_about, max_term_width = 100)]
 struct Cli {
@@ -71,9 +71,7 @@ fn run(cli: Cli) -> Result<()> {
         // Has exit codes of its own (0 right, 1 wrong, 2 not evaluated): handled in `main`.
         Some(Command::Lesson(_)) => Ok(()),
         Some(Command::Scenes) => {
-            for name in scene::builtin::NAMES {
-                out!("{name}");
-            }
+            out!("{}", scene::builtin::listing().trim_end());
             Ok(())
         }
         #[cfg(feature = "viewer")]
@@ -89,29 +87,35 @@ fn run(cli: Cli) -> Result<()> {
 /// Parses the arguments; a usage error becomes one line on stderr (exit code 2), as every
 /// other error is one line. `--help` and `--version` print as clap formats them.
 fn parse_args() -> Result<Cli, ExitCode> {
-    Cli::try_parse().map_err(|e| {
-        if !e.use_stderr() {
-            e.exit();
-        }
-        // clap's message is "error: ...", tips, a usage block and a pointer to --help:
-        // keep the error and its tips, on one line.
-        let text = e.render().to_string();
-        let mut line = String::new();
-        for part in text
-            .lines()
-            .map(str::trim)
-            .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
-            .filter(|l| !l.is_empty())
-        {
-            if !line.is_empty() {
-                line += if line.ends_with(':') { " " } else { "; " };
+    // The built-in scenes in the help from the one list `raytree scenes` prints.
+    let command =
+        Cli::command().after_help(format!("Built-in scenes:\n{}", scene::builtin::listing()));
+    command
+        .try_get_matches()
+        .and_then(|m| Cli::from_arg_matches(&m))
+        .map_err(|e| {
+            if !e.use_stderr() {
+                e.exit();
             }
-            line += part;
-        }
-        let line = line.strip_prefix("error: ").unwrap_or(&line);
-        eprintln!("error: {line} (see `raytree --help`)");
-        ExitCode::from(2)
-    })
+            // clap's message is "error: ...", tips, a usage block and a pointer to --help:
+            // keep the error and its tips, on one line.
+            let text = e.render().to_string();
+            let mut line = String::new();
+            for part in text
+                .lines()
+                .map(str::trim)
+                .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+                .filter(|l| !l.is_empty())
+            {
+                if !line.is_empty() {
+                    line += if line.ends_with(':') { " " } else { "; " };
+                }
+                line += part;
+            }
+            let line = line.strip_prefix("error: ").unwrap_or(&line);
+            eprintln!("error: {line} (see `raytree --help`)");
+            ExitCode::from(2)
+        })
 }
 
 fn main() -> ExitCode {

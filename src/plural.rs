@@ -5,19 +5,19 @@
 /// `count(2, "node")` is "2 nodes". `noun` is the singular; the plural follows English
 /// spelling for the words raytree counts (s, x, ch, sh take -es; a consonant and y, -ies).
 pub fn count(n: impl Count, noun: &str) -> String {
-    let n = n.as_u64();
+    let n = n.to_u64();
     format!("{n} {}", noun_for(n, noun))
 }
 
 /// A number of things: the integer types counts come in.
 pub trait Count {
-    fn as_u64(self) -> u64;
+    fn to_u64(self) -> u64;
 }
 
 macro_rules! counts {
     ($($t:ty),*) => {$(
         impl Count for $t {
-            fn as_u64(self) -> u64 {
+            fn to_u64(self) -> u64 {
                 self as u64
             }
         }
@@ -48,7 +48,7 @@ pub fn noun_for(n: u64, noun: &str) -> String {
 /// [`count`] with a large number shortened: "57k triangles", "1.2M triangles" (exact below
 /// 10,000).
 pub fn count_short(n: impl Count, noun: &str) -> String {
-    let n = n.as_u64();
+    let n = n.to_u64();
     let number = match n {
         0..10_000 => n.to_string(),
         10_000..1_000_000 => format!("{}k", (n + 500) / 1000),

@@ -377,11 +377,11 @@ fn fmt_v(v: Vec3) -> String {
 /// The tree as indented, readable text (what `raytree tree` prints without `--json`).
 pub fn tree_text(tree: &RayTree) -> String {
     let mut out = format!(
-        "pixel ({}, {}) colour {}  [{} nodes{}; max_depth {}, {:?}]\n",
+        "pixel ({}, {}) colour {}  [{}{}; max_depth {}, {:?}]\n",
         tree.pixel[0],
         tree.pixel[1],
         fmt_v(tree.color),
-        tree.nodes,
+        crate::plural::count(tree.nodes, "node"),
         if tree.truncated { ", truncated" } else { "" },
         tree.settings.max_depth,
         tree.settings.shading,

@@ -408,3 +408,39 @@ fn closed_stdout_is_not_a_panic() {
         check(&args.join(" "), output);
     }
 }
+
+/// `--help` and `raytree scenes` list the same built-in scenes (every one, `smooth` too), each
+/// with its line of description.
+#[test]
+fn help_and_scenes_list_every_built_in_scene_with_its_description() {
+    let out = raytree().arg("--help").output().expect("runs");
+    let help = String::from_utf8_lossy(&out.stdout).to_string();
+    let out = raytree().arg("scenes").output().expect("runs");
+    assert!(out.status.success());
+    let scenes = String::from_utf8_lossy(&out.stdout).to_string();
+    assert_eq!(scenes.lines().count(), raytree::scene::builtin::NAMES.len());
+    for name in raytree::scene::builtin::NAMES {
+        let line = scenes
+            .lines()
+            .find(|l| l.split_whitespace().next() == Some(name))
+            .unwrap_or_else(|| panic!("`raytree scenes` lists {name}:\n{scenes}"));
+        let description = raytree::scene::builtin::describe(name).expect("described");
+        assert!(line.contains(description), "{line}");
+        assert!(help.contains(line.trim()), "--help lists {name}:\n{help}");
+    }
+}
+
+/// A mistyped built-in name is answered with the closest names, not "cannot open this kind
+/// of file".
+#[test]
+fn a_misspelled_built_in_scene_is_answered_with_the_closest_name() {
+    let out = raytree()
+        .args(["render", "glas", "-o", "/nonexistent/x.png"])
+        .output()
+        .expect("runs");
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("did you mean \"glass\"?"), "{err}");
+    assert!(!err.contains("kind of file"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+}

@@ -713,3 +713,18 @@ fn bad_scenes_give_one_sentence_each() {
     }
     insta::assert_snapshot!(report);
 }
+
+/// An error in a named item calls it by its name, not by its place.
+#[test]
+fn an_error_names_a_material_or_light_by_its_name() {
+    let err = load_err(
+        "[[material]]\nname = \"plain\"\n\n[[material]]\nname = \"glass\"\nior = \"high\"\n",
+    );
+    assert!(err.contains("material `glass`"), "{err}");
+    assert!(!err.contains("material 2"), "{err}");
+    let err = load_err("[[light]]\nname = \"key\"\nposition = [0, 1]\n");
+    assert!(err.contains("light `key`"), "{err}");
+    // Without a name, the place.
+    let err = load_err("[[material]]\nior = \"high\"\n");
+    assert!(err.contains("material 1"), "{err}");
+}

@@ -160,7 +160,7 @@ mod tests {
 
     #[test]
     fn an_ior_edit_is_named_by_its_material_and_key() {
-        let scene = load_builtin("default").unwrap();
+        let scene = load_builtin("default").expect("built in");
         let before = Edits::of(&scene, Default::default());
         let mut after = before.clone();
         let glass = after

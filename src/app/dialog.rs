@@ -12,6 +12,7 @@ pub enum BrowseFor {
     Open,
     SaveScene,
     Export,
+    ExportFull,
     ExportOverlay,
     ExportSceneView,
     ExportTree,
@@ -23,7 +24,10 @@ impl BrowseFor {
         match self {
             BrowseFor::Open => "Open scene or OBJ",
             BrowseFor::SaveScene => "Save scene as TOML",
-            BrowseFor::Export => "Export render (.png or .exr)",
+            BrowseFor::Export => "Export the render as shown (.png or .exr)",
+            BrowseFor::ExportFull => {
+                "Export the render at the scene's size and samples (.png or .exr)"
+            }
             BrowseFor::ExportOverlay => "Export render with the rays drawn over it (.png)",
             BrowseFor::ExportSceneView => "Export the scene view at the scene's size (.png)",
             BrowseFor::ExportTree => "Export ray tree (.json)",
@@ -36,7 +40,7 @@ impl BrowseFor {
         match self {
             BrowseFor::Open => &["toml", "obj"],
             BrowseFor::SaveScene => &["toml"],
-            BrowseFor::Export => &["png", "exr"],
+            BrowseFor::Export | BrowseFor::ExportFull => &["png", "exr"],
             BrowseFor::ExportOverlay | BrowseFor::ExportSceneView => &["png"],
             BrowseFor::ExportTree => &["json"],
             BrowseFor::ExportDiagram => &["svg"],

@@ -71,7 +71,12 @@ pub enum Command {
     OpenFile(PathBuf),
     OpenBuiltin(String),
     SaveScene(PathBuf),
+    /// The render as shown in the pane (its size, its samples, the display's colours).
     Export(PathBuf),
+    /// The render at the scene's own size and samples, rendered in the background.
+    ExportFull(PathBuf),
+    /// Stop the export rendering in the background.
+    CancelExport,
     /// The render with the trees drawn over it, as PNG.
     ExportOverlay(PathBuf),
     /// The scene view at the scene's size, as PNG.
@@ -427,6 +432,12 @@ impl ViewerApp {
                 },
                 Command::SaveScene(path) => self.save_scene(&path),
                 Command::Export(path) => self.export(&path),
+                Command::ExportFull(path) => self.export_at_scene_size(&path),
+                Command::CancelExport => {
+                    if let Some(job) = self.render.export_job() {
+                        job.stop();
+                    }
+                }
                 Command::ExportOverlay(path) => self.export_drawn(&path, Drawn::Overlay),
                 Command::ExportSceneView(path) => self.export_drawn(&path, Drawn::SceneView),
                 Command::ExportTree(path) => self.export_tree(&path),

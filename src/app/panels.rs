@@ -17,6 +17,7 @@ use super::viewport::Tonemap;
 use super::workspace::{self, Prefs, Workspace};
 use super::{Command, tree_view};
 use crate::choice::Choice;
+use crate::plural::count;
 use crate::scene::{Light, Material, builtin, names, rules};
 use crate::trace::Tracer;
 
@@ -266,8 +267,26 @@ pub fn status_bar(
     selection: &TreeSelection,
     target: u32,
     finished: bool,
+    pending: &mut Vec<Command>,
 ) {
     egui::Panel::bottom("status").show(ui, |ui| {
+        if let Some(job) = render.export_job() {
+            ui.horizontal(|ui| {
+                ui.add(
+                    egui::ProgressBar::new(job.done())
+                        .desired_width(220.0)
+                        .show_percentage(),
+                );
+                ui.strong(format!("exporting {} at the scene's size", job.file));
+                if ui
+                    .button("Cancel")
+                    .on_hover_text("stop the export; no file is written")
+                    .clicked()
+                {
+                    pending.push(Command::CancelExport);
+                }
+            });
+        }
         if let Some((label, percent)) = files.status() {
             // The open runs in the background; the scene shown stays usable meanwhile.
             ui.horizontal(|ui| {
@@ -604,11 +623,11 @@ pub fn side_panel(
         .show(ui, |ui| {
             let s = render.scene();
             ui.label(format!(
-                "{} spheres, {} triangles, {} lights, {} materials",
-                s.spheres.len(),
-                s.triangles.len(),
-                s.lights.len(),
-                s.materials.len()
+                "{}, {}, {}, {}",
+                count(s.spheres.len(), "sphere"),
+                count(s.triangles.len(), "triangle"),
+                count(s.lights.len(), "light"),
+                count(s.materials.len(), "material")
             ));
             for name in builtin::NAMES {
                 if ui.button(format!("Open built-in \"{name}\"")).clicked() {
@@ -667,11 +686,11 @@ pub fn tree_panel(ui: &mut Ui, selection: &mut TreeSelection, ws: &mut Workspace
         }
     });
     ui.label(format!(
-        "colour ({:.4}, {:.4}, {:.4}) · {} nodes{}",
+        "colour ({:.4}, {:.4}, {:.4}) · {}{}",
         tree.color.x,
         tree.color.y,
         tree.color.z,
-        tree.nodes,
+        count(tree.nodes, "node"),
         if tree.truncated { " (truncated)" } else { "" }
     ));
     ui.horizontal(|ui| {
@@ -720,11 +739,11 @@ pub fn tree_panel(ui: &mut Ui, selection: &mut TreeSelection, ws: &mut Workspace
         prims.sort_unstable();
         prims.dedup();
         ui.label(format!(
-            "accelerator ({}): this ray entered {} boxes and tested {} primitives ({} tests)",
+            "accelerator ({}): this ray entered {} and tested {} ({})",
             crate::choice::Choice::name(tracer.accel.kind()),
-            visits.boxes.len(),
-            prims.len(),
-            visits.prims.len(),
+            count(visits.boxes.len(), "box"),
+            count(prims.len(), "primitive"),
+            count(visits.prims.len(), "test"),
         ))
         .on_hover_text("drawn as cyan boxes in the scene view (\"visits\")");
     }
@@ -735,24 +754,92 @@ pub fn tree_panel(ui: &mut Ui, selection: &mut TreeSelection, ws: &mut Workspace
         });
 }
 
-/// What Ctrl+S offers: the clean render, the render with the rays drawn over it, or the scene
-/// view; each then asks for a file name.
-pub fn export_window(ctx: &egui::Context, ws: &mut Workspace, has_tree: bool, stem: &str) {
+/// What each choice of the Export window gives, for its descriptions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ExportSizes {
+    /// The render as shown: its size and the samples reached of the viewer's target.
+    pub shown: (u32, u32),
+    pub done: u32,
+    pub target: u32,
+    /// The scene's own size and samples.
+    pub scene: (u32, u32),
+    pub samples: u32,
+}
+
+/// The Export window (Ctrl+S): the render as shown (the default: Enter takes it), the render at
+/// the scene's size and samples (in the background), the render with the trees drawn over it,
+/// the scene view; each says the size it gives.
+pub fn export_window(
+    ctx: &egui::Context,
+    ws: &mut Workspace,
+    has_tree: bool,
+    stem: &str,
+    sizes: ExportSizes,
+) {
     let mut open = ws.export_choice;
     let mut chosen = None;
+    let (sw, sh) = sizes.shown;
+    let (fw, fh) = sizes.scene;
+    let same = sizes.shown == sizes.scene && sizes.done == sizes.samples;
+    let choices = [
+        (
+            BrowseFor::Export,
+            "Render as shown",
+            true,
+            format!(
+                "{sw}x{sh}, {} of {}, the camera as it is; PNG in the display's colours \
+                 (exposure, tonemap, image mode), EXR linear",
+                count(sizes.done, "sample"),
+                sizes.target
+            ),
+        ),
+        (
+            BrowseFor::ExportFull,
+            "Render at the scene's size",
+            true,
+            if same {
+                format!(
+                    "{fw}x{fh}, {}: the same picture as shown",
+                    count(sizes.samples, "sample")
+                )
+            } else {
+                format!(
+                    "{fw}x{fh}, {}, rendered again in the background (progress and Cancel in \
+                     the status bar); exposure 1, clamped",
+                    count(sizes.samples, "sample")
+                )
+            },
+        ),
+        (
+            BrowseFor::ExportOverlay,
+            "Render with rays (PNG)",
+            has_tree,
+            format!("{sw}x{sh}: the render with the trees drawn over it, as in the render view"),
+        ),
+        (
+            BrowseFor::ExportSceneView,
+            "Scene view (PNG)",
+            has_tree,
+            format!("{fw}x{fh}: the scene view's camera, with the render camera, lights and trees"),
+        ),
+    ];
     egui::Window::new("Export")
         .open(&mut open)
         .collapsible(false)
         .resizable(false)
+        .default_width(420.0)
         .show(ctx, |ui| {
-            for (what, label, enabled, hint) in [
-                (BrowseFor::Export, "Render (PNG or EXR)", true, "the film at full resolution, as rendered"),
-                (BrowseFor::ExportOverlay, "Render with rays (PNG)", has_tree, "the render with the trees drawn over it, as in the render view"),
-                (BrowseFor::ExportSceneView, "Scene view (PNG)", has_tree, "the scene view's camera at the scene's size, with the render camera, lights and tree"),
-            ] {
-                if ui.add_enabled(enabled, egui::Button::new(label)).on_hover_text(hint).clicked() {
-                    chosen = Some(what);
+            ui.set_max_width(440.0);
+            for (i, (what, label, enabled, says)) in choices.iter().enumerate() {
+                let button = ui.add_enabled(*enabled, egui::Button::new(*label));
+                if i == 0 && ui.memory(|m| m.focused().is_none()) {
+                    button.request_focus();
                 }
+                if button.clicked() {
+                    chosen = Some(*what);
+                }
+                ui.add(egui::Label::new(egui::RichText::new(says).weak()).wrap());
+                ui.add_space(4.0);
             }
             if !has_tree {
                 ui.weak("click a pixel for a ray tree to export the rays");
@@ -763,6 +850,7 @@ pub fn export_window(ctx: &egui::Context, ws: &mut Workspace, has_tree: bool, st
         let suffix = match what {
             BrowseFor::ExportOverlay => "-rays",
             BrowseFor::ExportSceneView => "-scene-view",
+            BrowseFor::ExportFull => "-full",
             _ => "",
         };
         ws.browse(what, &format!("{stem}{suffix}.png"));

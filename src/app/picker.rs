@@ -20,9 +20,9 @@ pub fn summary(tree: &RayTree) -> String {
         .map_or("nothing".to_owned(), |h| h.object.clone());
     let [x, y] = tree.pixel;
     format!(
-        "({x}, {y}) {met} · depth {} · {} rays",
+        "({x}, {y}) {met} · depth {} · {}",
         crate::app::scene_pane::deepest([tree]),
-        tree.rays.total()
+        crate::plural::count(tree.rays.total(), "ray")
     )
 }
 

@@ -2,6 +2,7 @@
 //! of the current generation, the film its tiles fill, the display the GPU draws, the size the
 //! render follows, and an export rendering in the background.
 
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, TryRecvError};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -75,7 +76,7 @@ impl Progress {
             }
             Pass::Samples(n) => {
                 self.samples_done = n;
-                self.pass_label = format!("{n} samples");
+                self.pass_label = crate::plural::count(n, "sample");
             }
         }
     }
@@ -120,8 +121,41 @@ pub struct RenderView {
     pub(super) max_side: u32,
     /// The image mode the display was last painted in.
     painted_mode: ImageMode,
-    /// An export rendering at the scene's size in the background: its message when done.
-    pub(super) export_job: Option<Receiver<Message>>,
+    /// An export rendering at the scene's size in the background.
+    pub(super) export_job: Option<ExportJob>,
+}
+
+/// An export rendering at the scene's size in the background: its progress, its cancel flag
+/// and its message when done.
+#[derive(Debug)]
+pub struct ExportJob {
+    message: Receiver<Message>,
+    /// The file it writes, for the status bar.
+    pub file: String,
+    /// Thousandths of the work done.
+    pub progress: Arc<AtomicU64>,
+    pub cancel: Arc<AtomicBool>,
+}
+
+impl ExportJob {
+    pub fn new(message: Receiver<Message>, file: String) -> Self {
+        Self {
+            message,
+            file,
+            progress: Arc::default(),
+            cancel: Arc::default(),
+        }
+    }
+
+    /// The share of the work done, 0 to 1.
+    pub fn done(&self) -> f32 {
+        self.progress.load(Ordering::Relaxed) as f32 / 1000.0
+    }
+
+    /// Asks the job to stop; its message says it was cancelled.
+    pub fn stop(&self) {
+        self.cancel.store(true, Ordering::Relaxed);
+    }
 }
 
 impl RenderView {
@@ -335,10 +369,15 @@ impl RenderView {
         self.export_job.is_some()
     }
 
+    /// The export rendering in the background, if any.
+    pub fn export_job(&self) -> Option<&ExportJob> {
+        self.export_job.as_ref()
+    }
+
     /// Takes the message of a finished background export.
     pub fn poll_export(&mut self, messages: &mut Messages) {
-        if let Some(rx) = &self.export_job {
-            match rx.try_recv() {
+        if let Some(job) = &self.export_job {
+            match job.message.try_recv() {
                 Ok(message) => {
                     messages.push(message);
                     self.export_job = None;

@@ -7,6 +7,7 @@ use std::sync::Arc;
 
 use super::ViewerApp;
 use super::messages::Message;
+use super::render_view::ExportJob;
 use crate::export;
 use crate::scene;
 use crate::scene_view::headless::Layer;
@@ -65,37 +66,60 @@ impl ViewerApp {
         }
     }
 
-    /// Writes the film at full resolution (never a window grab), stamped with its progress.
+    /// "As shown": the picture in the render pane, at the size it is rendered, with the samples
+    /// reached so far and the camera as it is. A PNG has the display's colours (exposure,
+    /// tonemap, the image mode, exactly as the shader shows them); an EXR keeps linear radiance
+    /// (the film; exposure and tonemap are for display). Stamped with both.
     pub(super) fn export(&mut self, path: &Path) {
-        if self.render.size() != self.render.scene_size {
-            return self.export_at_scene_size(path);
-        }
+        let (w, h) = self.render.size();
         let target = self.viewer_target();
         let done = self.render.progress.samples_done;
-        let text = export::stamp(
+        let mut render = self.render.scene().render.clone();
+        (render.width, render.height) = (w, h);
+        let mut text = export::stamp(
             &self.files.label,
             done,
             target,
-            &self.render.scene().render,
+            &render,
             &self.working.settings.trace,
             self.render.accel().kind(),
         );
-        match export::write_image(path, &self.render.image(), &text) {
+        let prefs = &self.workspace.prefs;
+        text.push((
+            "raytree.display".to_string(),
+            serde_json::json!({
+                "exposure": prefs.exposure,
+                "tonemap": prefs.tonemap.label(),
+                "mode": prefs.mode.label(),
+            })
+            .to_string(),
+        ));
+        let png = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        let written = if png {
+            let shown = crate::sync::lock(&self.render.display).shown_rgb8();
+            export::write_png_rgb8(path, w, h, &shown, &text)
+        } else {
+            export::write_image(path, &self.render.image(), &text)
+        };
+        match written {
             Ok(()) => self.messages.notice(format!(
-                "exported {} ({done}/{target} samples)",
+                "exported {} as shown ({w}x{h}, {done}/{target} samples)",
                 path.display()
             )),
             Err(e) => self.messages.error(e.to_string()),
         }
     }
 
-    /// The render follows the pane: the export renders the scene at its own size and sample
-    /// count in the background (the viewer stays live) and says when the file is written.
-    fn export_at_scene_size(&mut self, path: &Path) {
+    /// The scene at its own size and sample count, rendered in the background (the viewer
+    /// stays live, the status bar shows the progress and can cancel it); a message says when
+    /// the file is written.
+    pub(super) fn export_at_scene_size(&mut self, path: &Path) {
         if self.render.export_job.is_some() {
             return self
                 .messages
-                .error("an export is still rendering: wait for its message");
+                .error("an export is still rendering: wait for it or cancel it in the status bar");
         }
         let mut scene = (**self.render.scene()).clone();
         (scene.render.width, scene.render.height) = self.render.scene_size;
@@ -115,30 +139,55 @@ impl ViewerApp {
         let shown = path.display().to_string();
         let path = path.to_path_buf();
         let (tx, rx) = std::sync::mpsc::channel();
-        let job = move || {
-            let message = match crate::render::render(&tracer, samples, threads, &|_, _| {}) {
-                Ok((image, _)) => match export::write_image(&path, &image, &stamp) {
-                    Ok(()) => Message::notice(format!(
-                        "exported {} ({w}x{h}, the scene's size, {samples} samples)",
-                        path.display()
-                    )),
-                    Err(e) => Message::error(e.to_string()),
-                },
-                Err(e) => Message::error(format!("cannot export {}: {e}", path.display())),
+        let job = ExportJob::new(rx, shown.clone());
+        let (progress, cancel, wake) =
+            (job.progress.clone(), job.cancel.clone(), self.files.waker());
+        let work = move || {
+            use std::sync::atomic::Ordering;
+            let report = |done: u64, total: u64| {
+                let permille = (done * 1000).checked_div(total).unwrap_or(0);
+                let before = progress.swap(permille, Ordering::Relaxed);
+                // A frame for each whole percent, not for each tile.
+                if permille / 10 != before / 10 {
+                    wake();
+                }
+            };
+            let tile = |t: &Tracer,
+                        f: &crate::scene::CameraFrame,
+                        r: crate::render::Rect,
+                        s: std::ops::Range<u32>,
+                        px: &mut [glam::Vec3]| {
+                if cancel.load(Ordering::Relaxed) {
+                    crate::trace::RayCounts::default()
+                } else {
+                    crate::render::trace_tile(t, f, r, s, px)
+                }
+            };
+            let rendered = crate::render::render_with(&tracer, samples, threads, &report, &tile);
+            let message = if cancel.load(Ordering::Relaxed) {
+                Message::notice(format!("cancelled the export of {}", path.display()))
+            } else {
+                match rendered {
+                    Ok((image, _)) => match export::write_image(&path, &image, &stamp) {
+                        Ok(()) => Message::notice(format!(
+                            "exported {} ({w}x{h}, the scene's size, {})",
+                            path.display(),
+                            crate::plural::count(samples, "sample")
+                        )),
+                        Err(e) => Message::error(e.to_string()),
+                    },
+                    Err(e) => Message::error(format!("cannot export {}: {e}", path.display())),
+                }
             };
             // The viewer may have closed meanwhile: then nobody waits for the message.
             let _ = tx.send(message);
+            wake();
         };
         match std::thread::Builder::new()
             .name("raytree-export".into())
-            .spawn(job)
+            .spawn(work)
         {
-            Ok(_) => {
-                self.render.export_job = Some(rx);
-                self.messages.notice(format!(
-                    "exporting {shown} at the scene's size ({w}x{h}, {samples} samples)..."
-                ));
-            }
+            Ok(_) => self.render.export_job = Some(job),
             Err(e) => self.messages.error(format!("cannot start the export: {e}")),
         }
     }

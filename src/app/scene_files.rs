@@ -71,6 +71,11 @@ impl SceneFiles {
         }
     }
 
+    /// What wakes the UI (a no-op before the window's first frame, and without a window).
+    pub fn waker(&self) -> watch::Waker {
+        self.waker.clone().unwrap_or_else(|| Arc::new(|| {}))
+    }
+
     pub fn has_waker(&self) -> bool {
         self.waker.is_some()
     }

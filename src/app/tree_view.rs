@@ -13,6 +13,7 @@ use glam::Vec3;
 use super::undo::Edits;
 pub use crate::diagram::end_text as end_label;
 use crate::diagram::{self, Glyph, Mark, descendants, end_text};
+use crate::plural::count;
 use crate::ray_tree::{Node, RayTree};
 use crate::scene::Shading;
 use crate::scene_view::{NodePath, Style, kind_rgb, node_at, style_rgba};
@@ -25,7 +26,8 @@ pub struct TreeState {
     pub hovered: Option<NodePath>,
     pub pinned: Option<RayTree>,
     /// The viewer's edits when the tree was pinned, and what the user changed since, one
-    /// phrase each ([`super::changes::between`]): the cause the compare view names.
+    /// phrase each (named as a scene file names them, app/changes.rs): the cause the compare
+    /// view names.
     pub pinned_edits: Option<Edits>,
     pub edited_since_pin: Vec<String>,
     /// The step-through: show generations `0..=n` only (`None`: all).
@@ -405,7 +407,7 @@ pub fn diagram_with(
         }
         ui.label(format!("{:.0}%", view.zoom * 100.0));
         if lay.hidden > 0 {
-            ui.label(format!("{} nodes folded or hidden", lay.hidden));
+            ui.label(format!("{} folded or hidden", count(lay.hidden, "node")));
         }
         ui.weak("drag or wheel pans, Ctrl+wheel zooms, double-click folds");
     });
@@ -565,8 +567,8 @@ pub fn diagram_with(
             }
             if n.hidden_children > 0 {
                 ui.label(format!(
-                    "{} nodes below are folded (double-click unfolds)",
-                    n.hidden_children
+                    "{} below folded (double-click unfolds)",
+                    count(n.hidden_children, "node")
                 ));
             }
         });
@@ -706,8 +708,10 @@ pub fn compare(
     let mut none = |_: &mut Ui| {};
     ui.columns(2, |cols| {
         cols[0].label(format!(
-            "pinned: ({}, {}) · {} nodes",
-            pinned.pixel[0], pinned.pixel[1], pinned.nodes
+            "pinned: ({}, {}) · {}",
+            pinned.pixel[0],
+            pinned.pixel[1],
+            count(pinned.nodes, "node")
         ));
         diagram_with(
             &mut cols[0],
@@ -718,8 +722,10 @@ pub fn compare(
             &mut none,
         );
         cols[1].label(format!(
-            "current: ({}, {}) · {} nodes",
-            tree.pixel[0], tree.pixel[1], tree.nodes
+            "current: ({}, {}) · {}",
+            tree.pixel[0],
+            tree.pixel[1],
+            count(tree.nodes, "node")
         ));
         diagram_with(
             &mut cols[1],

@@ -79,6 +79,38 @@ pub struct DisplayParams {
     pub smooth: bool,
 }
 
+impl DisplayParams {
+    /// The colour the display shader shows for a texture pixel `c` (linear), as 8-bit sRGB:
+    /// exposure and the tonemap for radiance, none for an image mode's colours, then clamped
+    /// and encoded. The "as shown" export writes these, so the file has the window's colours.
+    pub fn shown_srgb8(&self, c: [f32; 4]) -> [u8; 3] {
+        let c = glam::Vec3::new(c[0], c[1], c[2]);
+        let c = match self.pixels {
+            Pixels::Display => c,
+            Pixels::Radiance => {
+                let c = c * self.exposure;
+                match self.tonemap {
+                    Tonemap::Clamp => c,
+                    Tonemap::Reinhard => c / (glam::Vec3::ONE + c),
+                    Tonemap::Aces => (c * (2.51 * c + 0.03)) / (c * (2.43 * c + 0.59) + 0.14),
+                }
+            }
+        };
+        crate::export::to_srgb8(c)
+    }
+}
+
+impl DisplayState {
+    /// The picture as shown: every pixel through [`DisplayParams::shown_srgb8`], RGB bytes
+    /// row-major.
+    pub fn shown_rgb8(&self) -> Vec<u8> {
+        self.rgba
+            .iter()
+            .flat_map(|&c| self.params.shown_srgb8(c))
+            .collect()
+    }
+}
+
 /// What the texture should hold, shared between the UI thread (which writes pixels and marks
 /// rectangles dirty) and the paint callback (which uploads them).
 #[derive(Debug)]

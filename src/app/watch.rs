@@ -10,7 +10,7 @@
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::sync::mpsc::{Receiver, TryRecvError, channel};
+use std::sync::mpsc::{Receiver, channel};
 use std::time::{Duration, Instant};
 
 use notify::{RecursiveMode, Watcher};
@@ -142,11 +142,8 @@ impl SceneWatch {
     /// Takes the changes reported so far; true once, when the last relevant one is
     /// [`DEBOUNCE`] old.
     pub fn poll(&mut self) -> bool {
-        loop {
-            match self.events.try_recv() {
-                Ok(()) => self.changed = Some(Instant::now()),
-                Err(TryRecvError::Empty | TryRecvError::Disconnected) => break,
-            }
+        while self.events.try_recv().is_ok() {
+            self.changed = Some(Instant::now());
         }
         match self.changed {
             Some(t) if t.elapsed() >= DEBOUNCE => {

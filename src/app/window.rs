@@ -104,6 +104,7 @@ impl eframe::App for ViewerApp {
             &self.selection,
             target,
             finished,
+            &mut self.pending,
         );
         // Hover is transient: the views set it again while the pointer stays on a node.
         self.selection.tree_state.hovered = None;
@@ -164,7 +165,20 @@ impl eframe::App for ViewerApp {
         tree_window(self, &ctx);
         panels::help_window(&ctx, &mut self.workspace.show_help);
         let has_tree = self.selection.tree.is_some();
-        panels::export_window(&ctx, &mut self.workspace, has_tree, &self.files.file_stem());
+        let sizes = panels::ExportSizes {
+            shown: self.render.size(),
+            done: self.render.progress.samples_done,
+            target: self.viewer_target(),
+            scene: self.render.scene_size,
+            samples: self.working.scene.render.samples,
+        };
+        panels::export_window(
+            &ctx,
+            &mut self.workspace,
+            has_tree,
+            &self.files.file_stem(),
+            sizes,
+        );
         let working = &mut self.working;
         let sweep = &mut self.workspace.sweep;
         if sweep.open
@@ -188,8 +202,8 @@ impl eframe::App for ViewerApp {
         self.working.track(&ctx);
         self.note_pin();
         self.render.follow_display_prefs(&self.workspace.prefs);
-        if !self.is_finished() || !self.scene_view.is_finished() || self.render.export_job.is_some()
-        {
+        // A background export wakes the UI itself, at each percent and when it is done.
+        if !self.is_finished() || !self.scene_view.is_finished() {
             ctx.request_repaint();
         } else if let Some(wait) = self.files.reload_in() {
             // A save settles: one frame when it has, to reload. Otherwise an idle viewer asks

@@ -170,6 +170,7 @@ impl Workspace {
                     BrowseFor::Open => Command::OpenFile(path),
                     BrowseFor::SaveScene => Command::SaveScene(path),
                     BrowseFor::Export => Command::Export(path),
+                    BrowseFor::ExportFull => Command::ExportFull(path),
                     BrowseFor::ExportOverlay => Command::ExportOverlay(path),
                     BrowseFor::ExportSceneView => Command::ExportSceneView(path),
                     BrowseFor::ExportTree => Command::ExportTree(path),

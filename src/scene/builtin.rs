@@ -16,6 +16,35 @@ pub const NAMES: &[&str] = &[
     "default", "quiz", "glass", "box", "smooth", "acne", "cracks",
 ];
 
+/// One line on each built-in scene, in the order of [`NAMES`] (`raytree scenes`, `--help`).
+const DESCRIPTIONS: &[&str] = &[
+    "Whitted's picture: mirror and glass spheres over a checkerboard, a gold torus",
+    "the lecture's closing quiz: one triangle, one light, numbers to check by hand",
+    "refraction and total internal reflection: a glass sphere and a Porro prism",
+    "a closed room seen from inside, a mirror wall, glass and matte spheres",
+    "a smooth textured ball beside a faceted copy (vertex normals, map_Kd)",
+    "shadow acne on purpose: try --offset fixed against the default",
+    "cracks at shared edges: try --triangle moller-trumbore or lecture",
+];
+
+/// The one-line description of built-in scene `name`.
+pub fn describe(name: &str) -> Option<&'static str> {
+    NAMES
+        .iter()
+        .position(|n| *n == name)
+        .map(|i| DESCRIPTIONS[i])
+}
+
+/// Every built-in scene with its description, a line each, the names aligned.
+pub fn listing() -> String {
+    let width = NAMES.iter().map(|n| n.len()).max().unwrap_or(0);
+    NAMES
+        .iter()
+        .zip(DESCRIPTIONS)
+        .map(|(n, d)| format!("  {n:<width$}  {d}\n"))
+        .collect()
+}
+
 const SCENES: &[(&str, &str)] = &[
     ("default", include_str!("../../assets/scenes/default.toml")),
     ("quiz", include_str!("../../assets/scenes/quiz.toml")),
@@ -77,15 +106,22 @@ pub fn scene_text(name: &str) -> Option<&'static str> {
     SCENES.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)
 }
 
+/// "there is no `what` "name" (did you mean "glass"?); the built-in scenes are ...": the
+/// closest built-in names to a mistyped one.
+pub fn unknown(name: &str, what: &str) -> SceneError {
+    let names: Vec<String> = NAMES.iter().map(|n| format!("\"{n}\"")).collect();
+    let closest = super::diag::suggest(name, NAMES.iter().copied())
+        .map(|n| format!(" (did you mean \"{n}\"?)"))
+        .unwrap_or_default();
+    SceneError(format!(
+        "there is no {what} \"{name}\"{closest}; the built-in scenes are {}.",
+        list_and(&names)
+    ))
+}
+
 /// Loads a built-in scene by name ([`NAMES`]); [`Scene::source`] stays `None`.
 pub fn load_builtin(name: &str) -> Result<Scene, SceneError> {
-    let text = scene_text(name).ok_or_else(|| {
-        let names: Vec<String> = NAMES.iter().map(|n| format!("\"{n}\"")).collect();
-        SceneError(format!(
-            "there is no built-in scene \"{name}\"; the built-in scenes are {}.",
-            list_and(&names)
-        ))
-    })?;
+    let text = scene_text(name).ok_or_else(|| unknown(name, "built-in scene"))?;
     load_scene_str_with_files(
         text,
         &format!("builtin/{name}.toml"),
@@ -146,6 +182,7 @@ mod tests {
     #[test]
     fn every_name_has_a_scene() {
         assert_eq!(NAMES.len(), SCENES.len());
+        assert_eq!(NAMES.len(), DESCRIPTIONS.len());
         for name in NAMES {
             assert!(scene_text(name).is_some(), "{name}");
         }

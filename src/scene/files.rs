@@ -17,6 +17,10 @@ pub fn open_scene_arg(arg: &str) -> Result<Scene, SceneError> {
     if !path.exists() && builtin::NAMES.contains(&arg) {
         return builtin::load_builtin(arg);
     }
+    // Neither a file nor a scene file's name: most likely a built-in name mistyped.
+    if !path.exists() && path.extension().is_none() {
+        return Err(builtin::unknown(arg, "file or built-in scene"));
+    }
     load_scene_file(path)
 }
 

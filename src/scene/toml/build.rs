@@ -16,7 +16,7 @@ use super::keys::{
     check_sections,
 };
 use super::names::unique_names;
-use super::reader::{Section, syntax_error};
+use super::reader::{Section, Value, syntax_error};
 use super::sections::{choice, parse_camera, parse_light, parse_material, parse_render};
 use crate::scene::diag::{SceneError, Src, list_and, short, short_path, suggest};
 use crate::scene::obj::{self, MeshPlacement};
@@ -94,11 +94,31 @@ impl SceneBuilder<'_> {
             let Some(DeValue::Array(items)) = get(name).map(|v| v.get_ref()) else {
                 return Ok(Vec::new());
             };
-            let what = |i: usize| format!("{name} {}", i + 1);
+            // Messages call an item by its name where it has one ("material `glass`"), else by
+            // its place ("sphere 2").
+            let what = |i: usize, v: &Value| {
+                let named = match v.get_ref() {
+                    DeValue::Table(t) => t.iter().find_map(|(k, v)| match v.get_ref() {
+                        DeValue::String(s) if k.get_ref().as_ref() == "name" && !s.is_empty() => {
+                            Some(s.to_string())
+                        }
+                        _ => None,
+                    }),
+                    _ => None,
+                };
+                match named {
+                    Some(n) => format!("{name} `{n}`"),
+                    None => format!("{name} {}", i + 1),
+                }
+            };
             items
                 .iter()
                 .enumerate()
-                .map(|(i, v)| Section::new(src, what(i), v, keys))
+                .map(|(i, v)| {
+                    let mut section = Section::new(src, what(i, v), v, keys)?;
+                    section.place = format!("{name} {}", i + 1);
+                    Ok(section)
+                })
                 .collect()
         };
 

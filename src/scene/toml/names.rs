@@ -49,7 +49,7 @@ impl Names {
         kind: &str,
     ) -> Result<(), SceneError> {
         if let Some(first) = self.taken.get(name) {
-            return Err(s.error(
+            return Err(s.error_at_place(
                 span,
                 "name",
                 format!(
@@ -58,7 +58,7 @@ impl Names {
                 ),
             ));
         }
-        self.taken.insert(name.to_string(), s.what.clone());
+        self.taken.insert(name.to_string(), s.place.clone());
         Ok(())
     }
 

@@ -50,6 +50,8 @@ pub(crate) type Value<'i> = Spanned<DeValue<'i>>;
 pub(crate) struct Section<'s, 't, 'i> {
     src: &'s Src<'s>,
     pub what: String,
+    /// Its place ("material 2"), for messages where the name itself is in question.
+    pub place: String,
     table: &'t DeTable<'i>,
     pub span: Range<usize>,
 }
@@ -87,6 +89,7 @@ impl<'s, 't, 'i> Section<'s, 't, 'i> {
         }
         Ok(Self {
             src,
+            place: what.clone(),
             what,
             table,
             span: value.span(),
@@ -109,6 +112,19 @@ impl<'s, 't, 'i> Section<'s, 't, 'i> {
         self.src.error(
             span,
             format!("{} field `{key}` {}", self.what, phrase.as_ref()),
+        )
+    }
+
+    /// [`Self::error`] naming the section by its place, not its name.
+    pub(crate) fn error_at_place(
+        &self,
+        span: &Range<usize>,
+        key: &str,
+        phrase: impl AsRef<str>,
+    ) -> SceneError {
+        self.src.error(
+            span,
+            format!("{} field `{key}` {}", self.place, phrase.as_ref()),
         )
     }
 
