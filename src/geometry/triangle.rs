@@ -284,9 +284,6 @@ impl Shear {
         }
         let inv_det = 1.0 / det;
         let t = t_scaled * inv_det;
-        if !(t > t_min && t < t_max) {
-            return None;
-        }
         // pbrt-v4: accept only a t conservatively greater than zero. A ray that starts on the
         // triangle's plane (an offset origin of a flat, axis-aligned floor has a zero error
         // bound along the normal) can otherwise compute a tiny positive t and shadow itself.
@@ -306,6 +303,11 @@ impl Shear {
             // on a needle of length L and width w: past t, it no longer tells a real hit from
             // one at the origin. Decide these in f64 (rare: the common case never gets here).
             return close_hit_f64::<KX, KY, KZ>(v, ray, t_min, t_max);
+        }
+        // The range check after the bound: a close call is range-checked on its f64 `t`
+        // alone, so that the answer never depends on the order an accelerator tests in.
+        if !(t > t_min && t < t_max) {
+            return None;
         }
         Some(TriHit {
             t,
@@ -660,7 +662,8 @@ fn watertight_lanes<L: Lanes, const KX: usize, const KY: usize, const KZ: usize>
     let t_sign_ok =
         (det.cmp_lt(zero) & t_scaled.cmp_lt(zero)) | (det.cmp_gt(zero) & t_scaled.cmp_gt(zero));
     let in_range = t.cmp_gt(t_min) & t.cmp_lt(t_max);
-    let mut mask = L::bits(inside & det_ok & t_sign_ok & in_range) & !on_edge;
+    // In front and inside; the range is checked after the bound, as in the scalar test.
+    let mut mask = L::bits(inside & det_ok & t_sign_ok) & !on_edge;
     let mut close = 0;
     if mask != 0 {
         // pbrt-v4's conservative t > δt, as in the scalar test.
@@ -697,7 +700,7 @@ fn watertight_lanes<L: Lanes, const KX: usize, const KY: usize, const KZ: usize>
         // `t <= δt` goes to the scalar test, which decides it in `f64` (a NaN δt accepts,
         // as in the scalar test).
         close = L::bits(t.cmp_le(delta_t)) & mask;
-        mask &= !close;
+        mask &= !close & L::bits(in_range);
     }
     LaneHits {
         mask,
