@@ -699,8 +699,8 @@ pub(super) fn row_t5(o: &StabilityOptions, rng: &mut Pcg) -> Row {
         ),
         robust: format!(
             "watertight misses {:.2}% face-on and {:.2}% up to 85° up to 1e6 sizes (ulp of the \
-             distance ≤ 1/16 of the size); first misses from {} face-on, from {} up to 85° \
-             ({:.1}% at 1e7, where one ulp is the whole triangle; MT {:.1}%). The f32 bound δt \
+             distance ≤ 1/16 of the size); first miss: {} face-on, {} up to 85° ({:.1}% at \
+             1e7, where one ulp is the whole triangle; MT {:.1}%). The f32 bound δt \
              grows like ε·t²/size and passes t from ~1e5 sizes: hits with t ≤ δt are decided \
              in f64",
             placeable(0),
