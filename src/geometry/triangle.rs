@@ -368,7 +368,7 @@ fn close_hit_f64<const KX: usize, const KY: usize, const KZ: usize>(
     let delta_t =
         3.0 * (gamma64(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) / det.abs();
     // The sign of `t` itself is part of the test (`t > δt ≥ 0`).
-    if !(t > delta_t) {
+    if t.is_nan() || t <= delta_t {
         return None;
     }
     let t32 = t as f32;
