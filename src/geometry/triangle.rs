@@ -152,7 +152,16 @@ fn max_component_index(a: Vec3) -> usize {
 ///    shared edge gives exactly negated values in its two triangles), recomputed in `f64` when
 ///    any is exactly 0 (the ray passes through an edge or vertex);
 /// 5. reject mixed signs (outside) and `det = U + V + W == 0` only;
-/// 6. the scaled distance `T = U·z0 + V·z1 + W·z2` must have the sign of `det` (hit in front).
+/// 6. the scaled distance `T = U·z0 + V·z1 + W·z2` must have the sign of `det` (hit in front);
+/// 7. pbrt-v4's conservative `t > δt` (δt bounds the rounding error of `t`).
+///
+/// Close calls are decided again in `f64` from the same `f32` inputs (translation and shear
+/// included, see `close_hit_f64`): mixed signs with an edge function within its rounding
+/// error of 0, `det == 0`, and `t ≤ δt`. In `f32` the translation by the origin rounds a
+/// needle's width away once it is a few ulp of its ray-relative coordinates, and δt grows
+/// like ε·t²/size on a small triangle far away until it passes `t` (docs/stability.md, rows
+/// T3 and T5). Each of these only turns an `f32` miss into a hit that `f64` confirms, so
+/// shared edges stay watertight; none occurs on ordinary geometry, so the path stays cold.
 ///
 /// The range check `t_min < t < t_max` is made on the divided `t = T/det` (not on `T` against
 /// `t_max·det`) so the answer is a pure function of the triangle and the ray: the accelerators
@@ -243,11 +252,31 @@ impl Shear {
             e2 = f(p0x, p1y, p0y, p1x);
         }
         if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+            // Outside, unless an edge function is within its rounding error of 0: a needle
+            // thinner than a few ulp of its ray-relative coordinates has all of them there
+            // (the translation by the origin rounds its width away). Decide those in f64.
+            let m = p0x
+                .abs()
+                .max(p1x.abs())
+                .max(p2x.abs())
+                .max(p0y.abs())
+                .max(p1y.abs())
+                .max(p2y.abs());
+            let mz = (sz * p0z).abs().max((sz * p1z).abs()).max((sz * p2z).abs());
+            let bound = gamma(24) * ((m + mz) * m);
+            if e0.abs() <= bound || e1.abs() <= bound || e2.abs() <= bound {
+                return close_hit_f64::<KX, KY, KZ>(v, ray, t_min, t_max);
+            }
             return None;
         }
         let det = e0 + e1 + e2;
-        if det == 0.0 || det.is_nan() {
+        if det.is_nan() {
             return None;
+        }
+        if det == 0.0 {
+            // All three 0 even from exact products: the rounded triangle is a segment through
+            // the ray (a needle whose width rounded away), or the ray lies in its plane.
+            return close_hit_f64::<KX, KY, KZ>(v, ray, t_min, t_max);
         }
         let t_scaled = e0 * (sz * p0z) + e1 * (sz * p1z) + e2 * (sz * p2z);
         if t_scaled.is_nan() || (det < 0.0 && t_scaled >= 0.0) || (det > 0.0 && t_scaled <= 0.0) {
@@ -255,9 +284,6 @@ impl Shear {
         }
         let inv_det = 1.0 / det;
         let t = t_scaled * inv_det;
-        if !(t > t_min && t < t_max) {
-            return None;
-        }
         // pbrt-v4: accept only a t conservatively greater than zero. A ray that starts on the
         // triangle's plane (an offset origin of a flat, axis-aligned floor has a zero error
         // bound along the normal) can otherwise compute a tiny positive t and shadow itself.
@@ -273,6 +299,14 @@ impl Shear {
         let delta_t =
             3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs();
         if t <= delta_t {
+            // The bound grows like ε·t²/size on a small triangle far away, and like ε·t·L/w
+            // on a needle of length L and width w: past t, it no longer tells a real hit from
+            // one at the origin. Decide these in f64 (rare: the common case never gets here).
+            return close_hit_f64::<KX, KY, KZ>(v, ray, t_min, t_max);
+        }
+        // The range check after the bound: a close call is range-checked on its f64 `t`
+        // alone, so that the answer never depends on the order an accelerator tests in.
+        if !(t > t_min && t < t_max) {
             return None;
         }
         Some(TriHit {
@@ -281,6 +315,71 @@ impl Shear {
             b2: e2 * inv_det,
         })
     }
+}
+
+/// `γ(n)` of `f64` arithmetic: the relative error bound of `n` roundings.
+fn gamma64(n: u32) -> f64 {
+    let nu = f64::from(n) * (f64::EPSILON * 0.5);
+    nu / (1.0 - nu)
+}
+
+/// The watertight test's close cases (the computed `t` within its `f32` error bound `δt`),
+/// decided again from the same `f32` inputs in `f64`: the translation, the shear, the edge
+/// functions, `t`, and the same kind of bound `δt`, now in units of `f64` rounding (2⁻⁵³,
+/// some 5·10⁸ times smaller). A hit is kept when the `f64` edge functions agree in sign and
+/// `t > δt` there; `t` and the barycentrics then come from `f64`. Only hits the `f32` test
+/// would have dropped are added, so the test stays watertight, and the answer is still a pure
+/// function of the triangle and the ray.
+#[cold]
+#[inline(never)]
+fn close_hit_f64<const KX: usize, const KY: usize, const KZ: usize>(
+    v: &[Vec3; 3],
+    ray: &Ray,
+    t_min: f32,
+    t_max: f32,
+) -> Option<TriHit> {
+    let d = DVec3::from(ray.dir);
+    let (sx, sy, sz) = (-d[KX] / d[KZ], -d[KY] / d[KZ], 1.0 / d[KZ]);
+    let o = DVec3::from(ray.origin);
+    let p = v.map(|p| DVec3::from(p) - o);
+    let x = p.map(|p| p[KX] + sx * p[KZ]);
+    let y = p.map(|p| p[KY] + sy * p[KZ]);
+    let z = p.map(|p| sz * p[KZ]);
+    let e = [
+        x[1] * y[2] - y[1] * x[2],
+        x[2] * y[0] - y[2] * x[0],
+        x[0] * y[1] - y[0] * x[1],
+    ];
+    if e.iter().any(|&e| e < 0.0) && e.iter().any(|&e| e > 0.0) {
+        return None;
+    }
+    let det = e[0] + e[1] + e[2];
+    let t_scaled = e[0] * z[0] + e[1] * z[1] + e[2] * z[2];
+    if det == 0.0 || !det.is_finite() || !t_scaled.is_finite() {
+        return None;
+    }
+    let t = t_scaled / det;
+    let abs_max = |a: [f64; 3]| a[0].abs().max(a[1].abs()).max(a[2].abs());
+    let (max_x, max_y, max_z, max_e) = (abs_max(x), abs_max(y), abs_max(z), abs_max(e));
+    let delta_z = gamma64(3) * max_z;
+    let delta_x = gamma64(5) * (max_x + max_z);
+    let delta_y = gamma64(5) * (max_y + max_z);
+    let delta_e = 2.0 * (gamma64(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+    let delta_t =
+        3.0 * (gamma64(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) / det.abs();
+    // The sign of `t` itself is part of the test (`t > δt ≥ 0`).
+    if t.is_nan() || t <= delta_t {
+        return None;
+    }
+    let t32 = t as f32;
+    if !(t32 > t_min && t32 < t_max) {
+        return None;
+    }
+    Some(TriHit {
+        t: t32,
+        b1: (e[1] / det) as f32,
+        b2: (e[2] / det) as f32,
+    })
 }
 
 /// Four triangles, one per lane (structure of arrays): `v[3·k + axis]` holds the coordinate
@@ -359,7 +458,8 @@ impl Shear {
     /// the same operations in the same order on each lane, and IEEE `f32` arithmetic rounds
     /// the same in a vector lane as in a scalar register, so every lane's answer is
     /// bit-identical to the scalar test of its triangle. Lanes where an edge function is
-    /// exactly 0 (the `f64` re-evaluation) are answered by the scalar test.
+    /// exactly 0 or `t` is within its error bound (the `f64` re-evaluations) are answered by
+    /// the scalar test.
     #[inline(always)]
     pub fn intersect4(&self, tris: &Triangles4, ray: &Ray, t_min: f32, t_max: f32) -> TriHits4 {
         match self.kz {
@@ -387,8 +487,8 @@ impl Shear {
             b1: found.b1.to_array(),
             b2: found.b2.to_array(),
         };
-        if found.on_edge != 0 {
-            self.on_edges(&mut hits, found.on_edge, tris, ray, t_min, t_max);
+        if found.slow != 0 {
+            self.slow_lanes(&mut hits, found.slow, tris, ray, t_min, t_max);
         }
         hits
     }
@@ -458,19 +558,20 @@ impl Shear {
             b1: b1.1,
             b2: b2.1,
         };
-        if found.on_edge & 0xf != 0 {
-            sa.on_edges(&mut ha, found.on_edge & 0xf, tris, ra, a_min, a_max);
+        if found.slow & 0xf != 0 {
+            sa.slow_lanes(&mut ha, found.slow & 0xf, tris, ra, a_min, a_max);
         }
-        if found.on_edge >> 4 != 0 {
-            sb.on_edges(&mut hb, found.on_edge >> 4, tris, rb, b_min, b_max);
+        if found.slow >> 4 != 0 {
+            sb.slow_lanes(&mut hb, found.slow >> 4, tris, rb, b_min, b_max);
         }
         (ha, hb)
     }
 
-    /// The lanes in `lanes` (an edge function exactly 0), answered by the scalar test.
+    /// The lanes in `lanes` (an edge function exactly 0, or `t` within its error bound),
+    /// answered by the scalar test.
     #[cold]
     #[inline(never)]
-    fn on_edges(
+    fn slow_lanes(
         &self,
         hits: &mut TriHits4,
         mut lanes: u32,
@@ -491,11 +592,11 @@ impl Shear {
 }
 
 /// What [`watertight_lanes`] finds: bit `i` of `mask` when lane `i` hits (lanes with an edge
-/// function exactly 0 excluded: they are in `on_edge`, for the scalar test), and every lane's
-/// `t` and barycentrics.
+/// function exactly 0, or a `t` within its error bound, excluded: they are in `slow`, for the
+/// scalar test), and every lane's `t` and barycentrics.
 struct LaneHits<L> {
     mask: u32,
-    on_edge: u32,
+    slow: u32,
     t: L,
     b1: L,
     b2: L,
@@ -536,11 +637,34 @@ fn watertight_lanes<L: Lanes, const KX: usize, const KY: usize, const KZ: usize>
     // Every rejection of the scalar test, negated: inside, det ≠ 0 and not NaN, T of det's
     // sign (and not NaN), t in range.
     let inside = !(negative & positive);
+    // Outside but an edge function within its rounding error of 0 (a needle thinner than a
+    // few ulp), as in the scalar test: for the scalar test, which decides it in `f64`.
+    let m = p0x
+        .abs_lanes()
+        .max_lanes(p1x.abs_lanes())
+        .max_lanes(p2x.abs_lanes())
+        .max_lanes(p0y.abs_lanes())
+        .max_lanes(p1y.abs_lanes())
+        .max_lanes(p2y.abs_lanes());
+    let mz = (sz * p0z)
+        .abs_lanes()
+        .max_lanes((sz * p1z).abs_lanes())
+        .max_lanes((sz * p2z).abs_lanes());
+    let bound = zero.splat_as(gamma(24)) * ((m + mz) * m);
+    let uncertain = L::bits(
+        negative
+            & positive
+            & (e0.abs_lanes().cmp_le(bound)
+                | e1.abs_lanes().cmp_le(bound)
+                | e2.abs_lanes().cmp_le(bound)),
+    );
     let det_ok = det.cmp_ne(zero) & det.cmp_eq(det);
     let t_sign_ok =
         (det.cmp_lt(zero) & t_scaled.cmp_lt(zero)) | (det.cmp_gt(zero) & t_scaled.cmp_gt(zero));
     let in_range = t.cmp_gt(t_min) & t.cmp_lt(t_max);
-    let mut mask = L::bits(inside & det_ok & t_sign_ok & in_range) & !on_edge;
+    // In front and inside; the range is checked after the bound, as in the scalar test.
+    let mut mask = L::bits(inside & det_ok & t_sign_ok) & !on_edge;
+    let mut close = 0;
     if mask != 0 {
         // pbrt-v4's conservative t > δt, as in the scalar test.
         let (z0, z1, z2) = (
@@ -573,12 +697,14 @@ fn watertight_lanes<L: Lanes, const KX: usize, const KY: usize, const KZ: usize>
         let delta_t = zero.splat_as(3.0)
             * (g3 * max_e * max_z + delta_e * max_z + delta_z * max_e)
             * inv_det.abs_lanes();
-        // `t <= δt` rejects (a NaN δt accepts, as in the scalar test).
-        mask &= !L::bits(t.cmp_le(delta_t));
+        // `t <= δt` goes to the scalar test, which decides it in `f64` (a NaN δt accepts,
+        // as in the scalar test).
+        close = L::bits(t.cmp_le(delta_t)) & mask;
+        mask &= !close & L::bits(in_range);
     }
     LaneHits {
         mask,
-        on_edge,
+        slow: on_edge | close | uncertain | L::bits(det.cmp_eq(zero)),
         t,
         b1: e1 * inv_det,
         b2: e2 * inv_det,
