@@ -513,7 +513,7 @@ fn panel_body(app: &mut ViewerApp, ui: &mut Ui) {
     ui.horizontal(|ui| {
         ui.with_layout(egui::Layout::right_to_left(egui::Align::Min), |ui| {
             close = ui
-                .button("×")
+                .button("Close")
                 .on_hover_text("close the panel; the lesson stays: the Lessons menu resumes it")
                 .clicked();
             ui.with_layout(egui::Layout::left_to_right(egui::Align::Min), |ui| {
@@ -640,7 +640,8 @@ fn answer_ui(app: &mut ViewerApp, ui: &mut Ui, kind: &TaskKind) {
                 }
                 submit |= ui.button("Check").clicked();
             });
-            ui.weak(format!("checked to within ±{tolerance}"));
+            // Written as in the file (a tolerance is read as f32).
+            ui.weak(format!("checked to within ±{}", *tolerance as f32));
             if submit {
                 let typed = app
                     .lesson
@@ -696,7 +697,7 @@ fn verdict_ui(app: &mut ViewerApp, ui: &mut Ui, outcome: &Result<Verdict, String
                     ui.add(egui::Label::new(format!("Cannot check: {why}")).wrap());
                 }
                 Ok(v) => {
-                    let head = if v.correct { "Right" } else { "Not yet" };
+                    let head = if v.correct { "Correct" } else { "Not yet" };
                     ui.label(RichText::new(head).strong().color(stroke));
                     ui.add(egui::Label::new(&v.message).wrap());
                     if let Some(hint) = &v.hint {

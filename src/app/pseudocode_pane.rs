@@ -135,21 +135,19 @@ fn code(ui: &mut Ui, lines: &[Executed], current: Option<&str>) {
 /// The variables of the lines run, in order, each under its line's id.
 fn variables(ui: &mut Ui, lines: &[Executed]) {
     ui.label(RichText::new("variables").strong());
-    egui::Grid::new("pseudocode variables")
-        .num_columns(2)
-        .striped(true)
-        .show(ui, |ui| {
-            let width = ui.available_width();
-            for e in lines {
-                for (name, value) in &e.vars {
-                    ui.add(egui::Label::new(RichText::new(*name).monospace()).truncate());
-                    ui.scope(|ui| {
-                        ui.set_max_width((width - 90.0).max(80.0));
-                        ui.add(egui::Label::new(RichText::new(value).monospace()).truncate())
-                            .on_hover_text(format!("{name} = {value} (line {})", e.line));
-                    });
-                    ui.end_row();
-                }
-            }
-        });
+    // The names' column: as wide as the widest name ("sum so far"), a third of the pane at most.
+    let names = (ui.available_width() / 3.0).clamp(40.0, 100.0);
+    for e in lines {
+        for (name, value) in &e.vars {
+            ui.horizontal(|ui| {
+                let height = ui.spacing().interact_size.y;
+                ui.allocate_ui(egui::vec2(names, height), |ui| {
+                    ui.set_width(names);
+                    ui.add(egui::Label::new(RichText::new(*name).monospace().weak()).truncate());
+                });
+                ui.add(egui::Label::new(RichText::new(value).monospace()).truncate())
+                    .on_hover_text(format!("{name} = {value} (line \"{}\")", e.line));
+            });
+        }
+    }
 }
