@@ -13,7 +13,7 @@ mod viewer;
 
 use eframe::egui;
 use egui::accesskit::Role;
-use egui_kittest::kittest::{NodeT as _, Queryable};
+use egui_kittest::kittest::Queryable;
 use raytree::app::lesson_panel::{self, Enter};
 use raytree::app::workspace::Pane;
 use raytree::lessons::pseudocode;

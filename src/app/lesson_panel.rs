@@ -485,9 +485,11 @@ pub fn side_panel(app: &mut ViewerApp, ui: &mut Ui) {
     if !app.lesson.open || app.lesson.active.is_none() {
         return;
     }
+    // A quarter of the window, so that at 1024 points the render keeps most of the room.
+    let width = (ui.ctx().content_rect().width() * 0.25).clamp(240.0, 340.0);
     egui::Panel::right("lesson")
         .resizable(true)
-        .default_size(300.0)
+        .default_size(width)
         .min_size(220.0)
         .show(ui, |ui| {
             egui::ScrollArea::vertical()

@@ -5,7 +5,8 @@
 //! step or Play walks the tree, the pane follows the generation revealed: the call at that
 //! depth on the way to the selected node (or below it, along first children).
 //!
-//! Lines and values too wide for the pane are elided, the whole text on hover.
+//! Code lines too wide for the pane wrap; values too wide are elided, the whole text on
+//! hover.
 
 use eframe::egui::{self, Color32, RichText, Ui};
 
@@ -63,7 +64,7 @@ fn code_and_comment(text: &str) -> (&str, Option<&str>) {
 
 /// The pane for the selected node of the current tree.
 pub fn ui(ui: &mut Ui, selection: &TreeSelection, drawn: &mut Drawn) {
-    *drawn = Drawn::default();
+    let before = std::mem::take(drawn);
     let Some(tree) = &selection.tree else {
         ui.weak("click a pixel in the render view: its tree's calls of trace() are shown here");
         return;
@@ -75,6 +76,8 @@ pub fn ui(ui: &mut Ui, selection: &TreeSelection, drawn: &mut Drawn) {
     let current = lines.last().map(|e| e.line);
     drawn.node = Some(path.clone());
     drawn.line = current;
+    // A new line to show (another node, or the step-through moved on) is scrolled to.
+    let moved = (before.node.as_ref(), before.line) != (Some(&path), current);
     let body = egui::TextStyle::Body.resolve(ui.style()).size;
     let mono = egui::TextStyle::Monospace.resolve(ui.style()).size;
     drawn.least_text = Some(body.min(mono));
@@ -88,14 +91,14 @@ pub fn ui(ui: &mut Ui, selection: &TreeSelection, drawn: &mut Drawn) {
     egui::ScrollArea::vertical()
         .auto_shrink([false, false])
         .show(ui, |ui| {
-            code(ui, &lines, current);
+            code(ui, &lines, current, moved);
             ui.separator();
             variables(ui, &lines);
         });
 }
 
 /// The procedure, the lines run marked and the returning one highlighted.
-fn code(ui: &mut Ui, lines: &[Executed], current: Option<&str>) {
+fn code(ui: &mut Ui, lines: &[Executed], current: Option<&str>, scroll: bool) {
     let highlight = ui.visuals().selection.bg_fill;
     for line in LINES {
         let ran = lines.iter().any(|e| e.line == line.id);
@@ -119,7 +122,11 @@ fn code(ui: &mut Ui, lines: &[Executed], current: Option<&str>) {
         } else {
             rich.weak()
         };
-        let r = ui.add(egui::Label::new(rich).truncate());
+        // Wrapped, not cut, in a narrow pane: every line reads whole.
+        let r = ui.add(egui::Label::new(rich).wrap());
+        if here && scroll {
+            r.scroll_to_me(Some(egui::Align::Center));
+        }
         let mut hover = line.text.to_string();
         if here {
             hover.push_str("\n(the call returns here)");
@@ -137,8 +144,14 @@ fn variables(ui: &mut Ui, lines: &[Executed]) {
     ui.label(RichText::new("variables").strong());
     // The names' column: as wide as the widest name ("sum so far"), a third of the pane at most.
     let names = (ui.available_width() / 3.0).clamp(40.0, 100.0);
+    let mut listed: Vec<(&str, &str)> = Vec::new();
     for e in lines {
         for (name, value) in &e.vars {
+            // A variable shown again with the same value (`step` on two lines) is listed once.
+            if listed.contains(&(name, value.as_str())) {
+                continue;
+            }
+            listed.push((name, value.as_str()));
             ui.horizontal(|ui| {
                 let height = ui.spacing().interact_size.y;
                 ui.allocate_ui(egui::vec2(names, height), |ui| {
