@@ -10,11 +10,12 @@
 //! student sees. While a lesson is open the viewer renders at the scene's own size, so the
 //! pixels a lesson names are the pixels clicked; ending the lesson gives back the pane size.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use eframe::egui::{self, Color32, RichText, Ui};
 
+pub use super::LessonArg;
 use super::dialog::BrowseFor;
 use super::pseudocode_pane;
 use super::undo::WorkingCopy;
@@ -24,13 +25,6 @@ use crate::lessons::{
     Answer, Control, Lesson, SceneRef, Setup, Step, StepState, TaskKind, Verdict, View,
     choice_options, evaluate,
 };
-
-/// A lesson to open: a shipped one by name, or a file.
-#[derive(Clone, Debug, PartialEq)]
-pub enum LessonArg {
-    Shipped(String),
-    File(PathBuf),
-}
 
 /// Where entering a step stands.
 #[derive(Clone, Debug, PartialEq)]

@@ -92,7 +92,14 @@ pub enum Command {
     Stop,
     /// Open a lesson (or resume it when it is the one under way): its scene, then its first
     /// step ([`lesson_panel`]).
-    OpenLesson(lesson_panel::LessonArg),
+    OpenLesson(LessonArg),
+}
+
+/// A lesson to open: a shipped one by name, or a file.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LessonArg {
+    Shipped(String),
+    File(PathBuf),
 }
 
 /// The viewer.

@@ -168,9 +168,7 @@ impl Workspace {
                 self.browser = None;
                 Some(match purpose {
                     BrowseFor::Open => Command::OpenFile(path),
-                    BrowseFor::Lesson => {
-                        Command::OpenLesson(super::lesson_panel::LessonArg::File(path))
-                    }
+                    BrowseFor::Lesson => Command::OpenLesson(super::LessonArg::File(path)),
                     BrowseFor::SaveScene => Command::SaveScene(path),
                     BrowseFor::Export => Command::Export(path),
                     BrowseFor::ExportOverlay => Command::ExportOverlay(path),
