@@ -379,3 +379,31 @@ fn lesson_snapshot_1024x640() {
 fn lesson_snapshot_1600x1000() {
     lesson_snapshot([1600.0, 1000.0], "lesson_1600x1000");
 }
+
+#[test]
+fn a_viewer_with_a_lesson_open_asks_for_no_frame_once_its_step_is_shown() {
+    let mut h = viewer([1280.0, 800.0]);
+    open_from_menu(&mut h, "Termination conditions");
+    click_button(&mut h, "Next >");
+    step_done(&mut h);
+    let immediate = |h: &Window| {
+        h.output()
+            .viewport_output
+            .get(&egui::ViewportId::ROOT)
+            .is_some_and(|v| v.repaint_delay == std::time::Duration::ZERO)
+    };
+    // A layout change restarts the scene view at its new size once or twice: converge first.
+    let deadline = std::time::Instant::now() + viewer::DEADLINE;
+    loop {
+        settle(&mut h);
+        if !immediate(&h) {
+            break;
+        }
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the viewer kept asking for frames with a lesson open"
+        );
+    }
+    h.step();
+    assert!(!immediate(&h), "a shown step asks for no immediate frame");
+}

@@ -419,7 +419,16 @@ pub fn after_frame(app: &mut ViewerApp, ctx: &egui::Context) {
             a.enter = next;
         }
     }
-    ctx.request_repaint();
+    // A phase waits, or queued a command: the next frame carries on. A step shown asks for
+    // nothing (the viewer idles with a lesson open).
+    let waiting = app
+        .lesson
+        .active
+        .as_ref()
+        .is_some_and(|a| a.enter != Enter::Done);
+    if waiting || !app.pending.is_empty() {
+        ctx.request_repaint();
+    }
 }
 
 /// The current value of a control task's control in the working copy, as an answer, and in
