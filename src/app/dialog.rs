@@ -10,6 +10,8 @@ use egui_file::{FileDialog, State};
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BrowseFor {
     Open,
+    /// A lesson file (docs/lessons.md).
+    Lesson,
     SaveScene,
     Export,
     ExportFull,
@@ -23,6 +25,7 @@ impl BrowseFor {
     pub fn title(self) -> &'static str {
         match self {
             BrowseFor::Open => "Open scene or OBJ",
+            BrowseFor::Lesson => "Open lesson (.toml)",
             BrowseFor::SaveScene => "Save scene as TOML",
             BrowseFor::Export => "Export the render as shown (.png or .exr)",
             BrowseFor::ExportFull => {
@@ -39,7 +42,7 @@ impl BrowseFor {
     pub fn extensions(self) -> &'static [&'static str] {
         match self {
             BrowseFor::Open => &["toml", "obj"],
-            BrowseFor::SaveScene => &["toml"],
+            BrowseFor::SaveScene | BrowseFor::Lesson => &["toml"],
             BrowseFor::Export | BrowseFor::ExportFull => &["png", "exr"],
             BrowseFor::ExportOverlay | BrowseFor::ExportSceneView => &["png"],
             BrowseFor::ExportTree => &["json"],
@@ -70,7 +73,7 @@ pub struct FileBrowser {
 impl FileBrowser {
     /// A dialog for `purpose` in `dir`, the file name field holding `name`.
     pub fn new(purpose: BrowseFor, dir: PathBuf, name: &str) -> Self {
-        let dialog = if purpose == BrowseFor::Open {
+        let dialog = if matches!(purpose, BrowseFor::Open | BrowseFor::Lesson) {
             FileDialog::open_file()
         } else {
             FileDialog::save_file()

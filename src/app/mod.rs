@@ -16,6 +16,7 @@ mod film;
 pub mod gesture;
 mod input;
 mod legend;
+pub mod lesson_panel;
 pub mod messages;
 pub mod modes;
 mod open_scene;
@@ -23,6 +24,7 @@ pub mod opening;
 mod paint3d;
 mod panels;
 pub mod picker;
+pub mod pseudocode_pane;
 pub mod render_view;
 mod saving;
 pub mod scene_files;
@@ -93,6 +95,16 @@ pub enum Command {
     PickRect([u32; 2], [u32; 2]),
     FrameAll,
     Stop,
+    /// Open a lesson (or resume it when it is the one under way): its scene, then its first
+    /// step ([`lesson_panel`]).
+    OpenLesson(LessonArg),
+}
+
+/// A lesson to open: a shipped one by name, or a file.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LessonArg {
+    Shipped(String),
+    File(PathBuf),
 }
 
 /// The viewer.
@@ -111,6 +123,8 @@ pub struct ViewerApp {
     pub scene_view: scene_pane::SceneView,
     /// The preferences, the settings panel, the file dialog and the windows.
     pub workspace: Workspace,
+    /// The lesson under way and its panel.
+    pub lesson: lesson_panel::LessonState,
     pending: Vec<Command>,
 }
 
@@ -162,6 +176,7 @@ impl ViewerApp {
             selection: TreeSelection::default(),
             scene_view,
             workspace,
+            lesson: Default::default(),
             pending: Vec::new(),
         };
         // A built-in scene without notes needs no word at start; a file gets its summary.
@@ -450,7 +465,11 @@ impl ViewerApp {
                     self.selection
                         .add_rect(&self.render.tracer, a, b, &mut self.messages);
                 }
-                Command::Pick(x, y) => self.selection.pick(&self.render.tracer, x, y),
+                Command::Pick(x, y) => {
+                    self.selection.pick(&self.render.tracer, x, y);
+                    // The answer to a lesson's pixel task, when one is asked.
+                    self.lesson_clicked(x, y);
+                }
                 Command::FrameAll => {
                     let edit = &mut self.working.scene;
                     if let Some((lo, hi)) = edit.bounds() {
@@ -463,6 +482,7 @@ impl ViewerApp {
                     self.files.stop(&self.working.scene, &mut self.messages);
                     self.render.stop();
                 }
+                Command::OpenLesson(arg) => self.open_lesson(arg),
             }
         }
         // An accelerator change while a file opens: the open starts again with it (the

@@ -177,13 +177,14 @@ fn combo<T: Choice>(ui: &mut Ui, label: &str, value: &mut T, tip: &str) -> bool 
 
 // ---- panels -------------------------------------------------------------------------------
 
-/// The menu bar: Scene, Edit, View, the sweep, help, and the scene's name.
+/// The menu bar: Scene, Edit, View, Lessons, the sweep, help, and the scene's name.
 pub fn top_bar(
     ui: &mut Ui,
     ws: &mut Workspace,
     working: &mut WorkingCopy,
     files: &SceneFiles,
     messages: &mut Messages,
+    lessons: &mut super::lesson_panel::LessonState,
     pending: &mut Vec<Command>,
 ) {
     egui::Panel::top("menu").show(ui, |ui| {
@@ -245,6 +246,9 @@ pub fn top_bar(
                 {
                     messages.window = true;
                 }
+            });
+            ui.menu_button("Lessons", |ui| {
+                super::lesson_panel::menu(ui, lessons, ws, pending)
             });
             if ui.button("Speed vs accuracy").clicked() {
                 ws.sweep.open = true;

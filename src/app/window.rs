@@ -6,7 +6,10 @@ use std::path::{Path, PathBuf};
 use eframe::egui;
 
 use super::dialog::BrowseFor;
-use super::{Command, ViewerApp, input, panels, scene_pane, tree_view, watch, workspace};
+use super::{
+    Command, ViewerApp, input, lesson_panel, panels, pseudocode_pane, scene_pane, tree_view, watch,
+    workspace,
+};
 use crate::scene;
 
 /// Opens the window and runs the viewer until it is closed.
@@ -93,6 +96,7 @@ impl eframe::App for ViewerApp {
             &mut self.working,
             &self.files,
             &mut self.messages,
+            &mut self.lesson,
             &mut self.pending,
         );
         let finished = self.is_finished();
@@ -154,6 +158,7 @@ impl eframe::App for ViewerApp {
                     });
                 });
         }
+        lesson_panel::side_panel(self, ui);
         // The panes fill the central panel edge to edge.
         let frame = egui::Frame::central_panel(ui.style()).inner_margin(0);
         egui::CentralPanel::default()
@@ -200,6 +205,7 @@ impl eframe::App for ViewerApp {
         self.messages.log_window(&ctx);
         self.apply();
         self.working.track(&ctx);
+        lesson_panel::after_frame(self, &ctx);
         self.note_pin();
         self.render.follow_display_prefs(&self.workspace.prefs);
         // A background export wakes the UI itself, at each percent and when it is done.
@@ -213,7 +219,9 @@ impl eframe::App for ViewerApp {
     }
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
-        eframe::set_value(storage, eframe::APP_KEY, &self.workspace.prefs_to_save());
+        let mut prefs = self.workspace.prefs_to_save();
+        self.lesson.keep_prefs(&mut prefs);
+        eframe::set_value(storage, eframe::APP_KEY, &prefs);
     }
 }
 
@@ -346,6 +354,10 @@ fn pane_ui(app: &mut ViewerApp, ui: &mut egui::Ui, pane: workspace::Pane) {
                 ui.weak("click a pixel in the render view for its ray tree");
             }
         },
+        Pane::Pseudocode => {
+            super::picker::strip(ui, &mut app.selection, &app.render.tracer);
+            pseudocode_pane::ui(ui, &app.selection, &mut app.lesson.code);
+        }
         Pane::TreeList => {
             super::picker::strip(ui, &mut app.selection, &app.render.tracer);
             if app.selection.tree.is_some() {

@@ -168,6 +168,7 @@ impl Workspace {
                 self.browser = None;
                 Some(match purpose {
                     BrowseFor::Open => Command::OpenFile(path),
+                    BrowseFor::Lesson => Command::OpenLesson(super::LessonArg::File(path)),
                     BrowseFor::SaveScene => Command::SaveScene(path),
                     BrowseFor::Export => Command::Export(path),
                     BrowseFor::ExportFull => Command::ExportFull(path),
@@ -258,10 +259,22 @@ pub enum Pane {
     SceneView,
     Diagram,
     TreeList,
+    /// The lecture's procedure, the line the selected node's call ran highlighted
+    /// (pseudocode_pane.rs).
+    Pseudocode,
 }
 
 impl Pane {
-    pub const ALL: [Pane; 4] = [Pane::Render, Pane::SceneView, Pane::Diagram, Pane::TreeList];
+    pub const ALL: [Pane; 5] = [
+        Pane::Render,
+        Pane::SceneView,
+        Pane::Diagram,
+        Pane::TreeList,
+        Pane::Pseudocode,
+    ];
+
+    /// The tree's panes: shown when a pixel's tree is, hidden when none is.
+    pub const TREE: [Pane; 3] = [Pane::Diagram, Pane::TreeList, Pane::Pseudocode];
 
     pub fn title(self) -> &'static str {
         match self {
@@ -269,6 +282,7 @@ impl Pane {
             Pane::SceneView => "Scene view",
             Pane::Diagram => "Ray tree diagram",
             Pane::TreeList => "Ray tree",
+            Pane::Pseudocode => "Pseudocode",
         }
     }
 }
@@ -276,7 +290,7 @@ impl Pane {
 pub type Layout = egui_tiles::Tree<Pane>;
 
 /// The version of [`default_layout`]: a saved layout of another version is replaced.
-pub const LAYOUT_VERSION: u32 = 3;
+pub const LAYOUT_VERSION: u32 = 4;
 
 /// The render pane's share of the workspace's width in the default layout.
 pub const RENDER_SHARE: f32 = 0.74;
@@ -291,14 +305,16 @@ fn tabs(tiles: &mut egui_tiles::Tiles<Pane>, pane: Pane) -> TileId {
 }
 
 /// The render view on the left ([`RENDER_SHARE`] of the width); on the right the scene view
-/// above and the tree's diagram and list below, as two tabs of one pane (the diagram in front).
+/// above and the tree's diagram, list and pseudocode below, as tabs of one pane (the diagram in
+/// front).
 pub fn default_layout() -> Layout {
     let mut tiles = egui_tiles::Tiles::default();
     let render = tabs(&mut tiles, Pane::Render);
     let scene = tabs(&mut tiles, Pane::SceneView);
     let diagram = tiles.insert_pane(Pane::Diagram);
     let list = tiles.insert_pane(Pane::TreeList);
-    let tree = tiles.insert_tab_tile(vec![diagram, list]);
+    let code = tiles.insert_pane(Pane::Pseudocode);
+    let tree = tiles.insert_tab_tile(vec![diagram, list, code]);
     let right = tiles.insert_container(Linear::new_binary(
         LinearDir::Vertical,
         [scene, tree],
@@ -319,14 +335,17 @@ pub const FOCUS_RENDER_SHARE: f32 = 0.24;
 pub const FOCUS_DIAGRAM_SHARE: f32 = 0.46;
 
 /// Focus mode's layout: the render with the scene view as its neighbouring tab in a strip at
-/// the left ([`FOCUS_RENDER_SHARE`]), then the diagram and the list side by side.
+/// the left ([`FOCUS_RENDER_SHARE`]), then the diagram and the list (the pseudocode its
+/// neighbouring tab) side by side.
 pub fn focus_layout() -> Layout {
     let mut tiles = egui_tiles::Tiles::default();
     let render = tiles.insert_pane(Pane::Render);
     let scene = tiles.insert_pane(Pane::SceneView);
     let views = tiles.insert_tab_tile(vec![render, scene]);
     let diagram = tabs(&mut tiles, Pane::Diagram);
-    let list = tabs(&mut tiles, Pane::TreeList);
+    let list = tiles.insert_pane(Pane::TreeList);
+    let code = tiles.insert_pane(Pane::Pseudocode);
+    let list = tiles.insert_tab_tile(vec![list, code]);
     let mut row = Linear::new(LinearDir::Horizontal, vec![views, diagram, list]);
     row.shares.set_share(views, FOCUS_RENDER_SHARE);
     row.shares.set_share(diagram, FOCUS_DIAGRAM_SHARE);
@@ -369,7 +388,7 @@ fn follow_tree(ws: &mut Workspace, has_tree: bool) {
         return;
     }
     ws.tree_panes = Some(want);
-    for pane in [Pane::Diagram, Pane::TreeList] {
+    for pane in Pane::TREE {
         if let Some(id) = tile_of(&ws.prefs.layout, pane) {
             ws.prefs.layout.tiles.set_visible(id, has_tree);
         }
