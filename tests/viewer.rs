@@ -153,14 +153,32 @@ fn ctrl_s_exports_a_stamped_png() {
     let out = dir.path().join("shot.png");
     let mut h = harness(small("glass"));
     settle(&mut h);
-    export_via(&mut h, "Render (PNG or EXR)", &out);
-    let (size, _, text) = read_png(&out);
+    export_via(&mut h, "Render as shown", &out);
+    let (size, pixels, text) = read_png(&out);
     assert_eq!(size, (160, 120));
     assert!(
         text.iter()
             .any(|(k, v)| k == "raytree.samples" && v == "1/1"),
         "{text:?}"
     );
+    assert!(
+        text.iter()
+            .any(|(k, v)| k == "raytree.display" && v.contains("exposure")),
+        "{text:?}"
+    );
+    // As shown: the display's colours, exposure included.
+    h.state_mut().workspace.prefs.exposure = 2.0;
+    h.step();
+    let brighter = dir.path().join("brighter.png");
+    export_via(&mut h, "Render as shown", &brighter);
+    let (_, bright, _) = read_png(&brighter);
+    let sum = |p: &[u8]| p.iter().map(|&v| u64::from(v)).sum::<u64>();
+    assert!(
+        sum(&bright) > sum(&pixels) * 11 / 10,
+        "exposure 2 brightens the picture as shown"
+    );
+    let display = h.state().render.display_shown();
+    assert_eq!(bright, display, "the file holds what the display shows");
 }
 
 #[test]
@@ -184,7 +202,7 @@ fn ctrl_s_offers_the_render_with_rays_and_the_scene_view() {
         dir.path().join("rays.png"),
         dir.path().join("view.png"),
     );
-    export_via(&mut h, "Render (PNG or EXR)", &plain);
+    export_via(&mut h, "Render as shown", &plain);
     export_via(&mut h, "Render with rays (PNG)", &rays);
     export_via(&mut h, "Scene view (PNG)", &view);
     let (plain_size, plain_px, _) = read_png(&plain);
@@ -776,8 +794,13 @@ fn render_at_pane_size_follows_the_window_and_export_keeps_the_scene_size() {
     );
     settle(&mut h);
     let dir = tempfile::tempdir().expect("temp dir");
+    // As shown: the pane's size.
+    let shown = dir.path().join("shown.png");
+    export_via(&mut h, "Render as shown", &shown);
+    assert_eq!(read_png(&shown).0, second);
+    // At the scene's size: rendered again in the background.
     let out = dir.path().join("shot.png");
-    export_via(&mut h, "Render (PNG or EXR)", &out);
+    export_via(&mut h, "Render at the scene's size", &out);
     let deadline = Instant::now() + Duration::from_secs(60);
     while h.state().render.exporting() {
         assert!(Instant::now() < deadline, "the export did not finish");

@@ -146,15 +146,12 @@ impl ViewerApp {
             .and_then(|s| eframe::get_value::<Prefs>(s, eframe::APP_KEY))
             .unwrap_or_default()
             .checked();
-        let saved = cc
-            .storage
-            .is_some_and(|s| s.get_string(eframe::APP_KEY).is_some());
-        Self::with_limit(scene, label, max_side, Workspace::new(prefs, saved))
+        Self::with_limit(scene, label, max_side, Workspace::new(prefs))
     }
 
     /// The viewer's state without a window (the GPU display is installed by [`Self::new`]).
     pub fn headless(scene: Scene, label: String) -> Result<Self, String> {
-        let workspace = Workspace::new(Prefs::default(), false);
+        let workspace = Workspace::new(Prefs::default());
         Self::with_limit(scene, label, scene::rules::MAX_IMAGE_SIZE, workspace)
     }
 

@@ -369,6 +369,11 @@ impl RenderView {
         self.export_job.is_some()
     }
 
+    /// The picture the display shows, as 8-bit sRGB RGB bytes ("as shown").
+    pub fn display_shown(&self) -> Vec<u8> {
+        crate::sync::lock(&self.display).shown_rgb8()
+    }
+
     /// The export rendering in the background, if any.
     pub fn export_job(&self) -> Option<&ExportJob> {
         self.export_job.as_ref()

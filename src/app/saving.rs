@@ -98,7 +98,7 @@ impl ViewerApp {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("png"));
         let written = if png {
-            let shown = crate::sync::lock(&self.render.display).shown_rgb8();
+            let shown = self.render.display_shown();
             export::write_png_rgb8(path, w, h, &shown, &text)
         } else {
             export::write_image(path, &self.render.image(), &text)

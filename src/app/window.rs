@@ -68,6 +68,14 @@ impl eframe::App for ViewerApp {
                 .wake_with(waker, &self.working.scene, &mut self.messages);
         }
         self.poll_session();
+        self.workspace.scene_dir = self
+            .working
+            .scene
+            .source
+            .as_deref()
+            .and_then(std::path::Path::parent)
+            .filter(|p| !p.as_os_str().is_empty())
+            .map(std::path::Path::to_path_buf);
         self.render.poll_export(&mut self.messages);
         input::shortcuts(
             &ctx,

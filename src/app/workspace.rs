@@ -103,8 +103,10 @@ enum TreePanes {
 #[derive(Default)]
 pub struct Workspace {
     pub prefs: Prefs,
-    /// Whether the settings panel's visibility is settled: by the saved preferences, or on
-    /// the first frame by the window's width (shown from [`SETTINGS_MIN_WIDTH`] up).
+    /// Whether the settings panel's visibility is settled: on the first frame by the window's
+    /// width (a panel the saved preferences show is hidden below [`SETTINGS_MIN_WIDTH`], so a
+    /// choice made in a wide window does not crowd a small one; a hidden one stays hidden), or
+    /// by an explicit choice before it.
     settings_settled: bool,
     /// How the tree's panes were last set (`None`: not yet, or the layout was reset).
     tree_panes: Option<TreePanes>,
@@ -118,6 +120,9 @@ pub struct Workspace {
     focus: Option<Arrangement>,
     /// The tree's panes are in their own native window.
     pub popped_out: bool,
+    /// The folder of the open scene's file (`None`: a built-in scene), where opening and
+    /// saving start.
+    pub scene_dir: Option<PathBuf>,
 }
 
 /// What focus mode changes and gives back when it ends: the panes' layout and whether the
@@ -129,28 +134,32 @@ struct Arrangement {
 }
 
 impl Workspace {
-    /// `settled`: the preferences were saved by a run before, so the settings panel is as
-    /// they have it.
-    pub fn new(prefs: Prefs, settled: bool) -> Self {
+    pub fn new(prefs: Prefs) -> Self {
         Self {
             prefs,
-            settings_settled: settled,
             ..Self::default()
         }
     }
 
-    /// Where the file dialog starts: the folder of the last file chosen, else the current one.
-    pub fn start_dir(&self) -> PathBuf {
-        self.prefs
-            .last_dir
-            .clone()
+    /// Where the file dialog for `purpose` starts: opening and saving a scene in the open
+    /// scene file's folder, exports where the last file was chosen; else the other, else the
+    /// current folder.
+    pub fn start_dir(&self, purpose: BrowseFor) -> PathBuf {
+        let last = self.prefs.last_dir.clone();
+        let scene = self.scene_dir.clone();
+        let (first, then) = match purpose {
+            BrowseFor::Open | BrowseFor::SaveScene | BrowseFor::Lesson => (scene, last),
+            _ => (last, scene),
+        };
+        first
+            .or(then)
             .or_else(|| std::env::current_dir().ok())
             .unwrap_or_else(|| PathBuf::from("."))
     }
 
     /// Opens the file dialog for `purpose`, offering `name`.
     pub fn browse(&mut self, purpose: BrowseFor, name: &str) {
-        self.browser = Some(FileBrowser::new(purpose, self.start_dir(), name));
+        self.browser = Some(FileBrowser::new(purpose, self.start_dir(purpose), name));
     }
 
     /// Draws the file dialog, if one is open; a file chosen is the command for its purpose,
@@ -245,7 +254,7 @@ impl Workspace {
     pub fn settle_settings_panel(&mut self, window_width: f32, messages: &mut Messages) {
         if !self.settings_settled {
             self.settings_settled = true;
-            if window_width < SETTINGS_MIN_WIDTH {
+            if window_width < SETTINGS_MIN_WIDTH && self.prefs.settings_panel {
                 self.toggle_settings_panel(messages);
             }
         }
@@ -536,5 +545,45 @@ mod tests {
         let back: Layout = serde_json::from_str(&json).expect("deserialises");
         assert!(usable(&back));
         assert!(!usable(&egui_tiles::Tree::empty(egui::Id::unique("x"))));
+    }
+
+    #[test]
+    fn a_settings_panel_saved_in_a_wide_window_is_hidden_in_a_small_one() {
+        let mut messages = Messages::default();
+        let mut ws = Workspace::new(Prefs::default());
+        assert!(ws.prefs.settings_panel, "saved shown");
+        ws.settle_settings_panel(1024.0, &mut messages);
+        assert!(!ws.prefs.settings_panel, "hidden at 1024 px");
+        // Hidden by choice in a wide window: it stays hidden there.
+        let prefs = Prefs {
+            settings_panel: false,
+            ..Prefs::default()
+        };
+        let mut ws = Workspace::new(prefs);
+        ws.settle_settings_panel(1600.0, &mut messages);
+        assert!(!ws.prefs.settings_panel);
+    }
+
+    #[test]
+    fn opening_starts_in_the_scene_folder_and_exports_where_the_last_file_went() {
+        let mut ws = Workspace::new(Prefs {
+            last_dir: Some("/shots".into()),
+            ..Prefs::default()
+        });
+        ws.scene_dir = Some("/models/kitchen".into());
+        assert_eq!(
+            ws.start_dir(BrowseFor::Open),
+            PathBuf::from("/models/kitchen")
+        );
+        assert_eq!(
+            ws.start_dir(BrowseFor::SaveScene),
+            PathBuf::from("/models/kitchen")
+        );
+        assert_eq!(ws.start_dir(BrowseFor::Export), PathBuf::from("/shots"));
+        ws.prefs.last_dir = None;
+        assert_eq!(
+            ws.start_dir(BrowseFor::Export),
+            PathBuf::from("/models/kitchen")
+        );
     }
 }
