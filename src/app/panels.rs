@@ -621,14 +621,16 @@ pub fn side_panel(
                     restart |= material_editor(ui, m)
                 });
                 // A click on an object brings its material into view, once per selection.
-                let scrolled = egui::Id::new("raytree material scrolled to");
+                let scrolled = egui::Id::unique("raytree material scrolled to");
                 if selected && ui.data(|d| d.get_temp::<usize>(scrolled)) != Some(i) {
                     shown.header_response.scroll_to_me(Some(egui::Align::TOP));
                     ui.data_mut(|d| d.insert_temp(scrolled, i));
                 }
             }
             if selection.selected_material.is_none() {
-                ui.data_mut(|d| d.remove::<usize>(egui::Id::new("raytree material scrolled to")));
+                ui.data_mut(|d| {
+                    d.remove::<usize>(egui::Id::unique("raytree material scrolled to"))
+                });
             }
         });
     egui::CollapsingHeader::new("Scene")
