@@ -221,3 +221,41 @@ fn hiding_shadow_rays_hides_them_over_the_render_too() {
         "{before} lines over the render with shadow rays, {after} without"
     );
 }
+
+/// At 1024×640 with many trees (two shift-clicks and a rectangle's grid) the picker's strip
+/// stays inside its pane: its step line, the grid settings and "to depth" are all on screen
+/// (the strip wraps), and the window snapshot shows it.
+#[test]
+fn the_picker_strip_fits_its_pane_at_1024x640() {
+    let mut h = viewer::window_with(small("default"), [1024.0, 640.0], |app| {
+        app.set_view(2, false)
+    });
+    settle(&mut h);
+    for [x, y] in [GLASS, FLOOR] {
+        let at = pixel_pos(&h, x, y);
+        click(&mut h, at, egui::Modifiers::SHIFT);
+    }
+    h.state_mut()
+        .command(raytree::app::Command::PickRect([20, 20], [140, 100]));
+    h.step();
+    settle(&mut h);
+    h.step();
+    let trees = h.state().selection.trees().count();
+    assert!(trees > 10, "{trees} trees");
+    let right = h.ctx.content_rect().right();
+    for label in ["tree 1 of", "to depth", "list all trees"] {
+        let rect = h.get_by_label_contains(label).rect();
+        assert!(
+            rect.right() <= right + 0.5 && rect.width() > 0.0,
+            "{label:?} at {rect:?} leaves the window (right edge {right})"
+        );
+    }
+    h.state_mut().messages.clear_toasts();
+    h.step();
+    let status = h.get_by_label_contains("Mrays/s").rect();
+    h.mask(egui::Rect::from_min_max(
+        status.min,
+        egui::pos2(right, status.max.y),
+    ));
+    h.snapshot("picker_1024x640");
+}

@@ -144,7 +144,7 @@ impl Messages {
         let mut open_log = false;
         egui::Area::new(egui::Id::unique("raytree toasts"))
             .order(egui::Order::Foreground)
-            .anchor(egui::Align2::RIGHT_BOTTOM, egui::vec2(-12.0, -40.0))
+            .anchor(egui::Align2::RIGHT_BOTTOM, egui::vec2(-12.0, -56.0))
             .interactable(true)
             .show(ctx, |ui| {
                 ui.set_max_width(TOAST_WIDTH + 40.0);

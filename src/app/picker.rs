@@ -109,19 +109,25 @@ fn strip_ui(ui: &mut Ui, selection: &mut TreeSelection, tracer: &Tracer) {
         if ui.small_button(label).clicked() {
             picker.expanded = !picker.expanded;
         }
-        ui.label("grid");
+        // Each label stays with its value when the strip wraps.
         let side = ui
-            .add(
-                egui::DragValue::new(&mut picker.grid.per_side)
-                    .range(1..=MAX_GRID_SIDE)
-                    .suffix(" per side"),
-            )
-            .on_hover_text("Ctrl+drag picks at most this many pixels across and down");
-        ui.label("to depth");
-        ui.add(egui::DragValue::new(&mut picker.grid.depth).range(0..=64))
-            .on_hover_text(
-                "the other trees of a grid are drawn down to this generation; the selected one whole",
-            );
+            .horizontal(|ui| {
+                ui.label("grid");
+                ui.add(
+                    egui::DragValue::new(&mut picker.grid.per_side)
+                        .range(1..=MAX_GRID_SIDE)
+                        .suffix(" per side"),
+                )
+                .on_hover_text("Ctrl+drag picks at most this many pixels across and down")
+            })
+            .inner;
+        ui.horizontal(|ui| {
+            ui.label("to depth");
+            ui.add(egui::DragValue::new(&mut picker.grid.depth).range(0..=64))
+                .on_hover_text(
+                    "the other trees of a grid are drawn down to this generation; the selected one whole",
+                );
+        });
         if side.changed()
             && let Some((a, b)) = picker.last_rect
         {
