@@ -22,7 +22,7 @@ use raytree::app::messages::{MAX_TOASTS, Message};
 use raytree::render::render;
 use raytree::scene::Scene;
 use raytree::trace::{TraceSettings, Tracer};
-use viewer::{Window, harness, settle, small, window};
+use viewer::{Window, harness, settle, sized, small, window};
 
 fn batch(scene: &Scene) -> raytree::render::Image {
     let tracer = Tracer::new(Arc::new(scene.clone()), TraceSettings::default());
@@ -489,6 +489,12 @@ fn speed_vs_accuracy_window_runs_the_sweep_and_a_point_applies() {
     ];
     let chosen = raytree::app::sweep::nearest_point(&report, at, [1.0, 1.0]).expect("near");
     assert_eq!(chosen.samples, 4);
+    // Applied, it changes what the viewer shows: its own target becomes 4 samples.
+    h.state_mut().apply_point(&chosen);
+    h.step();
+    assert_eq!(h.state().viewer_target(), 4);
+    settle(&mut h);
+    assert_eq!(h.state().samples_done(), 4);
     assert!(
         raytree::app::sweep::nearest_point(&report, [at[0] + 0.5, at[1] + 0.5], [1.0, 1.0])
             .is_none()
@@ -838,4 +844,44 @@ fn ctrl_b_hides_the_settings_and_the_render_takes_the_room() {
     h.get_by_role_and_label(Role::Button, "»").click();
     h.step();
     assert!(h.state().workspace.prefs.settings_panel);
+}
+
+/// An export at the scene's size renders in the background, with its progress in the status
+/// bar; Cancel stops it, no file is written and a message says so.
+#[test]
+fn an_export_at_the_scenes_size_can_be_cancelled() {
+    let mut h = window(sized("default", 320, 240, Some(256)), [1024.0, 640.0]);
+    h.state_mut().set_view(1, true);
+    follow_pane(&mut h);
+    settle(&mut h);
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("full.png");
+    h.state_mut()
+        .command(raytree::app::Command::ExportFull(out.clone()));
+    h.step();
+    assert!(h.state().render.exporting());
+    // Applied at the end of that frame: the status bar shows it from the next one.
+    h.step();
+    h.get_by_label_contains("exporting");
+    // The status bar grew a row: let its layout settle before clicking its Cancel.
+    h.step();
+    h.get_by_role_and_label(Role::Button, "Cancel").click();
+    h.step();
+    h.step();
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while h.state().render.exporting() {
+        assert!(
+            Instant::now() < deadline,
+            "the cancelled export did not stop"
+        );
+        h.step();
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let last = h.state().messages.last().cloned().expect("a message");
+    assert!(
+        last.text.starts_with("cancelled the export"),
+        "{}",
+        last.text
+    );
+    assert!(!out.exists(), "no file for a cancelled export");
 }

@@ -400,6 +400,18 @@ impl ViewerApp {
         }
     }
 
+    /// A point of the speed-vs-accuracy chart applied: its settings become the viewer's, and
+    /// its sample count the viewer's own target too, so the image shown refines to it.
+    pub fn apply_point(&mut self, point: &crate::experiments::sweep::PointSettings) {
+        let scene = &mut self.working.scene;
+        scene.render.max_depth = point.max_depth;
+        scene.render.samples = point.samples;
+        self.working.settings.trace = point.trace;
+        self.pending.push(Command::Rebuild);
+        let pane_size = self.workspace.prefs.pane_size;
+        self.set_view(point.samples, pane_size);
+    }
+
     /// Keeps the edits of the moment a tree was pinned, and names what changed since.
     fn note_pin(&mut self) {
         let state = &mut self.selection.tree_state;

@@ -201,13 +201,7 @@ impl eframe::App for ViewerApp {
             if let Some(text) = sweep.applied.clone() {
                 self.messages.notice(text);
             }
-            working.scene.render.max_depth = point.max_depth;
-            working.scene.render.samples = point.samples;
-            working.settings.trace = point.trace;
-            self.pending.push(Command::Rebuild);
-            // The sample count is the viewer's own target too: the image shown refines to it.
-            let pane_size = self.workspace.prefs.pane_size;
-            self.set_view(point.samples, pane_size);
+            self.apply_point(&point);
         }
         self.messages.show(&ctx);
         self.messages.log_window(&ctx);
