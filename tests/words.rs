@@ -73,7 +73,8 @@ fn finding(line: &str) -> Option<&'static str> {
     }
     // Documents outside the repository.
     let mut from = 0;
-    while let Some(k) = line[from..].find("SPEC") {
+    let spec = ["SP", "EC"].concat();
+    while let Some(k) = line[from..].find(spec.as_str()) {
         let i = from + k;
         from = i + 4;
         let after = line[from..].chars().next();
@@ -81,7 +82,7 @@ fn finding(line: &str) -> Option<&'static str> {
             return Some("cites a document that is not in the repository");
         }
     }
-    if line.contains("STABILITY.md") || line.contains("shared/") {
+    if line.contains(&["STABI", "LITY.md"].concat()) || line.contains(&["sha", "red/"].concat()) {
         return Some("cites a document that is not in the repository");
     }
     None
@@ -121,19 +122,26 @@ fn no_history_and_no_outside_documents() {
 
 #[test]
 fn the_finder_finds_what_it_should_and_nothing_else() {
+    // The samples are put together from pieces, so the repository itself holds no such line
+    // for a search of the whole tree to find.
+    let (spec, stability, shared) = (
+        ["SP", "EC"].concat(),
+        ["STABI", "LITY.md"].concat(),
+        ["sha", "red/"].concat(),
+    );
     for bad in [
-        "// measured in session 12",
-        "//! (issue 14.4)",
-        "issue #7",
-        "a sprint goal",
-        "Measured 2026-11-29 on main",
-        "see SPEC §3",
-        "(SPEC)",
-        "STABILITY.md row T3",
-        "../shared/seed",
-        "today's machine is slower than yesterday's",
+        ["// measured in sess", "ion 12"].concat(),
+        ["//! (iss", "ue 14.4)"].concat(),
+        "issue #7".to_string(),
+        "a sprint goal".to_string(),
+        "Measured 2026-11-29 on main".to_string(),
+        format!("see {spec} §3"),
+        format!("({spec})"),
+        format!("{stability} row T3"),
+        format!("../{shared}seed"),
+        "today's machine is slower than yesterday's".to_string(),
     ] {
-        assert!(finding(bad).is_some(), "{bad}");
+        assert!(finding(&bad).is_some(), "{bad}");
     }
     for good in [
         "let session = Session::new();",
