@@ -128,6 +128,31 @@ pub struct Node {
     pub children: Vec<Node>,
 }
 
+impl Node {
+    /// A ray just started: where it goes and what it weighs, nothing met or computed yet.
+    pub fn new(kind: RayKind, depth: u32, origin: Vec3, direction: Vec3, weight: Vec3) -> Self {
+        Self {
+            kind,
+            depth,
+            origin,
+            direction,
+            weight,
+            end: None,
+            light: None,
+            hit: None,
+            view: None,
+            direction_corrected: false,
+            local: None,
+            shadow_rays: Vec::new(),
+            total_internal_reflection: false,
+            kr: None,
+            kt: None,
+            color: Vec3::ZERO,
+            children: Vec::new(),
+        }
+    }
+}
+
 /// What produced a tree.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TreeSettings {
@@ -184,25 +209,8 @@ impl Recorder for TreeRecorder<'_> {
             return;
         }
         self.nodes += 1;
-        self.stack.push(Node {
-            kind,
-            depth,
-            origin: ray.origin,
-            direction: ray.dir,
-            weight,
-            end: None,
-            light: None,
-            hit: None,
-            view: None,
-            direction_corrected: false,
-            local: None,
-            shadow_rays: Vec::new(),
-            total_internal_reflection: false,
-            kr: None,
-            kt: None,
-            color: Vec3::ZERO,
-            children: Vec::new(),
-        });
+        self.stack
+            .push(Node::new(kind, depth, ray.origin, ray.dir, weight));
     }
 
     fn direction_corrected(&mut self) {

@@ -22,7 +22,7 @@ use raytree::app::messages::{MAX_TOASTS, Message};
 use raytree::render::render;
 use raytree::scene::Scene;
 use raytree::trace::{TraceSettings, Tracer};
-use viewer::{Window, harness, settle, sized, small, window};
+use viewer::{Window, harness, mask_status, settle, sized, small, window};
 
 fn batch(scene: &Scene) -> raytree::render::Image {
     let tracer = Tracer::new(Arc::new(scene.clone()), TraceSettings::default());
@@ -419,17 +419,6 @@ fn the_depth_slider_hides_deeper_segments() {
         first > 0 && first < all,
         "generation 0 shows {first} pieces, the whole tree {all}"
     );
-}
-
-/// Hides the status line's timings and rates, which differ from run to run: from the start of
-/// its label to the window's right edge (the text's width varies with its digits).
-fn mask_status(h: &mut Window) {
-    let status = h.get_by_label_contains("Mrays/s").rect();
-    let right = h.ctx.content_rect().right();
-    h.mask(egui::Rect::from_min_max(
-        status.min,
-        egui::pos2(right, status.max.y),
-    ));
 }
 
 /// A snapshot of the window at `size` as a new user sees it (the render at the pane's size,

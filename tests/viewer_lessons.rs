@@ -17,7 +17,7 @@ use egui_kittest::kittest::Queryable;
 use raytree::app::lesson_panel::{self, Enter};
 use raytree::app::workspace::Pane;
 use raytree::lessons::pseudocode;
-use viewer::{Window, settle, small, steps_until, window_with};
+use viewer::{Window, mask_status, settle, small, steps_until, window_with};
 
 /// The viewer in a `size` window, refining to 1 sample per pixel (the lessons' checks read
 /// trees, not the image), the settings panel shown.
@@ -339,16 +339,6 @@ fn path_to(
         path.pop();
     }
     None
-}
-
-/// Hides the status line's timings and rates, which differ from run to run.
-fn mask_status(h: &mut Window) {
-    let status = h.get_by_label_contains("Mrays/s").rect();
-    let right = h.ctx.content_rect().right();
-    h.mask(egui::Rect::from_min_max(
-        status.min,
-        egui::pos2(right, status.max.y),
-    ));
 }
 
 /// The quiz lesson at its first step with the pseudocode pane in front, at `size`.

@@ -252,10 +252,6 @@ fn the_picker_strip_fits_its_pane_at_1024x640() {
     }
     h.state_mut().messages.clear_toasts();
     h.step();
-    let status = h.get_by_label_contains("Mrays/s").rect();
-    h.mask(egui::Rect::from_min_max(
-        status.min,
-        egui::pos2(right, status.max.y),
-    ));
+    viewer::mask_status(&mut h);
     h.snapshot("picker_1024x640");
 }

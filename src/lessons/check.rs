@@ -829,25 +829,7 @@ fn evaluate_choice(
 
 /// A node for questions that do not read the tree.
 fn tree_less_node() -> Node {
-    Node {
-        kind: RayKind::Primary,
-        depth: 0,
-        origin: Vec3::ZERO,
-        direction: Vec3::Z,
-        weight: Vec3::ONE,
-        end: None,
-        light: None,
-        hit: None,
-        view: None,
-        direction_corrected: false,
-        local: None,
-        shadow_rays: Vec::new(),
-        total_internal_reflection: false,
-        kr: None,
-        kt: None,
-        color: Vec3::ZERO,
-        children: Vec::new(),
-    }
+    Node::new(RayKind::Primary, 0, Vec3::ZERO, Vec3::Z, Vec3::ONE)
 }
 
 /// A pixel whose tree meets the goal: every 16th pixel first, then every 4th, then all.

@@ -149,3 +149,15 @@ pub fn frames_until(app: &mut ViewerApp, what: &str, done: impl Fn(&ViewerApp) -
 pub fn settle_headless(app: &mut ViewerApp) {
     frames_until(app, "the render did not finish", ViewerApp::is_finished);
 }
+
+/// Hides the status line's timings and rates, which differ from run to run: from the start of
+/// its label to the window's right edge (the text's width varies with its digits).
+pub fn mask_status(h: &mut Window) {
+    use egui_kittest::kittest::Queryable as _;
+    let status = h.get_by_label_contains("Mrays/s").rect();
+    let right = h.ctx.content_rect().right();
+    h.mask(egui::Rect::from_min_max(
+        status.min,
+        egui::pos2(right, status.max.y),
+    ));
+}

@@ -109,10 +109,7 @@ impl<'s, 't, 'i> Section<'s, 't, 'i> {
         key: &str,
         phrase: impl AsRef<str>,
     ) -> SceneError {
-        self.src.error(
-            span,
-            format!("{} field `{key}` {}", self.what, phrase.as_ref()),
-        )
+        self.error_as(&self.what, span, key, phrase.as_ref())
     }
 
     /// [`Self::error`] naming the section by its place, not its name.
@@ -122,10 +119,12 @@ impl<'s, 't, 'i> Section<'s, 't, 'i> {
         key: &str,
         phrase: impl AsRef<str>,
     ) -> SceneError {
-        self.src.error(
-            span,
-            format!("{} field `{key}` {}", self.place, phrase.as_ref()),
-        )
+        self.error_as(&self.place, span, key, phrase.as_ref())
+    }
+
+    fn error_as(&self, who: &str, span: &Range<usize>, key: &str, phrase: &str) -> SceneError {
+        self.src
+            .error(span, format!("{who} field `{key}` {phrase}"))
     }
 
     pub(crate) fn type_error(&self, key: &str, value: &Value, expected: &str) -> SceneError {
