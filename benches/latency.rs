@@ -3,9 +3,11 @@
 //! on the 80k-triangle benchmark scene; and the UI thread's per-frame cost of taking tiles
 //! while a render runs. The baseline, measured in the same run, is the batch render of the same
 //! 1-sample image (camera rays in packets, as the viewer's passes trace them), beside the same
-//! batch render with every ray traced alone.
+//! batch render with every ray traced alone. Then the whole refinement: from a camera edit to
+//! the viewer's 64 samples, against the batch 64-sample render of the same image (median of 3
+//! each, alternating), the ratio being what the viewer's progressive passes cost over batch.
 //!
-//! Run: `cargo bench --bench latency`
+//! Run: `cargo bench --bench latency` (`-- --no-64` leaves out the 64-sample measure).
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -102,7 +104,41 @@ fn latencies(mut scene: Scene) -> [f64; 6] {
     ]
 }
 
+/// Batch 64-sample render and edit → the viewer's 64 samples, in seconds: medians of `runs`
+/// pairs, alternating, and each pair's ratio (viewer / batch).
+fn refinement(mut scene: Scene, runs: usize) -> (f64, f64, Vec<f64>) {
+    scene.render.width = 1280;
+    scene.render.height = 720;
+    let settings = TraceSettings::default();
+    let base = Tracer::new(Arc::new(scene.clone()), settings);
+    let samples = raytree::app::VIEWER_SAMPLES;
+    let mut session = Session::new(0).expect("pool");
+    let (mut batch, mut viewer) = (Vec::new(), Vec::new());
+    for i in 0..runs {
+        let t = Instant::now();
+        render(&base, samples, 0, &|_, _| {}).expect("render");
+        batch.push(t.elapsed().as_secs_f64());
+        scene.camera.position.x += 0.01 * (i as f32 + 1.0);
+        let tracer = Tracer::with_accel(Arc::new(scene.clone()), settings, base.accel.clone());
+        let start = Instant::now();
+        let generation = session.start(Arc::new(tracer), samples, None);
+        loop {
+            match session.try_next() {
+                Some(SessionEvent::Finished { generation: g, .. }) if g == generation => {
+                    viewer.push(start.elapsed().as_secs_f64());
+                    break;
+                }
+                Some(_) => {}
+                None => std::thread::sleep(Duration::from_micros(200)),
+            }
+        }
+    }
+    let ratios = viewer.iter().zip(&batch).map(|(v, b)| v / b).collect();
+    (median(batch), median(viewer), ratios)
+}
+
 fn main() {
+    let with_64 = !std::env::args().any(|a| a == "--no-64");
     let dir = tempfile::tempdir().expect("a temporary folder");
     let bench = write_bench_scene(dir.path(), 80_000).expect("the bench scene is written");
     let scenes = [
@@ -117,7 +153,7 @@ fn main() {
     ];
     let threads = Session::new(0).expect("pool").threads();
     for (name, scene) in scenes {
-        let [batch, single, p, f, p64, f64_] = latencies(scene);
+        let [batch, single, p, f, p64, f64_] = latencies(scene.clone());
         println!("viewer latency, {name} 1280x720, {threads} threads, median of 10 edits");
         println!("  batch 1-spp render (baseline): {:.1} ms", batch * 1e3);
         println!(
@@ -141,6 +177,19 @@ fn main() {
             p64 * 1e3,
             f64_ * 1e3
         );
+        if with_64 {
+            let (batch64, viewer64, mut ratios) = refinement(scene, 3);
+            ratios.sort_by(f64::total_cmp);
+            println!(
+                "  batch {0}-sample render: {1:.2} s; edit -> the viewer's {0} samples: {2:.2} s ({3:.3}x batch, pairs {4:.3}-{5:.3})",
+                raytree::app::VIEWER_SAMPLES,
+                batch64,
+                viewer64,
+                median(ratios.clone()),
+                ratios[0],
+                ratios[ratios.len() - 1]
+            );
+        }
     }
     let mut scene = load_builtin("default").expect("built-in scene");
     scene.render.width = 1280;

@@ -12,17 +12,24 @@
 //! ray only where N·L > 0 and the light meets some diffuse or specular colour); rays are
 //! counted by kind on both sides and the bench fails when one kind differs by more than 1 %.
 //!
-//! Peer configurations (`--peer-config`, a comma list; default `best,user-high,user-medium`):
-//! `best` gives the spheres to Embree as its built-in sphere geometry, builds every BVH at
-//! `RTC_BUILD_QUALITY_HIGH` and sets flush-to-zero/denormals-are-zero on its tracing threads
-//! (Embree's advice); `user-high` is the same with the spheres as an Embree user geometry (whose
-//! callback is raytree's robust intersection), which measured faster than the built-in spheres on
-//! this scene; `user-medium` has user-geometry spheres with Embree's default build quality (medium)
-//! and denormals kept, for comparison; `SPHERES:QUALITY[:ftz][:robust]` (e.g. `builtin:medium`,
-//! `builtin:high:ftz:robust`) any other, `:robust` setting `RTC_SCENE_FLAG_ROBUST` (Embree's
-//! watertight mode; without it the scene flags are `RTC_SCENE_FLAG_NONE`, its fastest). The harness
-//! is compiled with `-O3 -march=native -ffp-contract=off` (no FMA contraction: its shading rounds
-//! as raytree's).
+//! Peer configurations (`--peer-config`, a comma list; default
+//! `best,user-high,builtin:high:ftz:packet,user:high:ftz:packet`; `all` adds the other ray
+//! layouts): `best` gives the spheres to Embree as its built-in sphere geometry, builds every
+//! BVH at `RTC_BUILD_QUALITY_HIGH`, sets flush-to-zero/denormals-are-zero on its tracing threads
+//! (Embree's advice) and traces single rays; `user-high` is the same with the spheres as an
+//! Embree user geometry (whose callback is raytree's robust intersection); `user-medium` has
+//! user-geometry spheres with Embree's default build quality (medium) and denormals kept, for
+//! comparison; `SPHERES:QUALITY[:FLAG...]` any other, the flags `:ftz`, `:robust`
+//! (`RTC_SCENE_FLAG_ROBUST`, Embree's watertight mode; without it the scene flags are
+//! `RTC_SCENE_FLAG_NONE`, its fastest), `:packet` or `:packetWxH` (camera rays in 8-wide
+//! packets of a 4×2 or W×H pixel block, `rtcIntersect8`, and each light's shadow rays of a
+//! block as one `rtcOccluded8`), `:stream` (a tile's camera and their shadow rays as
+//! `rtcIntersect1M`/`rtcOccluded1M` streams) and `:secstream` (reflected and refracted rays
+//! and their shadow rays as one stream per generation of a tile; without it they go one by
+//! one). After the per-configuration tables the bench names **Embree at its best**: per size
+//! and frame (first, warm), the configuration with the shortest median time, and raytree's
+//! ratio against it. The harness is compiled with `-O3 -march=native -ffp-contract=off` (no
+//! FMA contraction: its shading rounds as raytree's).
 //!
 //! Each process builds once and renders K frames (`--frames`, default 5): the first frame is
 //! frame 1, the warm frame the median of frames 2..K. Each size starts with `--warmup` rounds
@@ -53,7 +60,7 @@ use raytree::scene::{Scene, Shading, load_scene_file};
 
 const HARNESS_SOURCE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/benches/peer/embree_whitted.c");
 
-/// One Embree configuration of the peer: its sphere geometry and build quality.
+/// One Embree configuration of the peer: its sphere geometry, build quality and ray calls.
 #[derive(Clone, Debug)]
 struct PeerConfig {
     /// `builtin` (Embree's RTC_GEOMETRY_TYPE_SPHERE_POINT) or `user` (a callback per test).
@@ -65,14 +72,33 @@ struct PeerConfig {
     /// `RTC_SCENE_FLAG_ROBUST`: Embree's watertight mode, for a race at equal robustness
     /// (raytree's triangle test is watertight).
     robust: bool,
+    /// How the camera rays and their shadow rays are traced: `single` (rtcIntersect1 and
+    /// rtcOccluded1, depth first), `packet` (8-wide packets of a pixel block: rtcIntersect8 and
+    /// rtcOccluded8 per light) or `stream` (a tile's rays as one rtcIntersect1M/rtcOccluded1M
+    /// stream).
+    camera: String,
+    /// The packet's pixel block, `WxH` with W × H = 8.
+    block: String,
+    /// How reflected and refracted rays and their shadow rays are traced: `single` or
+    /// `stream` (each generation of a tile as one stream).
+    secondary: String,
 }
 
+/// The configurations `--peer-config all` names: every ray-call layout with either sphere
+/// geometry, at high quality with FTZ/DAZ.
+const ALL_CONFIGS: &str = "best,user-high,builtin:high:ftz:packet,user:high:ftz:packet,user:high:ftz:packet2x4,builtin:high:ftz:packet:secstream,user:high:ftz:packet:secstream,user:high:ftz:stream:secstream";
+
+/// The default: the single-ray configurations and the packet ones that measured fastest.
+const DEFAULT_CONFIGS: &str = "best,user-high,builtin:high:ftz:packet,user:high:ftz:packet";
+
 impl PeerConfig {
-    /// `best` (built-in spheres, high quality, FTZ/DAZ: the peer at its best as Embree's own
-    /// advice sets it up), `user-high` (the same with user-geometry spheres, which measure
-    /// faster here), `user-medium` (user-geometry spheres, medium quality, denormals kept), or
-    /// `SPHERES:QUALITY` with `:ftz` after it for FTZ/DAZ and `:robust` for Embree's watertight
-    /// mode.
+    /// `best` (built-in spheres, high quality, FTZ/DAZ: the peer at its best with single rays
+    /// as Embree's own advice sets it up), `user-high` (the same with user-geometry spheres),
+    /// `user-medium` (user-geometry spheres, medium quality, denormals kept), or
+    /// `SPHERES:QUALITY` followed by flags: `:ftz` (FTZ/DAZ), `:robust` (Embree's watertight
+    /// mode), `:packet` or `:packetWxH` (camera and their shadow rays in 8-wide packets of a
+    /// 4×2 or W×H block), `:stream` (camera rays as tile streams), `:secstream` (secondary
+    /// rays as streams).
     fn parse(text: &str) -> Self {
         let text = match text {
             "best" => "builtin:high:ftz",
@@ -84,17 +110,37 @@ impl PeerConfig {
         let (spheres, quality) = (
             parts.next().unwrap_or_default(),
             parts.next().unwrap_or_else(|| {
-                panic!("--peer-config: best, user-high, user-medium or SPHERES:QUALITY[:ftz][:robust], not {text}")
+                panic!("--peer-config: best, user-high, user-medium, all or SPHERES:QUALITY[:FLAG...], not {text}")
             }),
         );
-        let (mut ftz, mut robust) = (false, false);
+        let mut config = Self {
+            spheres: spheres.into(),
+            quality: quality.into(),
+            ftz: false,
+            robust: false,
+            camera: "single".into(),
+            block: "4x2".into(),
+            secondary: "single".into(),
+        };
         for flag in parts {
             match flag {
-                "ftz" => ftz = true,
-                "robust" => robust = true,
-                other => {
-                    panic!("--peer-config: after the quality only :ftz and :robust, not {other}")
+                "ftz" => config.ftz = true,
+                "robust" => config.robust = true,
+                "stream" => config.camera = "stream".into(),
+                "secstream" => config.secondary = "stream".into(),
+                "packet" => config.camera = "packet".into(),
+                block if block.starts_with("packet") => {
+                    let shape = &block["packet".len()..];
+                    assert!(
+                        matches!(shape, "8x1" | "4x2" | "2x4" | "1x8"),
+                        "--peer-config: a packet block is 8x1, 4x2, 2x4 or 1x8, not {shape}"
+                    );
+                    config.camera = "packet".into();
+                    config.block = shape.into();
                 }
+                other => panic!(
+                    "--peer-config: after the quality only :ftz, :robust, :packet[WxH], :stream and :secstream, not {other}"
+                ),
             }
         }
         assert!(
@@ -105,12 +151,22 @@ impl PeerConfig {
             matches!(quality, "low" | "medium" | "high"),
             "--peer-config: quality is low, medium or high, not {quality}"
         );
-        Self {
-            spheres: spheres.into(),
-            quality: quality.into(),
-            ftz,
-            robust,
-        }
+        assert!(
+            config.secondary == "single" || config.camera != "single",
+            "--peer-config {text}: :secstream needs :packet or :stream"
+        );
+        config
+    }
+
+    /// A comma list of configurations, `all` standing for [`ALL_CONFIGS`].
+    fn parse_list(text: &str) -> Vec<Self> {
+        text.split(',')
+            .flat_map(|c| match c.trim() {
+                "all" => ALL_CONFIGS.split(',').collect::<Vec<_>>(),
+                one => vec![one],
+            })
+            .map(Self::parse)
+            .collect()
     }
 
     fn label(&self) -> String {
@@ -121,7 +177,30 @@ impl PeerConfig {
         };
         let ftz = if self.ftz { ", FTZ/DAZ" } else { "" };
         let robust = if self.robust { ", robust" } else { "" };
-        format!("{spheres}, {} quality{ftz}{robust}", self.quality)
+        let rays = match (self.camera.as_str(), self.secondary.as_str()) {
+            ("single", _) => "single rays".to_string(),
+            ("packet", sec) => format!("{} packets, secondary {sec}", self.block),
+            (_, sec) => format!("camera streams, secondary {sec}"),
+        };
+        format!("{spheres}, {} quality{ftz}{robust}, {rays}", self.quality)
+    }
+
+    /// The Embree calls this configuration makes.
+    fn calls(&self) -> String {
+        let camera = match self.camera.as_str() {
+            "packet" => format!(
+                "camera rays in {} blocks by rtcIntersect8, their shadow rays by rtcOccluded8",
+                self.block
+            ),
+            "stream" => "camera and their shadow rays as tile streams (rtcIntersect1M/rtcOccluded1M, coherent)".into(),
+            _ => "rtcIntersect1/rtcOccluded1 for every ray".into(),
+        };
+        let secondary = match (self.camera.as_str(), self.secondary.as_str()) {
+            ("single", _) => String::new(),
+            (_, "stream") => "; reflected, refracted and their shadow rays as streams (rtcIntersect1M/rtcOccluded1M) per generation of a tile".into(),
+            _ => "; reflected, refracted and their shadow rays by rtcIntersect1/rtcOccluded1".into(),
+        };
+        format!("{camera}{secondary}")
     }
 }
 
@@ -160,9 +239,7 @@ fn parse_options() -> Options {
         keep: None,
         scaling: false,
         peer: true,
-        peer_configs: ["best", "user-high", "user-medium"]
-            .map(PeerConfig::parse)
-            .to_vec(),
+        peer_configs: PeerConfig::parse_list(DEFAULT_CONFIGS),
         chart: None,
         size: None,
         opaque: false,
@@ -193,10 +270,7 @@ fn parse_options() -> Options {
                 .extend(value("--scene").split(',').map(str::to_string)),
             "--no-peer" => o.peer = false,
             "--peer-config" => {
-                o.peer_configs = value("--peer-config")
-                    .split(',')
-                    .map(|c| PeerConfig::parse(c.trim()))
-                    .collect();
+                o.peer_configs = PeerConfig::parse_list(&value("--peer-config"));
             }
             "--chart" => o.chart = Some(PathBuf::from(value("--chart"))),
             "--size" => {
@@ -531,6 +605,8 @@ fn harness_run(
         .args(["--frames", &frames.to_string()])
         .args(["--ftz", if config.ftz { "1" } else { "0" }])
         .args(["--robust", if config.robust { "1" } else { "0" }])
+        .args(["--camera", &config.camera, "--block", &config.block])
+        .args(["--secondary", &config.secondary])
         .arg(scene_bin)
         .arg(threads.to_string())
         .arg(image)
@@ -689,11 +765,12 @@ fn peer_comparison(o: &Options, root: &Path) {
     }
     for (i, c) in configs.iter().enumerate() {
         println!(
-            "peer {}: Embree 3 ({}), {}; triangles in Embree's own BVH, scene flags {}, rtcIntersect1/rtcOccluded1, pthreads over 32x32 tiles",
+            "peer {}: Embree 3 ({}), {}; triangles in Embree's own BVH, scene flags {}, {}, pthreads over 32x32 tiles",
             i + 1,
             embree_version(),
             c.label(),
-            if c.robust { "robust" } else { "none" }
+            if c.robust { "robust" } else { "none" },
+            c.calls()
         );
     }
     let mut results = Vec::new();
@@ -904,6 +981,41 @@ fn print_tables(results: &[SizeResult], configs: &[PeerConfig]) {
                     2
                 ),
             );
+        }
+    }
+    // Embree at its best: per size and frame, the configuration with the shortest median time.
+    if !configs.is_empty() {
+        println!();
+        println!(
+            "Embree at its best: per size and frame, the configuration above with the shortest median time"
+        );
+        println!();
+        println!(
+            "| triangles | frame | Embree at its best | raytree s | Embree s | Embree / raytree (pairs: median, min–max) |"
+        );
+        println!("|---:|---|---|---:|---:|---:|");
+        let frames: [(&str, fn(&Run) -> f64); 2] =
+            [("first", Run::first_secs), ("warm", Run::warm_secs)];
+        for r in results {
+            for (frame, key) in frames {
+                let Some(best) = (0..configs.len())
+                    .filter(|&c| !r.theirs[c].is_empty())
+                    .min_by(|&a, &b| {
+                        medians(&r.theirs[a], key).total_cmp(&medians(&r.theirs[b], key))
+                    })
+                else {
+                    continue;
+                };
+                println!(
+                    "| {} | {frame} | {}. {} | {:.4} | {:.4} | {} |",
+                    r.label,
+                    best + 1,
+                    configs[best].label(),
+                    medians(&r.ours, key),
+                    medians(&r.theirs[best], key),
+                    ratio(ratios(&r.ours, &r.theirs[best], key)),
+                );
+            }
         }
     }
     println!();
