@@ -913,6 +913,9 @@ fn embree_version() -> String {
     format!("{}.{}.{}", part("MAJOR"), part("MINOR"), part("PATCH"))
 }
 
+/// One frame's time of a run: [`Run::first_secs`] or [`Run::warm_secs`].
+type FrameTime = fn(&Run) -> f64;
+
 fn print_tables(results: &[SizeResult], configs: &[PeerConfig]) {
     let pair = |a: f64, b: Option<f64>, digits: usize| match b {
         Some(b) => format!("{a:.digits$} / {b:.digits$}"),
@@ -994,8 +997,7 @@ fn print_tables(results: &[SizeResult], configs: &[PeerConfig]) {
             "| triangles | frame | Embree at its best | raytree s | Embree s | Embree / raytree (pairs: median, min–max) |"
         );
         println!("|---:|---|---|---:|---:|---:|");
-        let frames: [(&str, fn(&Run) -> f64); 2] =
-            [("first", Run::first_secs), ("warm", Run::warm_secs)];
+        let frames: [(&str, FrameTime); 2] = [("first", Run::first_secs), ("warm", Run::warm_secs)];
         for r in results {
             for (frame, key) in frames {
                 let Some(best) = (0..configs.len())
