@@ -35,36 +35,22 @@ fn shadow(light: usize, how: u64) -> ShadowRecord {
 }
 
 fn node(kind: RayKind, depth: u32, end: Option<EndReason>, object: &str) -> Node {
-    Node {
-        kind,
-        depth,
-        origin: Vec3::ZERO,
-        direction: Vec3::Z,
-        weight: Vec3::ONE,
-        end,
-        light: None,
-        hit: end.is_none().then(|| HitRecord {
-            t: 1.0,
-            point: Vec3::ZERO,
-            normal: Vec3::Y,
-            object: object.to_string(),
-            material: "m".to_string(),
-            front_face: true,
-            barycentric: None,
-            geometric_normal: None,
-            uv: None,
-            texel: None,
-        }),
-        view: None,
-        direction_corrected: false,
-        local: None,
-        shadow_rays: Vec::new(),
-        total_internal_reflection: false,
-        kr: None,
-        kt: None,
-        color: Vec3::new(0.2, 0.4, 0.6),
-        children: Vec::new(),
-    }
+    let mut n = Node::new(kind, depth, Vec3::ZERO, Vec3::Z, Vec3::ONE);
+    n.end = end;
+    n.hit = end.is_none().then(|| HitRecord {
+        t: 1.0,
+        point: Vec3::ZERO,
+        normal: Vec3::Y,
+        object: object.to_string(),
+        material: "m".to_string(),
+        front_face: true,
+        barycentric: None,
+        geometric_normal: None,
+        uv: None,
+        texel: None,
+    });
+    n.color = Vec3::new(0.2, 0.4, 0.6);
+    n
 }
 
 fn tree_of(root: Node) -> RayTree {

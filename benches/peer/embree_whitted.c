@@ -636,6 +636,23 @@ static WRay *gen_rays(Wave *w, uint32_t g) { return (WRay *)w->gen_buf[g].p; }
 
 static int lane_live(const WRay *r) { return r->pixel >= 0; }
 
+/* Lane j of an 8-wide packet: a ray from o along d up to tfar. */
+static void set_lane8(struct RTCRay8 *r, int j, vec3 o, vec3 d, float tfar) {
+    r->org_x[j] = o.x; r->org_y[j] = o.y; r->org_z[j] = o.z;
+    r->dir_x[j] = d.x; r->dir_y[j] = d.y; r->dir_z[j] = d.z;
+    r->tnear[j] = 0.0f;
+    r->tfar[j] = tfar;
+    r->time[j] = 0.0f;
+    r->mask[j] = 0xffffffffu;
+    r->id[j] = 0;
+    r->flags[j] = 0;
+}
+
+/* Whether generation g goes as streams (otherwise ray by ray, or as packets for generation 0). */
+static int streamed(uint32_t g) {
+    return g == 0 ? camera_mode == CAMERA_STREAM : secondary_mode == SECONDARY_STREAM;
+}
+
 /* Intersects generation g. */
 static void wave_intersect(Wave *w, uint32_t g) {
     WRay *rays = gen_rays(w, g);
@@ -647,14 +664,7 @@ static void wave_intersect(Wave *w, uint32_t g) {
             for (int j = 0; j < 8; j++) {
                 const WRay *r = &rays[b + j];
                 valid[j] = lane_live(r) ? -1 : 0;
-                rh.ray.org_x[j] = r->o.x; rh.ray.org_y[j] = r->o.y; rh.ray.org_z[j] = r->o.z;
-                rh.ray.dir_x[j] = r->d.x; rh.ray.dir_y[j] = r->d.y; rh.ray.dir_z[j] = r->d.z;
-                rh.ray.tnear[j] = 0.0f;
-                rh.ray.tfar[j] = INFINITY;
-                rh.ray.time[j] = 0.0f;
-                rh.ray.mask[j] = 0xffffffffu;
-                rh.ray.id[j] = 0;
-                rh.ray.flags[j] = 0;
+                set_lane8(&rh.ray, j, r->o, r->d, INFINITY);
                 rh.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
                 rh.hit.instID[0][j] = RTC_INVALID_GEOMETRY_ID;
             }
@@ -678,7 +688,7 @@ static void wave_intersect(Wave *w, uint32_t g) {
         init_rayhit(&rh[m], rays[i].o, rays[i].d);
         map[m++] = (uint32_t)i;
     }
-    int stream = g == 0 ? camera_mode == CAMERA_STREAM : secondary_mode == SECONDARY_STREAM;
+    int stream = streamed(g);
     struct RTCIntersectContext *ctx = g == 0 ? &w->coherent : &w->incoherent;
     if (stream) rtcIntersect1M(scene, ctx, rh, m, sizeof(struct RTCRayHit));
     else
@@ -710,14 +720,7 @@ static void wave_shadows(Wave *w, uint32_t g, const LightQuery *q, uint8_t *cast
                     any |= live;
                     const LightQuery *lq = &q[i * lights + k];
                     vec3 o = live ? lq->origin : v3(0, 0, 0), d = live ? lq->dir : v3(0, 0, 1);
-                    sr.org_x[j] = o.x; sr.org_y[j] = o.y; sr.org_z[j] = o.z;
-                    sr.dir_x[j] = d.x; sr.dir_y[j] = d.y; sr.dir_z[j] = d.z;
-                    sr.tnear[j] = 0.0f;
-                    sr.tfar[j] = live ? lq->length : 0.0f;
-                    sr.time[j] = 0.0f;
-                    sr.mask[j] = 0xffffffffu;
-                    sr.id[j] = 0;
-                    sr.flags[j] = 0;
+                    set_lane8(&sr, j, o, d, live ? lq->length : 0.0f);
                 }
                 if (!any) continue;
                 rtcOccluded8(valid, scene, &w->coherent, &sr);
@@ -736,7 +739,7 @@ static void wave_shadows(Wave *w, uint32_t g, const LightQuery *q, uint8_t *cast
         init_ray(&sr[m], q[i].origin, q[i].dir, q[i].length);
         map[m++] = (uint32_t)i;
     }
-    int stream = g == 0 ? camera_mode == CAMERA_STREAM : secondary_mode == SECONDARY_STREAM;
+    int stream = streamed(g);
     struct RTCIntersectContext *ctx = g == 0 ? &w->coherent : &w->incoherent;
     if (stream) rtcOccluded1M(scene, ctx, sr, m, sizeof(struct RTCRay));
     else
