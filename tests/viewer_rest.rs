@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 
 use eframe::egui::{self, ViewportId};
 use egui_kittest::kittest::Queryable;
-use raytree::app::Command;
+use raytree::app::{Command, PANE_SIZE_DEBOUNCE};
 use raytree::scene::load_scene_file;
 use viewer::{Window, settle, small, window_with};
 
@@ -61,21 +61,29 @@ fn painted_while_idle(h: &mut Window, interval: Duration) -> (usize, Vec<String>
     (frames, causes)
 }
 
-/// Steps until both renders have converged and the last frame asked for no immediate frame
-/// (a layout change after a click restarts the scene view at its new size once or twice).
+/// Frames asked for within this much are the viewer settling, not resting: a pane that
+/// changed size (a click opens the tree) is followed once its size held for
+/// [`PANE_SIZE_DEBOUNCE`], and the render restarts at it. A toast's expiry is seconds away.
+const SETTLING: Duration = PANE_SIZE_DEBOUNCE.saturating_mul(2);
+
+/// Steps until both renders have converged and the last frame asked for no frame within
+/// [`SETTLING`] (a layout change after a click restarts the renders at the new size).
 fn converge(h: &mut Window) {
     let deadline = Instant::now() + viewer::DEADLINE;
     loop {
         settle(h);
-        let immediate = h
+        let delay = h
             .output()
             .viewport_output
             .get(&ViewportId::ROOT)
-            .is_some_and(|v| v.repaint_delay == Duration::ZERO);
-        if !immediate && h.state().is_finished() && h.state().scene_view.is_finished() {
+            .map_or(Duration::MAX, |v| v.repaint_delay);
+        let finished = h.state().is_finished() && h.state().scene_view.is_finished();
+        if finished && delay > SETTLING {
             return;
         }
         assert!(Instant::now() < deadline, "the viewer never converged");
+        std::thread::sleep(delay.min(SETTLING));
+        h.step();
     }
 }
 
@@ -166,4 +174,26 @@ fn an_obj_opened_from_a_file_rests_after_a_click() {
     h.get_by_label("render viewport").click();
     h.step();
     assert_rests(&mut h, "an OBJ scene after a click");
+}
+
+#[test]
+fn a_new_window_renders_once_at_its_panes_final_size() {
+    for size in [[1024.0, 640.0], [1280.0, 800.0], [1600.0, 1000.0]] {
+        let mut h = window(small("default"), size);
+        h.step();
+        let first = h.state().generation();
+        converge(&mut h);
+        let app = h.state();
+        assert_eq!(
+            app.render.pane_seen(&app.workspace.prefs),
+            Some(app.render_size()),
+            "{size:?}: the render follows the pane"
+        );
+        assert_eq!(
+            app.generation(),
+            first,
+            "{size:?}: the render restarted after the first frame (the first frame's pane size \
+             was taken before the layout settled)"
+        );
+    }
 }

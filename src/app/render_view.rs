@@ -94,8 +94,8 @@ impl Progress {
 /// The render pane's size in pixels, and the size the render follows.
 #[derive(Clone, Copy, Debug, Default)]
 struct PaneSize {
-    /// As last seen, and since when it has held.
-    seen: Option<((u32, u32), Instant)>,
+    /// As last seen, since when it has held, and the egui pass it was first seen in.
+    seen: Option<((u32, u32), Instant, u64)>,
     /// The size the render follows (`None`: the scene's), set once `seen` held.
     follows: Option<(u32, u32)>,
 }
@@ -216,7 +216,10 @@ impl RenderView {
     /// The render pane's size in pixels as last drawn (`None`: not drawn yet, or the render
     /// does not follow it).
     pub fn pane_seen(&self, prefs: &Prefs) -> Option<(u32, u32)> {
-        self.pane.seen.map(|(px, _)| px).filter(|_| prefs.pane_size)
+        self.pane
+            .seen
+            .map(|(px, _, _)| px)
+            .filter(|_| prefs.pane_size)
     }
 
     /// Sets the viewer's sample target and whether the render follows the pane's size in
@@ -298,8 +301,10 @@ impl RenderView {
     }
 
     /// Notes the render pane's size `avail` (screen points). When the render follows the pane,
-    /// a size that held for [`PANE_SIZE_DEBOUNCE`] (at once the first time) becomes the render
-    /// size, within the loader's limits; returns true then.
+    /// a size that held for [`PANE_SIZE_DEBOUNCE`] becomes the render size, within the loader's
+    /// limits; returns true then. The first size is taken as soon as a second egui pass sees
+    /// it: a window's first pass lays out before every panel knows its height, so the size it
+    /// gives is not the window's (rendering it would mean a second render 250 ms later).
     pub fn observe_pane(&mut self, ctx: &egui::Context, avail: egui::Rect, prefs: &Prefs) -> bool {
         if !prefs.pane_size {
             return false;
@@ -309,14 +314,22 @@ impl RenderView {
         let side = |v: f32| (v * ppp).floor().clamp(1.0, max) as u32;
         let px = (side(avail.width()), side(avail.height()));
         let now = Instant::now();
-        let since = match self.pane.seen {
-            Some((seen, since)) if seen == px => since,
+        let pass = ctx.cumulative_pass_nr();
+        let (since, first_pass) = match self.pane.seen {
+            Some((seen, since, first)) if seen == px => (since, first),
             _ => {
-                self.pane.seen = Some((px, now));
-                now
+                self.pane.seen = Some((px, now, pass));
+                (now, pass)
             }
         };
         if self.pane.follows == Some(px) {
+            return false;
+        }
+        if self.pane.follows.is_none() && pass == first_pass {
+            // Lay the window out once more (in the same frame when egui allows it, or else in
+            // the next), and take the size that pass sees.
+            ctx.request_discard("the render pane's first size is not settled");
+            ctx.request_repaint();
             return false;
         }
         let waited = now.duration_since(since);
