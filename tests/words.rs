@@ -88,6 +88,16 @@ fn finding(line: &str) -> Option<&'static str> {
     None
 }
 
+/// `line` and the line after it as one line of text: a phrase a comment or paragraph breaks
+/// over two lines (the next line's indent and comment marks dropped).
+fn joined(line: &str, next: &str) -> String {
+    let next = next
+        .trim_start()
+        .trim_start_matches(['/', '!', '#', '*', '>'])
+        .trim_start();
+    format!("{} {next}", line.trim_end())
+}
+
 #[test]
 fn no_history_and_no_outside_documents() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -104,10 +114,21 @@ fn no_history_and_no_outside_documents() {
             continue;
         }
         let text = std::fs::read_to_string(file).unwrap_or_default();
-        for (n, line) in text.lines().enumerate() {
+        let lines: Vec<&str> = text.lines().collect();
+        for (n, line) in lines.iter().enumerate() {
+            let place = file.strip_prefix(root).unwrap_or(file).display();
             if let Some(why) = finding(line) {
-                let place = file.strip_prefix(root).unwrap_or(file).display();
                 found.push(format!("{place}:{}: {why}: {}", n + 1, line.trim()));
+            } else if let Some(next) = lines.get(n + 1)
+                && finding(next).is_none()
+                && let Some(why) = finding(&joined(line, next))
+            {
+                found.push(format!(
+                    "{place}:{}-{}: {why}: {}",
+                    n + 1,
+                    n + 2,
+                    joined(line, next)
+                ));
             }
         }
     }
@@ -143,6 +164,11 @@ fn the_finder_finds_what_it_should_and_nothing_else() {
     ] {
         assert!(finding(&bad).is_some(), "{bad}");
     }
+    let broken = joined(
+        "/// fewer instructions (measured in session",
+        "    /// 13) than 4×4",
+    );
+    assert!(finding(&broken).is_some(), "{broken}");
     for good in [
         "let session = Session::new();",
         "an issue with the file",

@@ -123,8 +123,8 @@ pub fn trace_tile_single(
 }
 
 /// Width and height in pixels of the block of neighbouring camera rays traced as one packet
-/// ([`Tracer::trace_packet`]): 32 rays, the most a packet's `u32` lane masks hold (session
-/// 13: 1.2 % fewer instructions than 4×4 on the bench's camera- and shadow-ray frame).
+/// ([`Tracer::trace_packet`]): 32 rays, the most a packet's `u32` lane masks hold (1.2 % fewer
+/// instructions than 4×4 on the bench's camera- and shadow-ray frame).
 pub const PACKET_BLOCK: (u32, u32) = (8, 4);
 const PACKET_RAYS: usize = (PACKET_BLOCK.0 * PACKET_BLOCK.1) as usize;
 
