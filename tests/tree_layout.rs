@@ -67,7 +67,7 @@ fn the_diagram_and_the_list_are_readable_at_common_sizes() {
         follow_pane(&mut h);
         click_glass(&mut h);
         let tree = h.state().selection.tree.clone().expect("a tree");
-        show_tab(&mut h, "Ray tree diagram");
+        show_tab(&mut h, "Diagram");
         let label = h.state().selection.tree_state.drawn.diagram_label;
         let label = label.expect("the diagram was drawn");
         assert!(
@@ -84,7 +84,7 @@ fn the_diagram_and_the_list_are_readable_at_common_sizes() {
         let root = h.get_by_label_contains("tree node primary:").rect();
         assert!(pane.intersects(root), "{size:?}: the root is out of view");
 
-        show_tab(&mut h, "Ray tree");
+        show_tab(&mut h, "Tree list");
         let cells = h.state().selection.tree_state.drawn.cells.clone();
         assert!(
             cells.len() >= 3,
@@ -106,7 +106,7 @@ fn focus_gives_the_tree_most_of_the_window_and_leaving_restores_the_layout() {
     let mut h = window(small("default"), [1024.0, 640.0]);
     follow_pane(&mut h);
     click_glass(&mut h);
-    show_tab(&mut h, "Ray tree diagram");
+    show_tab(&mut h, "Diagram");
     let before = layout_json(&h);
     let render_before = h.get_by_label("render viewport").rect();
     // The tree follows the render to its new size: the same point, maybe another pixel.

@@ -288,13 +288,12 @@ fn clicking_a_pixel_shows_its_ray_tree_in_every_view() {
     assert!(tree.nodes > 3, "the glass sphere's tree has children");
     let [x, y] = tree.pixel;
     // The list is the diagram's neighbouring tab.
-    h.get_by_role_and_label(Role::Button, "Ray tree").click();
+    h.get_by_role_and_label(Role::Button, "Tree list").click();
     h.step();
     h.step();
     h.get_by_label_contains(&format!("Ray tree of ({x}, {y})"));
     assert!(h.query_all_by_label_contains("primary d0").count() >= 1);
-    h.get_by_role_and_label(Role::Button, "Ray tree diagram")
-        .click();
+    h.get_by_role_and_label(Role::Button, "Diagram").click();
     h.step();
     h.step();
     // The diagram shows the same tree, its root labelled with what the primary ray met.
@@ -559,7 +558,7 @@ fn opening_another_scene_clears_the_pinned_and_extra_trees() {
     let (a, b) = (pixel_pos(&h, GLASS.0, GLASS.1), pixel_pos(&h, 99, 53));
     click(&mut h, a, egui::Modifiers::NONE);
     click(&mut h, b, egui::Modifiers::SHIFT);
-    h.get_by_role_and_label(Role::Button, "Ray tree").click();
+    h.get_by_role_and_label(Role::Button, "Tree list").click();
     h.step();
     h.step();
     h.get_by_role_and_label(Role::Button, "Pin for comparison")

@@ -289,8 +289,8 @@ impl Pane {
         match self {
             Pane::Render => "Render",
             Pane::SceneView => "Scene view",
-            Pane::Diagram => "Ray tree diagram",
-            Pane::TreeList => "Ray tree",
+            Pane::Diagram => "Diagram",
+            Pane::TreeList => "Tree list",
             Pane::Pseudocode => "Pseudocode",
         }
     }
