@@ -44,6 +44,9 @@
 //! With `--keep DIR` each scene's directory also gets `differences_N.png` for peer N: raytree's
 //! image with every pixel that differs by more than 2 of 255 marked red (the peer's is the
 //! brighter) or blue (raytree's is).
+//! `--check` (the test suite runs it on a small scene) fails unless the harness builds and
+//! every configuration gives raytree's image: no pixel more than 2/255 apart and at most one
+//! in 1,000 apart at all.
 //! `--size 1280x960` renders more rays than the scene's 640×480 (a longer, steadier render
 //! phase on a noisy machine). `--scene A,B` races on other scenes instead of the generated
 //! ones: built-in names, scene files or bare OBJ files, within the peer's reach (point lights,
@@ -229,7 +232,14 @@ struct Options {
     /// Scenes to race on instead of the generated ones (`--scene`): built-in names, scene
     /// files or bare OBJ files.
     scenes: Vec<String>,
+    /// `--check`: the harness must build, and every configuration must trace the same rays
+    /// as raytree and give its image (no pixel more than 2/255 apart, at most one in
+    /// [`CHECK_PIXELS`] apart at all); the bench fails otherwise. The test suite runs it.
+    check: bool,
 }
+
+/// With `--check`, at most one pixel in this many may differ at all between the two images.
+const CHECK_PIXELS: usize = 1000;
 
 fn parse_options() -> Options {
     let mut o = Options {
@@ -246,6 +256,7 @@ fn parse_options() -> Options {
         size: None,
         opaque: false,
         scenes: Vec::new(),
+        check: false,
     };
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
@@ -267,6 +278,7 @@ fn parse_options() -> Options {
             "--keep" => o.keep = Some(PathBuf::from(value("--keep"))),
             "--scaling" => o.scaling = true,
             "--opaque" => o.opaque = true,
+            "--check" => o.check = true,
             "--scene" => o
                 .scenes
                 .extend(value("--scene").split(',').map(str::to_string)),
@@ -746,6 +758,10 @@ const MAX_RAY_DIFFERENCE: f64 = 0.01;
 
 fn peer_comparison(o: &Options, root: &Path) {
     let harness = if o.peer { build_harness(root) } else { None };
+    if o.check && harness.is_none() {
+        eprintln!("--check: the Embree harness did not build (the reason is above)");
+        std::process::exit(1);
+    }
     let configs: &[PeerConfig] = if harness.is_some() {
         &o.peer_configs
     } else {
@@ -889,9 +905,27 @@ fn peer_comparison(o: &Options, root: &Path) {
             }
         }
     }
+    if o.check {
+        for r in &results {
+            for (c, &[any, visible]) in r.differing.iter().enumerate() {
+                if visible > 0 || any * CHECK_PIXELS > r.pixels {
+                    flagged.push(format!(
+                        "{}, peer {}: {any} pixels differ, {visible} by more than 2/255 (of {})",
+                        r.label,
+                        c + 1,
+                        r.pixels
+                    ));
+                }
+            }
+        }
+        if flagged.is_empty() {
+            println!("check: every configuration traced the same rays and gave the same image");
+        }
+    }
     if !flagged.is_empty() {
         eprintln!(
-            "unequal work: the renderers did not trace the same rays (more than {} % apart):\n{}",
+            "unequal work: the renderers did not trace the same rays (a kind more than {} % \
+             apart), or with --check did not give the same image:\n{}",
             100.0 * MAX_RAY_DIFFERENCE,
             flagged.join("\n")
         );

@@ -10,11 +10,11 @@ if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
 # libraries the window needs; Mesa's software Vulkan (lavapipe) so the viewer and its tests run
 # without a GPU; Xvfb to run the window without a display; Slurm and munge for the one-node
 # cluster that tests/cluster.rs starts (scripts/slurm/start-cluster.sh; no daemon is started
-# here).
+# here); Embree 3 for the peer bench's C harness, which the suite checks on a small scene.
 need=()
 for pkg in build-essential pkg-config curl ca-certificates \
   libvulkan1 mesa-vulkan-drivers libxkbcommon-x11-0 libx11-xcb1 libxcursor1 libxi6 libxrandr2 \
-  libwayland-client0 libwayland-cursor0 libgl1 xvfb slurm-wlm munge; do
+  libwayland-client0 libwayland-cursor0 libgl1 xvfb slurm-wlm munge libembree-dev; do
   dpkg -s "$pkg" >/dev/null 2>&1 || need+=("$pkg")
 done
 if [ ${#need[@]} -gt 0 ]; then

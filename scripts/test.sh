@@ -20,5 +20,10 @@ echo "== cargo clippy --no-default-features (headless core and CLI)"
 cargo clippy --release --no-default-features --locked -- -D warnings
 echo "== cargo test (release)"
 cargo test --release --locked
+# The peer bench's Embree harness traces the same rays as raytree and gives its image, in
+# every configuration (a small scene, one round: a check of the harness, not a measurement).
+echo "== the Embree peer harness (cargo bench --bench peer -- --check)"
+cargo bench --locked --bench peer -- --check --sizes 2000 --runs 1 --warmup 0 --frames 2 \
+  --peer-config all
 echo "== cargo doc"
 RUSTDOCFLAGS="-D warnings" cargo doc --release --no-deps --locked --quiet
