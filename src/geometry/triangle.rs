@@ -161,7 +161,9 @@ fn max_component_index(a: Vec3) -> usize {
 /// needle's width away once it is a few ulp of its ray-relative coordinates, and δt grows
 /// like ε·t²/size on a small triangle far away until it passes `t` (docs/stability.md, rows
 /// T3 and T5). Each of these only turns an `f32` miss into a hit that `f64` confirms, so
-/// shared edges stay watertight; none occurs on ordinary geometry, so the path stays cold.
+/// shared edges stay watertight. On ordinary geometry the one that occurs is a ray that starts
+/// exactly on an axis-aligned floor or wall and leaves it (`t ≤ δt`): the lanes' test answers
+/// that one without `f64` (see `leaves_plane_of`).
 ///
 /// The range check `t_min < t < t_max` is made on the divided `t = T/det` (not on `T` against
 /// `t_max·det`) so the answer is a pure function of the triangle and the ray: the accelerators
@@ -583,12 +585,30 @@ impl Shear {
         while lanes != 0 {
             let lane = lanes.trailing_zeros() as usize;
             lanes &= lanes - 1;
-            hits.set(
-                lane,
-                self.intersect(&tris.triangle(lane), ray, t_min, t_max),
-            );
+            let tri = tris.triangle(lane);
+            let hit = if leaves_plane_of(&tri, ray) {
+                None
+            } else {
+                self.intersect(&tri, ray, t_min, t_max)
+            };
+            hits.set(lane, hit);
         }
     }
+}
+
+/// Whether `ray` starts exactly in the plane of the axis-aligned triangle `v` and leaves it
+/// (`v`'s three vertices and the origin share one coordinate, and the direction's is not 0):
+/// the ray then meets that plane only at `t = 0`, so the watertight test cannot find a hit
+/// in any `(t_min ≥ 0, t_max)`: its `t ≤ δt` close call rejects it in `f64`. This answers it
+/// at once. It is the common close call: a shadow or secondary ray from a floor or wall at a
+/// round coordinate (`y = 0`), where the hit point is exact, so its error bound and offset
+/// are 0 and the ray starts on the surface (docs/performance.md).
+#[inline]
+fn leaves_plane_of(v: &[Vec3; 3], ray: &Ray) -> bool {
+    (0..3).any(|k| {
+        let c = ray.origin[k];
+        ray.dir[k] != 0.0 && v[0][k] == c && v[1][k] == c && v[2][k] == c
+    })
 }
 
 /// What [`watertight_lanes`] finds: bit `i` of `mask` when lane `i` hits (lanes with an edge
@@ -783,6 +803,73 @@ pub fn triangle_hit_f64(v: &[Vec3; 3], ray: &Ray) -> Option<(f64, f64, f64, f64)
     let b2 = d.dot(q) / det;
     let t = e2.dot(q) / det;
     Some((t, 1.0 - b1 - b2, b1, b2))
+}
+
+#[cfg(test)]
+mod plane_tests {
+    use super::*;
+
+    /// A ray that starts exactly in an axis-aligned triangle's plane and leaves it (a shadow
+    /// ray from a floor at `y = 0`): the full watertight test, `f64` close call included,
+    /// finds no hit, as `leaves_plane_of` answers; the lane test, which takes that answer,
+    /// agrees; and a ray lying in the plane is not taken for one that leaves it.
+    #[test]
+    fn a_ray_leaving_an_axis_aligned_triangles_plane_never_hits_it() {
+        let mut rnd = crate::rng::signed(0x51ab_0f17);
+        for round in 0..20_000 {
+            let k = round % 3;
+            let c = [0.0, 1.5, -3.25, 1000.0, 1e-3][round % 5];
+            let scale = [1.0, 12.0, 0.01][round % 3];
+            let on_plane = |rnd: &mut dyn FnMut() -> f32| {
+                let mut p = Vec3::new(rnd(), rnd(), rnd()) * scale;
+                p[k] = c;
+                p
+            };
+            let v = [on_plane(&mut rnd), on_plane(&mut rnd), on_plane(&mut rnd)];
+            // The origin inside the triangle (a hit point), on a vertex, or anywhere on the plane.
+            let origin = match round % 4 {
+                0 => v[1],
+                1 => on_plane(&mut rnd),
+                _ => {
+                    let (a, b) = (rnd().abs(), rnd().abs());
+                    let (a, b) = if a + b > 1.0 {
+                        (1.0 - a, 1.0 - b)
+                    } else {
+                        (a, b)
+                    };
+                    let mut p = v[0] + a * (v[1] - v[0]) + b * (v[2] - v[0]);
+                    p[k] = c;
+                    p
+                }
+            };
+            let mut dir = Vec3::new(rnd(), rnd(), rnd());
+            dir[k] = if round % 7 == 0 { 1e-4 } else { dir[k] };
+            let Some(dir) = dir.try_normalize() else {
+                continue;
+            };
+            if dir[k] == 0.0 {
+                continue;
+            }
+            let ray = Ray::new(origin, dir);
+            assert!(leaves_plane_of(&v, &ray), "round {round}");
+            let Some(shear) = Shear::new(ray.dir) else {
+                continue;
+            };
+            let full = shear.intersect(&v, &ray, 0.0, f32::INFINITY);
+            assert!(
+                full.is_none(),
+                "round {round}: {v:?} {ray:?} hit at {full:?}"
+            );
+            let lanes = shear.intersect4(&Triangles4::new(&[v]), &ray, 0.0, f32::INFINITY);
+            assert_eq!(lanes.mask & 1, 0, "round {round}: the lane test hit");
+            let mut flat = ray;
+            flat.dir[k] = 0.0;
+            assert!(
+                !leaves_plane_of(&v, &flat),
+                "a ray in the plane does not leave it"
+            );
+        }
+    }
 }
 
 #[cfg(all(test, target_arch = "x86_64"))]
