@@ -121,14 +121,11 @@ fn no_history_and_no_outside_documents() {
                 found.push(format!("{place}:{}: {why}: {}", n + 1, line.trim()));
             } else if let Some(next) = lines.get(n + 1)
                 && finding(next).is_none()
-                && let Some(why) = finding(&joined(line, next))
             {
-                found.push(format!(
-                    "{place}:{}-{}: {why}: {}",
-                    n + 1,
-                    n + 2,
-                    joined(line, next)
-                ));
+                let both = joined(line, next);
+                if let Some(why) = finding(&both) {
+                    found.push(format!("{place}:{}-{}: {why}: {both}", n + 1, n + 2));
+                }
             }
         }
     }
