@@ -110,6 +110,9 @@ pub struct Workspace {
     settings_settled: bool,
     /// How the tree's panes were last set (`None`: not yet, or the layout was reset).
     tree_panes: Option<TreePanes>,
+    /// The workspace's width when the tree's column was last given its room
+    /// ([`make_room_for_tree`]); `None`: not yet, or the layout was replaced.
+    room_width: Option<f32>,
     pub(super) browser: Option<FileBrowser>,
     pub(super) show_help: bool,
     /// The Ctrl+S window: which picture to export.
@@ -364,6 +367,65 @@ pub fn focus_layout() -> Layout {
     egui_tiles::Tree::new(egui::Id::unique("raytree focus"), root, tiles)
 }
 
+/// The narrowest the column of the scene view and the tree's panes is made while the
+/// workspace has room (at most [`TREE_COLUMN_MAX_SHARE`] of it): below about 300 points the
+/// tree's three tabs no longer fit their bar and the pseudocode wraps its lines.
+pub const TREE_COLUMN_MIN: f32 = 300.0;
+
+/// The largest share of the workspace's width [`TREE_COLUMN_MIN`] may take from the render.
+pub const TREE_COLUMN_MAX_SHARE: f32 = 0.4;
+
+/// Widens the column holding the tree's panes to [`TREE_COLUMN_MIN`] points of `width` (the
+/// workspace's), taking it from its neighbours, when it is narrower; a wider column is left as
+/// it is. Only a layout whose root is a row holding that column is touched (the default one;
+/// a rearranged layout is the user's).
+fn make_room_for_tree(layout: &mut Layout, width: f32) {
+    let Some((root, column)) = tree_column(layout) else {
+        return;
+    };
+    let visible: Vec<TileId> = match layout.tiles.get(root) {
+        Some(Tile::Container(egui_tiles::Container::Linear(row)))
+            if row.dir == LinearDir::Horizontal && row.children.contains(&column) =>
+        {
+            row.children
+                .iter()
+                .copied()
+                .filter(|&id| layout.tiles.is_visible(id))
+                .collect()
+        }
+        _ => return,
+    };
+    if visible.len() < 2 || !visible.contains(&column) || !width.is_finite() || width <= 0.0 {
+        return;
+    }
+    let Some(Tile::Container(egui_tiles::Container::Linear(row))) = layout.tiles.get_mut(root)
+    else {
+        return;
+    };
+    let total: f32 = visible.iter().map(|&id| row.shares[id]).sum();
+    let own = row.shares[column];
+    let others = total - own;
+    let wanted = (TREE_COLUMN_MIN / width).min(TREE_COLUMN_MAX_SHARE);
+    if others > 0.0 && own / total < wanted {
+        // own' / (own' + others) = wanted
+        row.shares
+            .set_share(column, wanted * others / (1.0 - wanted));
+    }
+}
+
+/// The root and the root's child that holds the tree's diagram.
+fn tree_column(layout: &Layout) -> Option<(TileId, TileId)> {
+    let root = layout.root()?;
+    let mut column = tile_of(layout, Pane::Diagram)?;
+    while let Some(parent) = layout.tiles.parent_of(column) {
+        if parent == root {
+            break;
+        }
+        column = parent;
+    }
+    Some((root, column))
+}
+
 /// Whether `layout` can be used: a root, and every pane exactly once.
 pub fn usable(layout: &Layout) -> bool {
     layout.root().is_some()
@@ -413,8 +475,16 @@ pub fn show(app: &mut ViewerApp, ui: &mut Ui, pane_ui: PaneUi) {
     if !usable(&ws.prefs.layout) {
         ws.prefs.layout = default_layout();
         ws.tree_panes = None;
+        ws.room_width = None;
     }
     follow_tree(ws, app.selection.tree.is_some());
+    // On the first frame and whenever the workspace's width changes (the window, the lesson
+    // or settings panel): between those the splitter stays where the user drags it.
+    let width = ui.available_width();
+    if !ws.focused() && ws.room_width.is_none_or(|w| (w - width).abs() > 0.5) {
+        make_room_for_tree(&mut ws.prefs.layout, width);
+        ws.room_width = Some(width);
+    }
     let mut layout = std::mem::replace(
         &mut app.workspace.prefs.layout,
         egui_tiles::Tree::empty(egui::Id::unique("none")),
@@ -452,6 +522,7 @@ pub fn pane_toggles(ws: &mut Workspace, messages: &mut Messages, ui: &mut Ui) {
         ws.prefs.layout = default_layout();
         ws.prefs.settings_panel = true;
         ws.tree_panes = None;
+        ws.room_width = None;
     }
 }
 
@@ -585,5 +656,59 @@ mod tests {
             ws.start_dir(BrowseFor::Export),
             PathBuf::from("/models/kitchen")
         );
+    }
+
+    /// The share of the workspace's width the column holding the tree's panes gets.
+    fn tree_column_share(layout: &Layout) -> f32 {
+        let (root, column) = tree_column(layout).expect("a tree column");
+        let Some(Tile::Container(egui_tiles::Container::Linear(row))) = layout.tiles.get(root)
+        else {
+            panic!("the root is a row");
+        };
+        let total: f32 = row.children.iter().map(|&c| row.shares[c]).sum();
+        row.shares[column] / total
+    }
+
+    #[test]
+    fn a_narrow_workspace_gives_the_tree_column_its_room_from_the_render() {
+        let wide = {
+            let mut l = default_layout();
+            make_room_for_tree(&mut l, 2000.0);
+            tree_column_share(&l)
+        };
+        assert!(
+            (wide - (1.0 - RENDER_SHARE)).abs() < 1e-6,
+            "left alone when wide: {wide}"
+        );
+        // 1024×640 with the lesson panel open: about 756 points of workspace.
+        let mut l = default_layout();
+        make_room_for_tree(&mut l, 756.0);
+        let got = tree_column_share(&l) * 756.0;
+        assert!((got - TREE_COLUMN_MIN).abs() < 0.01, "column {got} points");
+        // Very narrow: the render keeps the larger part.
+        let mut l = default_layout();
+        make_room_for_tree(&mut l, 500.0);
+        let share = tree_column_share(&l);
+        assert!(
+            (share - TREE_COLUMN_MAX_SHARE).abs() < 1e-6,
+            "share {share}"
+        );
+        // A column the user made wider stays as it is.
+        let mut l = default_layout();
+        make_room_for_tree(&mut l, 500.0);
+        make_room_for_tree(&mut l, 756.0);
+        assert!((tree_column_share(&l) - TREE_COLUMN_MAX_SHARE).abs() < 1e-6);
+        // A rearranged layout (the tree's tabs beside the render in the root row's first
+        // child) is the user's: untouched.
+        let mut l = focus_layout();
+        let before = serde_json::to_string(&l).expect("serialises");
+        let root = l.root().expect("root");
+        if let Some(Tile::Container(egui_tiles::Container::Linear(row))) = l.tiles.get_mut(root) {
+            row.dir = LinearDir::Vertical;
+        }
+        let vertical = serde_json::to_string(&l).expect("serialises");
+        make_room_for_tree(&mut l, 756.0);
+        assert_eq!(serde_json::to_string(&l).expect("serialises"), vertical);
+        assert_ne!(before, vertical);
     }
 }
