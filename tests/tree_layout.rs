@@ -109,12 +109,31 @@ fn focus_gives_the_tree_most_of_the_window_and_leaving_restores_the_layout() {
     show_tab(&mut h, "Diagram");
     let before = layout_json(&h);
     let render_before = h.get_by_label("render viewport").rect();
-    // The tree follows the render to its new size: the same point, maybe another pixel.
     let label = "ray tree diagram of (";
     let diagram_before = h.get_by_label_contains(label).rect();
+    let pixel = |h: &Window| h.state().selection.tree.as_ref().map(|t| t.pixel);
+    let (pixel_before, size_before) = (pixel(&h), h.state().render_size());
+    let generation = h.state().render.generation();
     h.key_press(egui::Key::F);
     h.run_steps(4);
     assert!(h.state().workspace.focused(), "F turns focus on");
+    // The render keeps its size and its samples (drawn scaled into the strip it has), so the
+    // tree is the pixel that was clicked (waited past the pane's debounce).
+    for _ in 0..12 {
+        h.step();
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    assert_eq!(pixel(&h), pixel_before, "focus keeps the tree's pixel");
+    assert_eq!(
+        h.state().render_size(),
+        size_before,
+        "focus keeps the render's size"
+    );
+    assert_eq!(
+        h.state().render.generation(),
+        generation,
+        "focus restarts no render"
+    );
     let diagram = h.get_by_label_contains(label).rect();
     let window_area = h.ctx.content_rect().area();
     // The diagram and the list (beside it) hold most of the window.

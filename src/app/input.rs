@@ -86,7 +86,10 @@ pub(super) fn shortcuts(
 }
 
 /// The render pane: draws the render fitted into `ui`'s space, the trees over it (by
-/// `filter`), and handles orbit, pan and zoom of the render `camera`, click and hover.
+/// `filter`), and handles orbit, pan and zoom of the render `camera`, click and hover. While
+/// `hold` (focus on the ray tree) the render keeps its size and is drawn scaled into the strip
+/// it has: entering and leaving focus restart nothing and every tree keeps its pixel.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn render_pane(
     ui: &mut egui::Ui,
     render: &mut RenderView,
@@ -94,6 +97,7 @@ pub(super) fn render_pane(
     camera: &mut Camera,
     prefs: &Prefs,
     filter: &Filter,
+    hold: bool,
     pending: &mut Vec<Command>,
 ) {
     let mut avail = ui.available_rect_before_wrap();
@@ -121,7 +125,7 @@ pub(super) fn render_pane(
         );
     }
     // The render follows the image area's size (when set); it is drawn fitted, on whole pixels.
-    if render.observe_pane(ui.ctx(), avail, prefs) {
+    if !hold && render.observe_pane(ui.ctx(), avail, prefs) {
         pending.push(Command::MoveCamera);
     }
     let (w, h) = (scene.render.width as f32, scene.render.height as f32);

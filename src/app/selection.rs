@@ -33,12 +33,16 @@ pub struct TreeSelection {
     pub selected_light: Option<usize>,
 }
 
-/// Pixel `p` of a `from`-sized image as the pixel at the same place of a `to`-sized one.
+/// Pixel `p` of a `from`-sized image as the pixel of a `to`-sized one that looks the same way:
+/// the camera keeps its vertical field of view, so rows scale with the height and columns keep
+/// their distance from the centre in units of the height (a narrower image is the same picture
+/// cropped at the sides). A pixel the new image no longer shows goes to its nearest edge.
 pub fn remap_pixel(p: [u32; 2], from: (u32, u32), to: (u32, u32)) -> [u32; 2] {
-    let axis = |v: u32, a: u32, b: u32| {
-        (((v as f64 + 0.5) * b as f64 / a.max(1) as f64) as u32).min(b.saturating_sub(1))
-    };
-    [axis(p[0], from.0, to.0), axis(p[1], from.1, to.1)]
+    let s = to.1 as f64 / from.1.max(1) as f64;
+    let cell = |v: f64, n: u32| (v.floor().max(0.0) as u32).min(n.saturating_sub(1));
+    let x = (p[0] as f64 + 0.5 - from.0 as f64 * 0.5) * s + to.0 as f64 * 0.5;
+    let y = (p[1] as f64 + 0.5) * s;
+    [cell(x, to.0), cell(y, to.1)]
 }
 
 impl TreeSelection {
@@ -284,5 +288,24 @@ mod tests {
         assert_eq!(remap_pixel([320, 240], (640, 480), (800, 300)), [400, 150]);
         // Never outside the new image.
         assert_eq!(remap_pixel([9, 9], (10, 10), (3, 3)), [2, 2]);
+    }
+
+    #[test]
+    fn a_pixel_keeps_its_ray_when_the_render_changes_shape() {
+        use crate::scene::{Camera, CameraFrame};
+        let camera = Camera::default();
+        let (from, to) = ((694, 543), (238, 543));
+        let old = CameraFrame::new(&camera, from.0, from.1);
+        let new = CameraFrame::new(&camera, to.0, to.1);
+        // A pixel near the centre: the new pixel holds the old pixel's ray.
+        for p in [[340, 300], [300, 100], [400, 500]] {
+            let ray = old.ray(p[0] as f32 + 0.5, p[1] as f32 + 0.5);
+            let (x, y) = new.project(ray.origin + ray.dir).expect("in front");
+            let q = remap_pixel(p, from, to);
+            assert_eq!(q, [x.floor() as u32, y.floor() as u32], "pixel {p:?}");
+        }
+        // A pixel the narrower image crops away goes to the nearest edge, its row kept.
+        assert_eq!(remap_pixel([20, 300], from, to), [0, 300]);
+        assert_eq!(remap_pixel([680, 300], from, to), [237, 300]);
     }
 }

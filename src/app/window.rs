@@ -320,6 +320,7 @@ fn pane_ui(app: &mut ViewerApp, ui: &mut egui::Ui, pane: workspace::Pane) {
             &mut app.working.scene.camera,
             &app.workspace.prefs,
             &app.scene_view.filter,
+            app.workspace.focused(),
             &mut app.pending,
         ),
         Pane::SceneView => scene_pane::scene_view_ui(
