@@ -393,12 +393,13 @@ mod viewer {
     use eframe::egui;
     use egui_kittest::kittest::Queryable;
 
-    use super::harness::{settle_render, sized, window_with};
+    use super::harness::{Window, settle_render, sized, window_with};
 
-    #[test]
-    fn the_glass_spheres_tree_is_readable_in_its_pane_zooms_and_pans() {
+    /// The viewer in a `size` window with the glass sphere's tree picked (pixel (75, 62) of
+    /// the 160×120 image: a 13-node tree).
+    fn glass_tree(size: [f32; 2]) -> Window {
         // Few samples: the layout, not the picture, is under test.
-        let mut h = window_with(sized("default", 160, 120, None), [1600.0, 1000.0], |app| {
+        let mut h = window_with(sized("default", 160, 120, None), size, |app| {
             app.set_view(4, true)
         });
         settle_render(&mut h, "the render did not finish");
@@ -419,6 +420,63 @@ mod viewer {
         for _ in 0..4 {
             h.step();
         }
+        h
+    }
+
+    fn ctrl_wheel(h: &mut Window, at: egui::Pos2, delta: f32) {
+        h.hover_at(at);
+        h.event(egui::Event::MouseWheel {
+            unit: egui::MouseWheelUnit::Point,
+            delta: egui::Vec2::new(0.0, delta),
+            phase: egui::TouchPhase::Move,
+            source: egui::MouseWheelSource::Unknown,
+            modifiers: egui::Modifiers {
+                ctrl: true,
+                command: true,
+                ..egui::Modifiers::NONE
+            },
+        });
+        for _ in 0..4 {
+            h.step();
+        }
+    }
+
+    #[test]
+    fn the_overview_folds_away_and_comes_back() {
+        let mut h = glass_tree([1600.0, 1000.0]);
+        let [x, y] = h.state().selection.tree.as_ref().expect("a tree").pixel;
+        let pane = h
+            .get_by_label(&format!("ray tree diagram of ({x}, {y})"))
+            .rect();
+        // Zoomed in until the tree overflows the pane: the overview shows where the view is.
+        for _ in 0..6 {
+            ctrl_wheel(&mut h, pane.center(), 120.0);
+            if h.query_by_label("ray tree overview").is_some() {
+                break;
+            }
+        }
+        let map = h.get_by_label("ray tree overview").rect();
+        h.get_by_label("×").click();
+        h.step();
+        h.step();
+        assert!(
+            h.query_by_label("ray tree overview").is_none(),
+            "the overview did not fold"
+        );
+        let button = h.get_by_label("map").rect();
+        assert!(
+            button.height() < map.height() * 0.5 && pane.contains_rect(button),
+            "the folded overview leaves a small button in the pane: {button:?} for {map:?}"
+        );
+        h.get_by_label("map").click();
+        h.step();
+        h.step();
+        assert_eq!(h.get_by_label("ray tree overview").rect(), map);
+    }
+
+    #[test]
+    fn the_glass_spheres_tree_is_readable_in_its_pane_zooms_and_pans() {
+        let mut h = glass_tree([1600.0, 1000.0]);
         let tree = h
             .state()
             .selection
@@ -451,21 +509,7 @@ mod viewer {
         // Ctrl+wheel zooms about the pointer: the root grows and stays under it.
         let root_label = "tree node primary: glass sphere";
         let before = h.get_by_label(root_label).rect();
-        h.hover_at(before.center());
-        h.event(egui::Event::MouseWheel {
-            unit: egui::MouseWheelUnit::Point,
-            delta: egui::Vec2::new(0.0, 60.0),
-            phase: egui::TouchPhase::Move,
-            source: egui::MouseWheelSource::Unknown,
-            modifiers: egui::Modifiers {
-                ctrl: true,
-                command: true,
-                ..egui::Modifiers::NONE
-            },
-        });
-        for _ in 0..4 {
-            h.step();
-        }
+        ctrl_wheel(&mut h, before.center(), 60.0);
         let zoomed = h.get_by_label(root_label).rect();
         assert!(
             zoomed.width() > before.width() * 1.05,

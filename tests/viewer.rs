@@ -393,8 +393,22 @@ fn shift_click_adds_a_tree_and_a_plain_click_starts_over() {
     click(&mut h, b, egui::Modifiers::SHIFT);
     let c = pixel_pos(&h, 20, 100);
     click(&mut h, c, egui::Modifiers::SHIFT);
+    // Each shift-clicked tree becomes the one shown; the earlier ones stay, in picking order.
     let pixels: Vec<[u32; 2]> = h.state().selection.trees().map(|t| t.pixel).collect();
-    assert_eq!(pixels, vec![[60, 69], [99, 53], [20, 100]]);
+    assert_eq!(
+        pixels[0],
+        [20, 100],
+        "the last shift-clicked tree is the current one"
+    );
+    let picked: Vec<[u32; 2]> = h
+        .state()
+        .selection
+        .picker
+        .entries
+        .iter()
+        .map(|e| e.pixel)
+        .collect();
+    assert_eq!(picked, vec![[60, 69], [99, 53], [20, 100]]);
     // A plain click away from the drawn rays (a click on one selects it instead).
     let d = pixel_pos(&h, 150, 5);
     click(&mut h, d, egui::Modifiers::NONE);

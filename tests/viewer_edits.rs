@@ -318,3 +318,49 @@ fn shift_dragging_a_sphere_in_the_scene_view_moves_it_as_one_undoable_step() {
     settle(&mut h);
     assert!(*h.state().scene() == scene);
 }
+
+#[test]
+fn a_selected_material_opens_once_then_folds_and_the_settings_do_not_slide_sideways() {
+    let scene = small("default");
+    let i = scene.materials.len() - 1;
+    let mut h = harness(scene);
+    settle(&mut h);
+    let left = |h: &Window| h.get_by_label_contains("Materials (").rect().left();
+    let before = left(&h);
+    // Each open material shows its reflection coefficient (one field, or three for RGB).
+    let opened = |h: &Window| {
+        h.query_all_by_role_and_label(Role::SpinButton, "reflect kr")
+            .count()
+    };
+    let opened_before = opened(&h);
+    h.state_mut().selection.selected_material = Some(i);
+    // The scroll is animated: frames enough for it to end.
+    for _ in 0..30 {
+        h.step();
+    }
+    let header = |h: &Window| {
+        h.query_by(|n| n.label().is_some_and(|l| l.starts_with("> ")))
+            .map(|n| n.rect())
+    };
+    let shown = header(&h).expect("the selected material's header, marked >");
+    let panel = h.get_by_label("« hide").rect();
+    assert!(
+        shown.top() >= panel.bottom() && shown.top() < 800.0,
+        "the selected material scrolled into view: its header at {shown:?}"
+    );
+    assert!(opened(&h) > opened_before, "the selected material opened");
+    assert_eq!(left(&h), before, "the settings slid sideways");
+    // Its header folds on a click, and stays folded while it stays selected.
+    h.query_by(|n| n.label().is_some_and(|l| l.starts_with("> ")))
+        .expect("the header")
+        .click();
+    for _ in 0..10 {
+        h.step();
+    }
+    assert_eq!(
+        opened(&h),
+        opened_before,
+        "the selected material did not fold"
+    );
+    assert_eq!(h.state().selection.selected_material, Some(i));
+}

@@ -76,7 +76,13 @@ fn shift_clicked_trees_are_listed_and_the_arrow_keys_step_through_them() {
         click(&mut h, at, egui::Modifiers::SHIFT);
     }
     assert_eq!(h.state().selection.trees().count(), 2);
-    assert_eq!(current(&h), Some(GLASS));
+    assert_eq!(
+        current(&h),
+        Some(FLOOR),
+        "the last shift-clicked tree is shown"
+    );
+    press(&mut h, egui::Key::ArrowUp);
+    assert_eq!(current(&h), Some(GLASS), "Up selects the tree before");
     // The picker lists both, in picking order, each with its own tint.
     let entries = &h.state().selection.picker.entries;
     assert_eq!(
@@ -111,8 +117,8 @@ fn a_click_three_pixels_from_a_drawn_ray_selects_it_and_keeps_every_tree() {
     let mut h = harness(small("default"));
     settle(&mut h);
     for ([x, y], modifiers) in [
-        (GLASS, egui::Modifiers::NONE),
-        (FLOOR, egui::Modifiers::SHIFT),
+        (FLOOR, egui::Modifiers::NONE),
+        (GLASS, egui::Modifiers::SHIFT),
     ] {
         let at = pixel_pos(&h, x, y);
         click(&mut h, at, modifiers);
@@ -243,7 +249,8 @@ fn the_picker_strip_fits_its_pane_at_1024x640() {
     let trees = h.state().selection.trees().count();
     assert!(trees > 10, "{trees} trees");
     let right = h.ctx.content_rect().right();
-    for label in ["tree 1 of", "to depth", "list all trees"] {
+    // The last shift-clicked tree is the current one: the grid's trees were added after it.
+    for label in ["tree 2 of", "to depth", "list all trees"] {
         let rect = h.get_by_label_contains(label).rect();
         assert!(
             rect.right() <= right + 0.5 && rect.width() > 0.0,

@@ -467,8 +467,14 @@ impl ViewerApp {
                 Command::ExportTree(path) => self.export_tree(&path),
                 Command::ExportDiagram(path) => self.export_diagram(&path),
                 Command::PickMore(x, y) => {
-                    self.selection
-                        .add(&self.render.tracer, x, y, &mut self.messages);
+                    // The pixel just clicked is the one the list, detail and diagram show;
+                    // the others stay drawn beside it.
+                    if self
+                        .selection
+                        .add(&self.render.tracer, x, y, &mut self.messages)
+                    {
+                        self.selection.select_pixel([x, y]);
+                    }
                 }
                 Command::PickRect(a, b) => {
                     self.selection

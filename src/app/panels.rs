@@ -48,8 +48,7 @@ pub mod tips {
     pub const LOOK_AT: &str = "The point at the centre of the image; the camera orbits about it.";
     pub const UP: &str = "Which way is up in the image.";
     pub const FOV: &str = "Vertical field of view: the angle the image spans from top to bottom.";
-    pub const ORBIT: &str =
-        "How far a drag across the whole image turns the camera (the same rate up and down).";
+    pub const ORBIT: &str = "Degrees a drag across the whole width of the image turns the camera (the same rate up and down).";
     pub const LIGHT_POSITION: &str = "Where the point light is: shadow rays are shot from each hit towards it. Drag the light's marker in the scene view to move it.";
     pub const LIGHT_FOLLOW: &str = "A headlight: the light stands at the render camera's eye and moves with it, so what the camera sees is lit (saved as `follow_camera = true`).";
     pub const LIGHT_COLOUR: &str = "The light's colour and intensity: multiplies the diffuse and specular terms of every point it lights.";
@@ -106,6 +105,10 @@ fn color_edit(ui: &mut Ui, label: &str, v: &mut Vec3, tip: &str) -> bool {
         .data(|d| d.get_temp::<bool>(id))
         .unwrap_or(v.x == v.y && v.y == v.z);
     ui.horizontal(|ui| {
+        // Tighter than the default so that a swatch, three channels and "=" fit the
+        // settings panel at its default width inside a material's header.
+        ui.spacing_mut().item_spacing.x = 3.0;
+        ui.spacing_mut().interact_size.x = 24.0;
         let l = ui.label(label).on_hover_text(tip);
         let (mut rgb, k) = picker_rgb(*v);
         if ui
@@ -514,7 +517,7 @@ pub fn side_panel(
             });
             ui.add(
                 egui::Slider::new(&mut prefs.orbit_degrees, 30.0..=720.0)
-                    .text("orbit (° per width)")
+                    .text("orbit °/width")
                     .max_decimals(0),
             )
             .on_hover_text(tips::ORBIT);
@@ -598,8 +601,16 @@ pub fn side_panel(
     egui::CollapsingHeader::new(format!("Materials ({})", edit.materials.len()))
         .default_open(true)
         .show(ui, |ui| {
+            // Each material's fields sit one indent in: a shallow one leaves them the width.
+            ui.spacing_mut().indent = 10.0;
             ui.small("click an object in the image to select its material");
             let titles = names::material_titles(edit);
+            // A click on an object opens its material and brings it into view, once per
+            // selection: afterwards the header folds and the panel scrolls as the user likes.
+            let scrolled = egui::Id::unique("raytree material scrolled to");
+            let arrived = selection
+                .selected_material
+                .filter(|&i| ui.data(|d| d.get_temp::<usize>(scrolled)) != Some(i));
             for (i, m) in edit.materials.iter_mut().enumerate() {
                 let selected = selection.selected_material == Some(i);
                 let named = titles.get(i).cloned().unwrap_or_default();
@@ -609,7 +620,7 @@ pub fn side_panel(
                     RichText::new(named.title)
                 };
                 let header = egui::CollapsingHeader::new(title).id_salt(("material", i));
-                let header = if selected {
+                let header = if arrived == Some(i) {
                     header.open(Some(true))
                 } else {
                     header
@@ -620,17 +631,16 @@ pub fn side_panel(
                     }
                     restart |= material_editor(ui, m)
                 });
-                // A click on an object brings its material into view, once per selection.
-                let scrolled = egui::Id::unique("raytree material scrolled to");
-                if selected && ui.data(|d| d.get_temp::<usize>(scrolled)) != Some(i) {
-                    shown.header_response.scroll_to_me(Some(egui::Align::TOP));
+                if arrived == Some(i) {
+                    // Vertically only: the header is indented, and aligning both axes would
+                    // also slide the whole panel sideways by that indent.
+                    let rise = ui.clip_rect().top() - shown.header_response.rect.top();
+                    ui.scroll_with_delta(egui::vec2(0.0, rise));
                     ui.data_mut(|d| d.insert_temp(scrolled, i));
                 }
             }
             if selection.selected_material.is_none() {
-                ui.data_mut(|d| {
-                    d.remove::<usize>(egui::Id::unique("raytree material scrolled to"))
-                });
+                ui.data_mut(|d| d.remove::<usize>(scrolled));
             }
         });
     egui::CollapsingHeader::new("Scene")

@@ -162,6 +162,8 @@ struct DiagramView {
     legend: Legend,
     /// Whether the legend fitted beside the tree in the last frame.
     legend_fits: bool,
+    /// Whether the user folded the overview away (it can cover nodes in its corner).
+    overview_folded: bool,
 }
 
 /// Whether the diagram's legend is shown: as the user set it with its toggle, or, before that,
@@ -192,6 +194,7 @@ impl Default for DiagramView {
             key: None,
             legend: Legend::WhenItFits,
             legend_fits: true,
+            overview_folded: false,
         }
     }
 }
@@ -405,11 +408,16 @@ pub fn diagram_with(
         {
             export = true;
         }
-        ui.label(format!("{:.0}%", view.zoom * 100.0));
+        ui.label(format!("{:.0}%", view.zoom * 100.0))
+            .on_hover_text(DIAGRAM_HINT);
         if lay.hidden > 0 {
             ui.label(format!("{} folded or hidden", count(lay.hidden, "node")));
         }
-        ui.weak("drag or wheel pans, Ctrl+wheel zooms, double-click folds");
+        // The hint where the row has room for it; a narrow pane keeps it in the diagram's
+        // hover text rather than spend a toolbar row on it.
+        if ui.available_width() >= HINT_WIDTH {
+            ui.weak(DIAGRAM_HINT);
+        }
     });
     // The space left that is shown (never wider than the pane's clip rectangle).
     let shown = ui.available_rect_before_wrap().intersect(ui.clip_rect());
@@ -769,6 +777,10 @@ fn keep_in_view(offset: Vec2, size: Vec2, area: Rect, min: Pos2) -> Vec2 {
     )
 }
 
+/// How to move about the diagram, and the width the toolbar needs left to show it.
+const DIAGRAM_HINT: &str = "drag or wheel pans, Ctrl+wheel zooms, double-click folds";
+const HINT_WIDTH: f32 = 330.0;
+
 /// Largest size of the overview in the diagram's corner.
 const OVERVIEW: Vec2 = Vec2::new(170.0, 110.0);
 
@@ -790,6 +802,20 @@ fn overview(
         .expand(4.0);
     if frame.width() * 2.0 > area.width() || frame.height() * 2.0 > area.height() {
         return; // a pane this small is all view
+    }
+    if view.overview_folded {
+        let at = Rect::from_min_size(
+            Pos2::new(area.min.x + 8.0, area.max.y - 26.0),
+            Vec2::new(46.0, 18.0),
+        );
+        if ui
+            .put(at, egui::Button::new("map").small())
+            .on_hover_text("show the overview of the whole tree")
+            .clicked()
+        {
+            view.overview_folded = false;
+        }
+        return;
     }
     let inner = frame.shrink(4.0);
     painter.rect_filled(frame, 4.0, Color32::from_rgba_unmultiplied(20, 20, 20, 230));
@@ -836,6 +862,18 @@ fn overview(
         view.fit = false;
     }
     let _ = r.on_hover_text("the whole tree: the outline is the part shown; click or drag to move");
+    // Folds the overview away, for the nodes under it.
+    let fold = Rect::from_min_size(
+        frame.right_top() + Vec2::new(-19.0, 1.0),
+        Vec2::new(18.0, 18.0),
+    );
+    if ui
+        .put(fold, egui::Button::new("×").small())
+        .on_hover_text("hide the overview (\"map\" brings it back)")
+        .clicked()
+    {
+        view.overview_folded = true;
+    }
 }
 
 // ---- the numbers --------------------------------------------------------------------------
@@ -928,6 +966,9 @@ pub fn tree_list(
     let mut fold = None;
     let mut select = None;
     let mut hover = None;
+    // The first two columns take their share of the pane, so the colours fit beside them in
+    // a narrow one (the user can drag the dividers after).
+    let width = ui.available_width();
     TableBuilder::new(ui)
         .id_salt(("tree list", salt))
         .striped(true)
@@ -935,8 +976,16 @@ pub fn tree_list(
         .vscroll(false)
         .sense(Sense::click())
         .cell_layout(egui::Layout::left_to_right(egui::Align::Center))
-        .column(Column::initial(110.0).at_least(50.0).clip(true))
-        .column(Column::initial(170.0).at_least(60.0).clip(true))
+        .column(
+            Column::initial((width * 0.3).clamp(50.0, 110.0))
+                .at_least(50.0)
+                .clip(true),
+        )
+        .column(
+            Column::initial((width * 0.38).clamp(60.0, 170.0))
+                .at_least(60.0)
+                .clip(true),
+        )
         .column(Column::remainder().at_least(60.0).clip(true))
         .header(ROW_H, |mut header| {
             for name in ["ray", "met", "colour"] {
