@@ -304,7 +304,7 @@ pub fn advance_playback(view: &mut SceneView, selection: &mut TreeSelection, ctx
 }
 
 /// Width (points) from which the scene view's filters sit in the toolbar as checkboxes; a
-/// narrower pane keeps them in its "Show" menu, so the toolbar stays two or three rows and the
+/// narrower pane keeps them in its "Show" menu, so the toolbar stays two rows and the
 /// view below keeps its height (at 1024×640 the checkboxes wrapped into five rows and left the
 /// 3D view a strip about 50 points tall once a pixel was clicked).
 pub const FILTERS_INLINE_WIDTH: f32 = 560.0;
@@ -313,7 +313,7 @@ pub const FILTERS_INLINE_WIDTH: f32 = 560.0;
 const KEY_MIN_VIEW: (f32, f32) = (360.0, 320.0);
 
 /// The toolbar: the step-through (play, depth slider, speed), "Frame", and the filters, inline
-/// in a wide pane and in the "Show" menu otherwise (two rows, three in the narrowest pane).
+/// in a wide pane and in the "Show" menu otherwise (two rows either way).
 fn toolbar(ui: &mut Ui, view: &mut SceneView, selection: &mut TreeSelection, tracer: &Arc<Tracer>) {
     let inline = ui.available_width() >= FILTERS_INLINE_WIDTH;
     if inline {
@@ -323,15 +323,16 @@ fn toolbar(ui: &mut Ui, view: &mut SceneView, selection: &mut TreeSelection, tra
         });
         ui.horizontal_wrapped(|ui| filters(ui, view, tracer));
     } else {
-        ui.horizontal(|ui| step_through(ui, view, selection));
-        ui.horizontal_wrapped(|ui| {
-            speed_and_frame(ui, view, tracer, false);
+        // "Show" leads the first row, whose slider takes what is left: two rows in all.
+        ui.horizontal(|ui| {
             MenuButton::new("Show")
                 .config(stays_open())
                 .ui(ui, |ui| filters(ui, view, tracer))
                 .0
                 .on_hover_text("ray kinds, normals, visits, BVH level and end reasons shown");
+            step_through(ui, view, selection)
         });
+        ui.horizontal_wrapped(|ui| speed_and_frame(ui, view, tracer, false));
     }
 }
 
