@@ -474,6 +474,46 @@ mod viewer {
         assert_eq!(h.get_by_label("ray tree overview").rect(), map);
     }
 
+    /// How to move about the diagram: in the status line while the pointer is over it, and
+    /// in the toolbar only on one line where its row has room (at 1024×640 in focus mode it
+    /// had wrapped into a second row of the pane).
+    #[test]
+    fn the_diagram_says_how_to_move_about_it_without_wrapping() {
+        const HINT: &str = "drag or wheel pans, Ctrl+wheel zooms, double-click folds";
+        for size in [[1024.0, 640.0], [1280.0, 800.0], [1600.0, 1000.0]] {
+            let mut h = glass_tree(size);
+            for focus in [false, true] {
+                if focus {
+                    h.get_by_role_and_label(egui::accesskit::Role::Button, "Focus")
+                        .click();
+                    for _ in 0..4 {
+                        h.step();
+                    }
+                    assert!(h.state().workspace.focused(), "{size:?}: focus is on");
+                }
+                let fit = h
+                    .get_by_role_and_label(egui::accesskit::Role::Button, "Fit")
+                    .rect();
+                if let Some(hint) = h.query_by_label(HINT) {
+                    let r = hint.rect();
+                    assert!(
+                        r.height() < fit.height() * 1.5
+                            && (r.center().y - fit.center().y).abs() < 4.0,
+                        "{size:?}, focus {focus}: the hint {r:?} is not on Fit's row {fit:?}"
+                    );
+                }
+                let [x, y] = h.state().selection.tree.as_ref().expect("a tree").pixel;
+                let pane = h
+                    .get_by_label(&format!("ray tree diagram of ({x}, {y})"))
+                    .rect();
+                h.hover_at(pane.left_bottom() + egui::vec2(pane.width() * 0.6, -4.0));
+                h.step();
+                h.step();
+                h.get_by_label(&format!("ray tree: {HINT}"));
+            }
+        }
+    }
+
     #[test]
     fn the_glass_spheres_tree_is_readable_in_its_pane_zooms_and_pans() {
         let mut h = glass_tree([1600.0, 1000.0]);

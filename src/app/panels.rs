@@ -340,6 +340,8 @@ pub fn status_bar(
                     "pixel ({x}, {y})  rgb ({:.4}, {:.4}, {:.4})  depth {}  rays {}  normal ({:.2}, {:.2}, {:.2})",
                     c.x, c.y, c.z, a.depth_reached, a.rays, a.normal.x, a.normal.y, a.normal.z
                 ));
+            } else if selection.tree_state.drawn.diagram_hovered {
+                ui.monospace(format!("ray tree: {}", tree_view::DIAGRAM_HINT));
             } else {
                 ui.monospace("move over the image for pixel values; click a pixel for its ray tree");
             }

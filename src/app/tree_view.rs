@@ -46,6 +46,8 @@ pub struct TreeState {
 pub struct Drawn {
     /// Points of the diagram's node labels (`None`: no diagram drawn).
     pub diagram_label: Option<f32>,
+    /// The pointer is over the diagram: the status line then says how to move about it.
+    pub diagram_hovered: bool,
     /// Every table cell drawn: text width unelided, width shown, the column's width, whether
     /// it was elided (the full text then shows on hover).
     pub cells: Vec<Cell>,
@@ -415,7 +417,9 @@ pub fn diagram_with(
         }
         // The hint where the row has room for it; a narrow pane keeps it in the diagram's
         // hover text rather than spend a toolbar row on it.
-        if ui.available_width() >= HINT_WIDTH {
+        // (In a wrapping row the available width is the next row's, so measure from the
+        // cursor to the row's end.)
+        if ui.max_rect().right() - ui.cursor().min.x >= HINT_WIDTH {
             ui.weak(DIAGRAM_HINT);
         }
     });
@@ -430,6 +434,7 @@ pub fn diagram_with(
             format!("ray tree diagram of ({}, {})", tree.pixel[0], tree.pixel[1]),
         )
     });
+    state.drawn.diagram_hovered |= ui.rect_contains_pointer(rect);
     // As many columns as the pane's height needs.
     let legend_rows = ((rect.height() - 12.0 - LEGEND_TOP - 6.0) / LEGEND_ROW).floor() as usize;
     let legend_box = legend_size(legend_rows);
@@ -778,7 +783,7 @@ fn keep_in_view(offset: Vec2, size: Vec2, area: Rect, min: Pos2) -> Vec2 {
 }
 
 /// How to move about the diagram, and the width the toolbar needs left to show it.
-const DIAGRAM_HINT: &str = "drag or wheel pans, Ctrl+wheel zooms, double-click folds";
+pub const DIAGRAM_HINT: &str = "drag or wheel pans, Ctrl+wheel zooms, double-click folds";
 const HINT_WIDTH: f32 = 330.0;
 
 /// Largest size of the overview in the diagram's corner.
