@@ -441,37 +441,67 @@ mod viewer {
         }
     }
 
+    /// The overview shows in the small window's pane too (within 40 % of it each way), folds
+    /// away on its × and comes back from "map".
     #[test]
     fn the_overview_folds_away_and_comes_back() {
-        let mut h = glass_tree([1600.0, 1000.0]);
-        let [x, y] = h.state().selection.tree.as_ref().expect("a tree").pixel;
-        let pane = h
-            .get_by_label(&format!("ray tree diagram of ({x}, {y})"))
-            .rect();
-        // Zoomed in until the tree overflows the pane: the overview shows where the view is.
-        for _ in 0..6 {
-            ctrl_wheel(&mut h, pane.center(), 120.0);
-            if h.query_by_label("ray tree overview").is_some() {
-                break;
+        for size in [[1024.0, 640.0], [1600.0, 1000.0]] {
+            let mut h = glass_tree(size);
+            let [x, y] = h.state().selection.tree.as_ref().expect("a tree").pixel;
+            let pane = h
+                .get_by_label(&format!("ray tree diagram of ({x}, {y})"))
+                .rect();
+            // Zoomed in until the tree overflows the pane: the overview shows where the view is.
+            for _ in 0..6 {
+                ctrl_wheel(&mut h, pane.center(), 120.0);
+                if h.query_by_label("ray tree overview").is_some() {
+                    break;
+                }
             }
+            let map = h
+                .query_by_label("ray tree overview")
+                .unwrap_or_else(|| panic!("{size:?}: no overview of the zoomed tree"))
+                .rect();
+            assert!(
+                pane.contains_rect(map)
+                    && map.width() <= pane.width() * 0.4 + 9.0
+                    && map.height() <= pane.height() * 0.4 + 9.0,
+                "{size:?}: the overview {map:?} is not a corner of the pane {pane:?}"
+            );
+            // The × inside the overview (a small window has others, on its messages).
+            h.query_all_by_label("×")
+                .find(|n| map.contains_rect(n.rect()))
+                .expect("a × inside the overview")
+                .click();
+            h.step();
+            h.step();
+            assert!(
+                h.query_by_label("ray tree overview").is_none(),
+                "{size:?}: the overview did not fold"
+            );
+            let button = h.get_by_label("map").rect();
+            assert!(
+                button.height() < map.height() * 0.5 && pane.contains_rect(button),
+                "{size:?}: the folded overview leaves a small button in the pane: {button:?} for {map:?}"
+            );
+            // A toast in the corner (the small window's "settings hidden") would take the
+            // click: dismissed first.
+            for _ in 0..4 {
+                match h.query_all_by_label("×").next() {
+                    Some(toast) => toast.click(),
+                    None => break,
+                }
+                h.step();
+                h.step();
+            }
+            h.get_by_label("map").click();
+            h.step();
+            h.step();
+            let back = h
+                .query_by_label("ray tree overview")
+                .unwrap_or_else(|| panic!("{size:?}: \"map\" did not bring the overview back"));
+            assert_eq!(back.rect(), map, "{size:?}");
         }
-        let map = h.get_by_label("ray tree overview").rect();
-        h.get_by_label("×").click();
-        h.step();
-        h.step();
-        assert!(
-            h.query_by_label("ray tree overview").is_none(),
-            "the overview did not fold"
-        );
-        let button = h.get_by_label("map").rect();
-        assert!(
-            button.height() < map.height() * 0.5 && pane.contains_rect(button),
-            "the folded overview leaves a small button in the pane: {button:?} for {map:?}"
-        );
-        h.get_by_label("map").click();
-        h.step();
-        h.step();
-        assert_eq!(h.get_by_label("ray tree overview").rect(), map);
     }
 
     /// How to move about the diagram: in the status line while the pointer is over it, and

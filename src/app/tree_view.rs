@@ -788,6 +788,8 @@ const HINT_WIDTH: f32 = 330.0;
 
 /// Largest size of the overview in the diagram's corner.
 const OVERVIEW: Vec2 = Vec2::new(170.0, 110.0);
+/// Below this room (40 % of the pane) there is no overview.
+const OVERVIEW_LEAST: Vec2 = Vec2::new(60.0, 40.0);
 
 /// The whole tree in small, in the bottom-left corner of `area`, with the part the pane shows
 /// outlined; a click or drag on it moves the view there.
@@ -801,13 +803,15 @@ fn overview(
     id: egui::Id,
 ) {
     let [w, h] = lay.size;
-    let scale = (OVERVIEW.x / w.max(1.0)).min(OVERVIEW.y / h.max(1.0));
+    // At most 40 % of the pane each way, so that a small pane still shows where it is.
+    let most = OVERVIEW.min(area.size() * 0.4);
+    if most.x < OVERVIEW_LEAST.x || most.y < OVERVIEW_LEAST.y {
+        return; // a pane this small is all view
+    }
+    let scale = (most.x / w.max(1.0)).min(most.y / h.max(1.0));
     let size = Vec2::new(w, h) * scale;
     let frame = Rect::from_min_size(Pos2::new(area.min.x + 8.0, area.max.y - size.y - 8.0), size)
         .expand(4.0);
-    if frame.width() * 2.0 > area.width() || frame.height() * 2.0 > area.height() {
-        return; // a pane this small is all view
-    }
     if view.overview_folded {
         let at = Rect::from_min_size(
             Pos2::new(area.min.x + 8.0, area.max.y - 26.0),
@@ -869,8 +873,8 @@ fn overview(
     let _ = r.on_hover_text("the whole tree: the outline is the part shown; click or drag to move");
     // Folds the overview away, for the nodes under it.
     let fold = Rect::from_min_size(
-        frame.right_top() + Vec2::new(-19.0, 1.0),
-        Vec2::new(18.0, 18.0),
+        frame.right_top() + Vec2::new(-25.0, 1.0),
+        Vec2::new(24.0, 18.0),
     );
     if ui
         .put(fold, egui::Button::new("×").small())
