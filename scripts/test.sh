@@ -15,9 +15,10 @@ cargo fmt --all -- --check
 echo "== cargo clippy"
 cargo clippy --release --all-targets --locked -- -D warnings
 # The headless core: without the `viewer` and `lab` features the library and the CLI must
-# build with no window library, so the compiler keeps egui, eframe and wgpu out of the core.
+# build with no window library, so the compiler keeps egui, eframe and wgpu out of the core;
+# the tests and benches that need them say so (`required-features` in Cargo.toml).
 echo "== cargo clippy --no-default-features (headless core and CLI)"
-cargo clippy --release --no-default-features --locked -- -D warnings
+cargo clippy --release --all-targets --no-default-features --locked -- -D warnings
 echo "== cargo test (release)"
 cargo test --release --locked
 # The peer bench's Embree harness traces the same rays as raytree and gives its image, in
