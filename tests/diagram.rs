@@ -509,7 +509,7 @@ mod viewer {
     /// had wrapped into a second row of the pane).
     #[test]
     fn the_diagram_says_how_to_move_about_it_without_wrapping() {
-        const HINT: &str = "drag or wheel pans, Ctrl+wheel zooms, double-click folds";
+        use raytree::app::tree_view::DIAGRAM_HINT as HINT;
         for size in [[1024.0, 640.0], [1280.0, 800.0], [1600.0, 1000.0]] {
             let mut h = glass_tree(size);
             for focus in [false, true] {

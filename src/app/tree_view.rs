@@ -415,10 +415,9 @@ pub fn diagram_with(
         if lay.hidden > 0 {
             ui.label(format!("{} folded or hidden", count(lay.hidden, "node")));
         }
-        // The hint where the row has room for it; a narrow pane keeps it in the diagram's
-        // hover text rather than spend a toolbar row on it.
-        // (In a wrapping row the available width is the next row's, so measure from the
-        // cursor to the row's end.)
+        // The hint where the row has room for it; otherwise it is in the zoom's hover text
+        // and the status line rather than on a toolbar row of its own. (In a wrapping row
+        // the available width is the next row's, so this measures from the cursor.)
         if ui.max_rect().right() - ui.cursor().min.x >= HINT_WIDTH {
             ui.weak(DIAGRAM_HINT);
         }
