@@ -94,6 +94,27 @@ fn the_diagram_and_the_list_are_readable_at_common_sizes() {
         for c in &cells {
             assert!(c.readable(), "{size:?}: a list cell is cut: {c:?}");
         }
+        // The table has the room: at least four of its rows above the selected node's
+        // detail (which starts with the root's summary, "primary d0 · …").
+        let detail = h
+            .query_all_by_label_contains("primary d0 · ")
+            .map(|n| n.rect())
+            .find(|r| r.is_finite())
+            .expect("the root's detail is shown");
+        let rows = h
+            .query_all_by(|n| {
+                let label = n.value().unwrap_or_default();
+                let mut words = label.split(' ');
+                matches!(words.next(), Some("primary" | "R" | "T"))
+                    && words.next().is_some_and(|d| d.starts_with('d'))
+                    && words.next().is_none()
+            })
+            .filter(|n| n.rect().max.y <= detail.min.y + 0.5)
+            .count();
+        assert!(
+            rows >= 4,
+            "{size:?}: {rows} rows of the tree list above its detail at {detail:?}"
+        );
     }
 }
 

@@ -738,8 +738,14 @@ fn toasts_do_not_move_the_layout() {
         h.state().messages.toasts_shown(),
         (shown + 4).min(MAX_TOASTS)
     );
-    assert!(h.query_by_label_contains("message 3").is_some());
+    let newest = h.get_by_label_contains("message 3").rect();
     assert!(h.query_by_label_contains("message 0").is_none());
+    // In the render pane's corner, over the image: not over the scene view or the status bar.
+    let pane = h.get_by_label("render viewport").rect().expand(12.0);
+    assert!(
+        pane.contains_rect(newest) && newest.center().x > pane.center().x,
+        "the toast {newest:?} is not in the render pane's bottom-right corner {pane:?}"
+    );
     assert_eq!(h.state().messages.len(), logged + 4);
     assert_eq!(h.get_by_label("render viewport").rect(), before);
     assert_eq!(h.get_by_label("Scene").rect(), menu);

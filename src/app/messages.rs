@@ -1,5 +1,5 @@
 //! The viewer's messages: a log of errors and notices, newest last; each new one shows once as
-//! a toast in the bottom-right corner (never moving the layout, never more than
+//! a toast in the bottom-right corner of the render pane (never moving the layout, never more than
 //! [`MAX_TOASTS`] at once, each at most [`TOAST_LINES`] lines), and the whole log, with each
 //! message's details, is in the Messages window (View › Messages).
 //!
@@ -86,6 +86,10 @@ pub struct Messages {
     toasted: usize,
     /// The Messages window is open.
     pub window: bool,
+    /// Where this frame's toasts go: the render pane, set by it each frame (so they cover the
+    /// image for a few seconds rather than the tree's panes or the status bar). `None`, or a
+    /// pane narrower than a toast: the window's bottom-right corner.
+    pub corner: Option<egui::Rect>,
 }
 
 impl Messages {
@@ -121,6 +125,7 @@ impl Messages {
     /// Messages not yet shown become toasts; expired toasts go. Asks for a frame when the next
     /// toast expires, and for none otherwise.
     pub fn show(&mut self, ctx: &egui::Context) {
+        let corner = self.corner.take();
         let now = Instant::now();
         for index in self.toasted..self.log.len() {
             let secs = match self.log[index].level {
@@ -142,51 +147,54 @@ impl Messages {
         let mut dismissed = None;
         let mut hovered = false;
         let mut open_log = false;
-        egui::Area::new(egui::Id::unique("raytree toasts"))
+        let area = egui::Area::new(egui::Id::unique("raytree toasts"))
             .order(egui::Order::Foreground)
-            .anchor(egui::Align2::RIGHT_BOTTOM, egui::vec2(-12.0, -56.0))
-            .interactable(true)
-            .show(ctx, |ui| {
-                ui.set_max_width(TOAST_WIDTH + 40.0);
-                for (k, toast) in self.toasts.iter().enumerate().rev() {
-                    let message = &self.log[toast.index];
-                    let frame = egui::Frame::popup(ui.style()).show(ui, |ui| {
-                        ui.set_width(TOAST_WIDTH + 24.0);
-                        ui.horizontal_top(|ui| {
-                            let (mark, colour) = match message.level {
-                                Level::Error => ("!", egui::Color32::from_rgb(235, 100, 100)),
-                                Level::Notice => ("i", egui::Color32::from_rgb(150, 200, 210)),
-                            };
-                            ui.label(egui::RichText::new(mark).strong().color(colour));
-                            ui.vertical(|ui| {
-                                ui.set_max_width(TOAST_WIDTH);
-                                let mut job = egui::text::LayoutJob::simple(
-                                    message.text.clone(),
-                                    egui::TextStyle::Body.resolve(ui.style()),
-                                    ui.visuals().text_color(),
-                                    TOAST_WIDTH,
-                                );
-                                job.wrap.max_rows = TOAST_LINES;
-                                ui.label(job);
-                                if !message.details.is_empty() {
-                                    let n = message.details.len();
-                                    let more = format!(
-                                        "{}: View › Messages",
-                                        crate::plural::count(n, "note")
-                                    );
-                                    if ui.small_button(more).clicked() {
-                                        open_log = true;
-                                    }
+            .interactable(true);
+        let area = match corner {
+            Some(pane) if pane.width() >= TOAST_WIDTH + 64.0 => area
+                .pivot(egui::Align2::RIGHT_BOTTOM)
+                .fixed_pos(pane.right_bottom() - egui::vec2(10.0, 10.0)),
+            _ => area.anchor(egui::Align2::RIGHT_BOTTOM, egui::vec2(-12.0, -56.0)),
+        };
+        area.show(ctx, |ui| {
+            ui.set_max_width(TOAST_WIDTH + 40.0);
+            for (k, toast) in self.toasts.iter().enumerate().rev() {
+                let message = &self.log[toast.index];
+                let frame = egui::Frame::popup(ui.style()).show(ui, |ui| {
+                    ui.set_width(TOAST_WIDTH + 24.0);
+                    ui.horizontal_top(|ui| {
+                        let (mark, colour) = match message.level {
+                            Level::Error => ("!", egui::Color32::from_rgb(235, 100, 100)),
+                            Level::Notice => ("i", egui::Color32::from_rgb(150, 200, 210)),
+                        };
+                        ui.label(egui::RichText::new(mark).strong().color(colour));
+                        ui.vertical(|ui| {
+                            ui.set_max_width(TOAST_WIDTH);
+                            let mut job = egui::text::LayoutJob::simple(
+                                message.text.clone(),
+                                egui::TextStyle::Body.resolve(ui.style()),
+                                ui.visuals().text_color(),
+                                TOAST_WIDTH,
+                            );
+                            job.wrap.max_rows = TOAST_LINES;
+                            ui.label(job);
+                            if !message.details.is_empty() {
+                                let n = message.details.len();
+                                let more =
+                                    format!("{}: View › Messages", crate::plural::count(n, "note"));
+                                if ui.small_button(more).clicked() {
+                                    open_log = true;
                                 }
-                            });
-                            if ui.small_button("×").on_hover_text("dismiss").clicked() {
-                                dismissed = Some(k);
                             }
                         });
+                        if ui.small_button("×").on_hover_text("dismiss").clicked() {
+                            dismissed = Some(k);
+                        }
                     });
-                    hovered |= frame.response.contains_pointer();
-                }
-            });
+                });
+                hovered |= frame.response.contains_pointer();
+            }
+        });
         if let Some(k) = dismissed {
             self.toasts.remove(k);
         }

@@ -703,24 +703,42 @@ pub fn tree_panel(ui: &mut Ui, selection: &mut TreeSelection, ws: &mut Workspace
     let Some(tree) = selection.tree.clone() else {
         return;
     };
+    // The title, the pixel's colour (a swatch, its numbers on hover and in the root's row) and
+    // the count on one row, the buttons on the next: the table below gets the room.
     ui.horizontal(|ui| {
-        ui.heading(format!(
-            "Ray tree of ({}, {})",
-            tree.pixel[0], tree.pixel[1]
+        ui.label(
+            RichText::new(format!(
+                "Ray tree of ({}, {})",
+                tree.pixel[0], tree.pixel[1]
+            ))
+            .strong()
+            .size(15.0),
+        );
+        let numbers = format!(
+            "colour ({:.4}, {:.4}, {:.4})",
+            tree.color.x, tree.color.y, tree.color.z,
+        );
+        let side = ui.text_style_height(&egui::TextStyle::Body);
+        let (swatch, response) =
+            ui.allocate_exact_size(egui::vec2(side, side), egui::Sense::hover());
+        let c = tree.color.clamp(Vec3::ZERO, Vec3::ONE);
+        ui.painter()
+            .rect_filled(swatch, 2.0, egui::Rgba::from_rgb(c.x, c.y, c.z));
+        response.on_hover_text(numbers);
+        ui.weak(format!(
+            "{}{}",
+            count(tree.nodes, "node"),
+            if tree.truncated { " (truncated)" } else { "" }
         ));
-        if ui.small_button("x").clicked() {
+        if ui
+            .small_button("x")
+            .on_hover_text("close this tree")
+            .clicked()
+        {
             selection.tree = None;
         }
     });
-    ui.label(format!(
-        "colour ({:.4}, {:.4}, {:.4}) · {}{}",
-        tree.color.x,
-        tree.color.y,
-        tree.color.z,
-        count(tree.nodes, "node"),
-        if tree.truncated { " (truncated)" } else { "" }
-    ));
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         if selection.tree_state.pinned.is_some() {
             if ui.button("Unpin").clicked() {
                 selection.tree_state.pinned = None;
@@ -739,29 +757,65 @@ pub fn tree_panel(ui: &mut Ui, selection: &mut TreeSelection, ws: &mut Workspace
     });
     ui.separator();
     let state = &mut selection.tree_state;
-    egui::ScrollArea::both()
-        .id_salt("tree list")
-        .max_height(ui.available_height() * 0.5)
-        .show(ui, |ui| match state.pinned.clone() {
-            Some(pinned) => {
-                tree_view::say_changes(ui, state, &crate::diagram::changes(&pinned, &tree));
-                ui.label("changed nodes are marked *");
-                ui.columns(2, |cols| {
-                    cols[0].label(format!(
-                        "pinned: ({}, {}), max depth {}",
-                        pinned.pixel[0], pinned.pixel[1], pinned.settings.max_depth
-                    ));
-                    tree_view::tree_list(&mut cols[0], &pinned, state, Some(&tree), "pinned");
-                    cols[1].label(format!("current: max depth {}", tree.settings.max_depth));
-                    tree_view::tree_list(&mut cols[1], &tree, state, Some(&pinned), "current");
-                });
-            }
-            None => tree_view::tree_list(ui, &tree, state, None, "current"),
-        });
-    ui.separator();
     let selected = state.selected.clone().unwrap_or_default();
-    // What the accelerator did for the selected ray (replayed: one query, cheap).
-    if let Some((_, visits)) = crate::scene_view::visit_segments(tracer, &tree, &selected) {
+    // The selected node's numbers below, the table above: the table keeps at least
+    // TABLE_LEAST of the pane and the detail starts at DETAIL_SHARE of it; the divider
+    // between them drags (and is remembered).
+    let room = ui.available_height();
+    let detail_most = (room - TABLE_LEAST).max(DETAIL_LEAST);
+    egui::Panel::bottom("tree detail pane")
+        .resizable(true)
+        .frame(egui::Frame::NONE.inner_margin(egui::Margin {
+            top: 4,
+            ..Default::default()
+        }))
+        .default_size((room * DETAIL_SHARE).clamp(DETAIL_LEAST, detail_most))
+        .size_range(DETAIL_LEAST..=detail_most)
+        .show(ui, |ui| {
+            // A scroll area of any height: its default least height would push the panel
+            // past the pane's bottom.
+            egui::ScrollArea::both()
+                .id_salt("tree detail")
+                .auto_shrink(false)
+                .min_scrolled_height(0.0)
+                .show(ui, |ui| {
+                    tree_view::detail(ui, &tree, &selected);
+                    accelerator_line(ui, tracer, &tree, &selected);
+                });
+        });
+    let rest = egui::CentralPanel::default().frame(egui::Frame::NONE);
+    rest.show(ui, |ui| {
+        egui::ScrollArea::both()
+            .id_salt("tree list")
+            .auto_shrink(false)
+            .min_scrolled_height(0.0)
+            .show(ui, |ui| match state.pinned.clone() {
+                Some(pinned) => {
+                    tree_view::say_changes(ui, state, &crate::diagram::changes(&pinned, &tree));
+                    ui.label("changed nodes are marked *");
+                    ui.columns(2, |cols| {
+                        cols[0].label(format!(
+                            "pinned: ({}, {}), max depth {}",
+                            pinned.pixel[0], pinned.pixel[1], pinned.settings.max_depth
+                        ));
+                        tree_view::tree_list(&mut cols[0], &pinned, state, Some(&tree), "pinned");
+                        cols[1].label(format!("current: max depth {}", tree.settings.max_depth));
+                        tree_view::tree_list(&mut cols[1], &tree, state, Some(&pinned), "current");
+                    });
+                }
+                None => tree_view::tree_list(ui, &tree, state, None, "current"),
+            });
+    });
+}
+
+/// What the accelerator did for the selected ray (replayed: one query, cheap).
+fn accelerator_line(
+    ui: &mut Ui,
+    tracer: &Tracer,
+    tree: &crate::ray_tree::RayTree,
+    selected: &[usize],
+) {
+    if let Some((_, visits)) = crate::scene_view::visit_segments(tracer, tree, selected) {
         let mut prims = visits.prims.clone();
         prims.sort_unstable();
         prims.dedup();
@@ -774,12 +828,14 @@ pub fn tree_panel(ui: &mut Ui, selection: &mut TreeSelection, ws: &mut Workspace
         ))
         .on_hover_text("drawn as cyan boxes in the scene view (\"visits\")");
     }
-    egui::ScrollArea::both()
-        .id_salt("tree detail")
-        .show(ui, |ui| {
-            tree_view::detail(ui, &tree, &selected);
-        });
 }
+
+/// The least height of the tree list's table (its header and about four rows), in points.
+const TABLE_LEAST: f32 = 110.0;
+/// The least height of the selected node's detail below it (the accelerator's line and a row).
+const DETAIL_LEAST: f32 = 48.0;
+/// The detail's first share of the pane's height below the header.
+const DETAIL_SHARE: f32 = 0.38;
 
 /// What each choice of the Export window gives, for its descriptions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

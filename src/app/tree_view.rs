@@ -166,6 +166,9 @@ struct DiagramView {
     legend_fits: bool,
     /// Whether the user folded the overview away (it can cover nodes in its corner).
     overview_folded: bool,
+    /// The overview sits in the bottom-right corner (else the bottom-left): whichever covers
+    /// less of the nodes shown ([`overview_corner`]).
+    overview_right: bool,
 }
 
 /// Whether the diagram's legend is shown: as the user set it with its toggle, or, before that,
@@ -197,6 +200,7 @@ impl Default for DiagramView {
             legend: Legend::WhenItFits,
             legend_fits: true,
             overview_folded: false,
+            overview_right: false,
         }
     }
 }
@@ -787,11 +791,42 @@ const HINT_WIDTH: f32 = 330.0;
 
 /// Largest size of the overview in the diagram's corner.
 const OVERVIEW: Vec2 = Vec2::new(170.0, 110.0);
-/// Below this room (40 % of the pane) there is no overview.
+/// The overview's largest share of the pane, each way.
+const OVERVIEW_SHARE: f32 = 0.34;
+/// Below this room (its share of the pane) there is no overview.
 const OVERVIEW_LEAST: Vec2 = Vec2::new(60.0, 40.0);
 
-/// The whole tree in small, in the bottom-left corner of `area`, with the part the pane shows
-/// outlined; a click or drag on it moves the view there.
+/// Whether the overview, of `size` (its frame), goes in the bottom-right corner of `area`
+/// rather than the bottom-left: the corner whose rectangle covers less of the nodes as drawn
+/// (`nodes`, screen rectangles). It moves only when the other corner covers less than half as
+/// much, so that panning does not make it jump back and forth.
+fn overview_corner(area: Rect, size: Vec2, nodes: &[Rect], right_now: bool) -> bool {
+    let corner = |right: bool| {
+        let x = if right {
+            area.max.x - size.x - 4.0
+        } else {
+            area.min.x + 4.0
+        };
+        Rect::from_min_size(Pos2::new(x, area.max.y - size.y - 4.0), size)
+    };
+    let covered = |r: Rect| -> f32 {
+        nodes
+            .iter()
+            .map(|n| n.intersect(r))
+            .filter(|i| i.is_positive())
+            .map(|i| i.area())
+            .sum()
+    };
+    let (now, other) = (covered(corner(right_now)), covered(corner(!right_now)));
+    if other < 0.5 * now {
+        !right_now
+    } else {
+        right_now
+    }
+}
+
+/// The whole tree in small, in a bottom corner of `area` (the one over fewer nodes), with the
+/// part the pane shows outlined; a click or drag on it moves the view there.
 fn overview(
     ui: &mut Ui,
     painter: &egui::Painter,
@@ -802,20 +837,40 @@ fn overview(
     id: egui::Id,
 ) {
     let [w, h] = lay.size;
-    // At most 40 % of the pane each way, so that a small pane still shows where it is.
-    let most = OVERVIEW.min(area.size() * 0.4);
+    // At most a third of the pane each way, so that a small pane still shows where it is.
+    let most = OVERVIEW.min(area.size() * OVERVIEW_SHARE);
     if most.x < OVERVIEW_LEAST.x || most.y < OVERVIEW_LEAST.y {
         return; // a pane this small is all view
     }
     let scale = (most.x / w.max(1.0)).min(most.y / h.max(1.0));
     let size = Vec2::new(w, h) * scale;
-    let frame = Rect::from_min_size(Pos2::new(area.min.x + 8.0, area.max.y - size.y - 8.0), size)
-        .expand(4.0);
+    // The corner is kept while the overview itself is dragged.
+    if ui.ctx().dragged_id() != Some(id.with("overview")) {
+        let at = |[x, y]: [f32; 2]| min + view.offset + Vec2::new(x, y) * view.zoom;
+        let nodes: Vec<Rect> = lay
+            .nodes
+            .iter()
+            .map(|n| {
+                let [x0, y0, x1, y1] = n.rect();
+                Rect::from_min_max(at([x0, y0]), at([x1, y1]))
+            })
+            .collect();
+        view.overview_right =
+            overview_corner(area, size + Vec2::splat(8.0), &nodes, view.overview_right);
+    }
+    let left = if view.overview_right {
+        area.max.x - size.x - 8.0
+    } else {
+        area.min.x + 8.0
+    };
+    let frame = Rect::from_min_size(Pos2::new(left, area.max.y - size.y - 8.0), size).expand(4.0);
     if view.overview_folded {
-        let at = Rect::from_min_size(
-            Pos2::new(area.min.x + 8.0, area.max.y - 26.0),
-            Vec2::new(46.0, 18.0),
-        );
+        let x = if view.overview_right {
+            area.max.x - 54.0
+        } else {
+            area.min.x + 8.0
+        };
+        let at = Rect::from_min_size(Pos2::new(x, area.max.y - 26.0), Vec2::new(46.0, 18.0));
         if ui
             .put(at, egui::Button::new("map").small())
             .on_hover_text("show the overview of the whole tree")
@@ -1268,4 +1323,29 @@ fn detail_table(ui: &mut Ui, tree: &RayTree, path: &[usize]) {
                 });
             }
         });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_overview_takes_the_bottom_corner_over_fewer_nodes_and_keeps_it_on_a_near_tie() {
+        let area = Rect::from_min_size(Pos2::ZERO, Vec2::new(400.0, 300.0));
+        let size = Vec2::new(120.0, 80.0);
+        let node = |x: f32, y: f32| Rect::from_min_size(Pos2::new(x, y), Vec2::new(80.0, 30.0));
+        // A tree leaning left: the right corner.
+        let left_leaning = [node(150.0, 10.0), node(40.0, 150.0), node(10.0, 250.0)];
+        assert!(overview_corner(area, size, &left_leaning, false));
+        assert!(overview_corner(area, size, &left_leaning, true));
+        // Leaning right: the left corner.
+        let right_leaning = [node(150.0, 10.0), node(280.0, 150.0), node(310.0, 250.0)];
+        assert!(!overview_corner(area, size, &right_leaning, true));
+        // Nodes under both corners, about as much: it stays where it is.
+        let both = [node(10.0, 250.0), node(300.0, 255.0)];
+        assert!(overview_corner(area, size, &both, true));
+        assert!(!overview_corner(area, size, &both, false));
+        // No nodes under either: it stays too.
+        assert!(!overview_corner(area, size, &[node(150.0, 10.0)], false));
+    }
 }

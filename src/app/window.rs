@@ -313,16 +313,19 @@ fn tree_window(app: &mut ViewerApp, ctx: &egui::Context) {
 fn pane_ui(app: &mut ViewerApp, ui: &mut egui::Ui, pane: workspace::Pane) {
     use workspace::Pane;
     match pane {
-        Pane::Render => input::render_pane(
-            ui,
-            &mut app.render,
-            &mut app.selection,
-            &mut app.working.scene.camera,
-            &app.workspace.prefs,
-            &app.scene_view.filter,
-            app.workspace.focused(),
-            &mut app.pending,
-        ),
+        Pane::Render => {
+            app.messages.corner = Some(ui.max_rect());
+            input::render_pane(
+                ui,
+                &mut app.render,
+                &mut app.selection,
+                &mut app.working.scene.camera,
+                &app.workspace.prefs,
+                &app.scene_view.filter,
+                app.workspace.focused(),
+                &mut app.pending,
+            )
+        }
         Pane::SceneView => scene_pane::scene_view_ui(
             ui,
             &mut app.scene_view,

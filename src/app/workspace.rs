@@ -103,11 +103,15 @@ enum TreePanes {
 #[derive(Default)]
 pub struct Workspace {
     pub prefs: Prefs,
-    /// Whether the settings panel's visibility is settled: on the first frame by the window's
-    /// width (a panel the saved preferences show is hidden below [`SETTINGS_MIN_WIDTH`], so a
-    /// choice made in a wide window does not crowd a small one; a hidden one stays hidden), or
-    /// by an explicit choice before it.
+    /// Whether the settings panel's visibility is settled: by the window's width on the first
+    /// frame ([`Workspace::settle_settings_panel`]), or by an explicit choice before it.
     settings_settled: bool,
+    /// Whether the window was narrower than [`SETTINGS_MIN_WIDTH`] on the last frame (`None`:
+    /// no frame yet).
+    was_narrow: Option<bool>,
+    /// The settings panel was hidden because the window became narrow, not by the user: it
+    /// comes back when the window is wide again, and is saved as shown.
+    settings_auto_hidden: bool,
     /// How the tree's panes were last set (`None`: not yet, or the layout was reset).
     tree_panes: Option<TreePanes>,
     /// The workspace's width when the tree's column was last given its room
@@ -197,11 +201,13 @@ impl Workspace {
     pub fn set_settings_panel(&mut self, shown: bool) {
         self.prefs.settings_panel = shown;
         self.settings_settled = true;
+        self.settings_auto_hidden = false;
     }
 
     /// Shows the settings panel, or hides it (saying how it comes back).
     pub fn toggle_settings_panel(&mut self, messages: &mut Messages) {
         self.prefs.settings_panel = !self.prefs.settings_panel;
+        self.settings_auto_hidden = false;
         if !self.prefs.settings_panel {
             messages.notice("settings hidden: Ctrl+B or View > Settings panel shows them");
         }
@@ -248,18 +254,38 @@ impl Workspace {
         if let Some(saved) = &self.focus {
             prefs.layout = saved.layout.clone();
             prefs.settings_panel = saved.settings_panel;
+        } else if self.settings_auto_hidden {
+            prefs.settings_panel = true;
         }
         prefs
     }
 
-    /// On the first frame of a first run, a window narrower than [`SETTINGS_MIN_WIDTH`]
-    /// (points) hides the settings panel.
+    /// Fits the settings panel to the window's width, each frame. When the window is (or
+    /// becomes) narrower than [`SETTINGS_MIN_WIDTH`] points, a shown panel is hidden, saying
+    /// how it comes back; when it is wide again, a panel hidden that way comes back. A choice
+    /// the user makes (Ctrl+B, the « hide and » buttons, the View menu) stands until the
+    /// window's width next crosses the threshold. Focus mode keeps its own arrangement.
     pub fn settle_settings_panel(&mut self, window_width: f32, messages: &mut Messages) {
-        if !self.settings_settled {
-            self.settings_settled = true;
-            if window_width < SETTINGS_MIN_WIDTH && self.prefs.settings_panel {
-                self.toggle_settings_panel(messages);
-            }
+        let narrow = window_width < SETTINGS_MIN_WIDTH;
+        // The first frame counts as a crossing unless a choice was made before it.
+        let crossed = match self.was_narrow {
+            None => !self.settings_settled,
+            Some(was) => was != narrow,
+        };
+        self.was_narrow = Some(narrow);
+        self.settings_settled = true;
+        if !crossed || self.focused() {
+            return;
+        }
+        if narrow && self.prefs.settings_panel {
+            self.prefs.settings_panel = false;
+            self.settings_auto_hidden = true;
+            messages.notice(
+                "settings hidden in this narrow window: Ctrl+B or View > Settings panel shows them",
+            );
+        } else if !narrow && self.settings_auto_hidden {
+            self.prefs.settings_panel = true;
+            self.settings_auto_hidden = false;
         }
     }
 }
@@ -633,6 +659,47 @@ mod tests {
         let mut ws = Workspace::new(prefs);
         ws.settle_settings_panel(1600.0, &mut messages);
         assert!(!ws.prefs.settings_panel);
+    }
+
+    #[test]
+    fn the_settings_panel_follows_the_window_across_the_width_and_a_choice_stands_between() {
+        let mut messages = Messages::default();
+        let mut ws = Workspace::new(Prefs::default());
+        ws.settle_settings_panel(1600.0, &mut messages);
+        assert!(ws.prefs.settings_panel && messages.is_empty());
+        // Made narrow: hidden, once, saying how it comes back; saved as shown.
+        ws.settle_settings_panel(1024.0, &mut messages);
+        ws.settle_settings_panel(1000.0, &mut messages);
+        assert!(!ws.prefs.settings_panel);
+        assert_eq!(messages.len(), 1);
+        assert!(messages.log()[0].mentions("Ctrl+B"));
+        assert!(
+            ws.prefs_to_save().settings_panel,
+            "saved as the user left it"
+        );
+        // Wide again: back.
+        ws.settle_settings_panel(1400.0, &mut messages);
+        assert!(ws.prefs.settings_panel);
+        // Shown by the user in a narrow window: it stays while the window stays narrow.
+        ws.settle_settings_panel(1024.0, &mut messages);
+        assert!(!ws.prefs.settings_panel);
+        ws.toggle_settings_panel(&mut messages);
+        ws.settle_settings_panel(1100.0, &mut messages);
+        assert!(ws.prefs.settings_panel, "the user's choice stands");
+        // Hidden by the user in a wide window: widening does not bring it back.
+        ws.settle_settings_panel(1400.0, &mut messages);
+        ws.toggle_settings_panel(&mut messages);
+        ws.settle_settings_panel(1200.0, &mut messages);
+        ws.settle_settings_panel(1500.0, &mut messages);
+        assert!(!ws.prefs.settings_panel, "hidden by choice stays hidden");
+        assert!(!ws.prefs_to_save().settings_panel);
+        // Focus mode keeps its own arrangement through a resize.
+        let mut ws = Workspace::new(Prefs::default());
+        ws.settle_settings_panel(1600.0, &mut messages);
+        ws.toggle_focus();
+        ws.settle_settings_panel(1024.0, &mut messages);
+        ws.toggle_focus();
+        assert!(ws.prefs.settings_panel, "focus gave back what it took");
     }
 
     #[test]
