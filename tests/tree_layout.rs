@@ -118,6 +118,38 @@ fn the_diagram_and_the_list_are_readable_at_common_sizes() {
     }
 }
 
+/// Columns sized in a wide pane start again from their shares when the pane narrows, so the
+/// colour column stays in view.
+#[test]
+fn the_list_columns_follow_a_narrowed_pane() {
+    let mut h = window(small("default"), [1600.0, 1000.0]);
+    follow_pane(&mut h);
+    click_glass(&mut h);
+    show_tab(&mut h, "Tree list");
+    // Where the colour column starts, as a share of the pane (the list is the rightmost pane;
+    // its "ray" header starts at the pane's left edge).
+    let share = |h: &Window| {
+        let header = |name: &str| {
+            h.query_all_by_value(name)
+                .map(|n| n.rect())
+                .find(|r| r.is_finite())
+                .unwrap_or_else(|| panic!("the list's {name} header"))
+        };
+        let (ray, colour) = (header("ray"), header("colour"));
+        (colour.min.x - ray.min.x) / (h.ctx.content_rect().max.x - ray.min.x)
+    };
+    let wide = share(&h);
+    h.set_size(egui::vec2(1024.0, 640.0));
+    h.run_steps(4);
+    let narrow = share(&h);
+    assert!(
+        narrow <= 0.76,
+        "the colour column starts {:.0} % into the narrowed pane ({:.0} % in the wide one)",
+        narrow * 100.0,
+        wide * 100.0
+    );
+}
+
 fn layout_json(h: &Window) -> String {
     serde_json::to_string(&h.state().workspace.prefs.layout).expect("the layout serialises")
 }

@@ -1032,8 +1032,17 @@ pub fn tree_list(
     // The first two columns take their share of the pane, so the colours fit beside them in
     // a narrow one (the user can drag the dividers after).
     let width = ui.available_width();
-    TableBuilder::new(ui)
-        .id_salt(("tree list", salt))
+    // When the pane's width changes by more than a tenth (a resized window, a moved
+    // splitter), the columns start again from their shares of it: widths kept from a wider
+    // pane would push the colours out of a narrow one.
+    let width_id = ui.scope_id().with(("tree list width", salt));
+    let before: Option<f32> = ui.data(|d| d.get_temp(width_id));
+    ui.data_mut(|d| d.insert_temp(width_id, width));
+    let table = TableBuilder::new(ui).id_salt(("tree list", salt));
+    if before.is_some_and(|b| (width - b).abs() > 0.1 * b) {
+        table.reset();
+    }
+    table
         .striped(true)
         .resizable(true)
         .vscroll(false)
