@@ -578,8 +578,23 @@ fn opening_another_scene_clears_the_pinned_and_extra_trees() {
     h.get_by_role_and_label(Role::Button, "Pin for comparison")
         .click();
     h.step();
+    h.step();
     assert!(h.state().selection.tree_state.pinned.is_some());
     assert_eq!(h.state().selection.trees().count(), 2);
+    // The list pane is too narrow for the two tables side by side: one above the other, each
+    // as wide as the pane.
+    let mut headers: Vec<egui::Rect> = h
+        .query_all_by_value("ray")
+        .map(|n| n.rect())
+        .filter(|r| r.is_finite())
+        .collect();
+    headers.dedup();
+    assert!(
+        headers.len() == 2
+            && (headers[0].min.x - headers[1].min.x).abs() < 1.0
+            && (headers[0].min.y - headers[1].min.y).abs() > 20.0,
+        "the pinned and current tables' headers: {headers:?}"
+    );
     h.state_mut()
         .command(raytree::app::Command::OpenBuiltin("quiz".into()));
     h.step();

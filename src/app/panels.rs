@@ -791,17 +791,48 @@ pub fn tree_panel(ui: &mut Ui, selection: &mut TreeSelection, ws: &mut Workspace
             .min_scrolled_height(0.0)
             .show(ui, |ui| match state.pinned.clone() {
                 Some(pinned) => {
-                    tree_view::say_changes(ui, state, &crate::diagram::changes(&pinned, &tree));
-                    ui.label("changed nodes are marked *");
-                    ui.columns(2, |cols| {
-                        cols[0].label(format!(
+                    let changes = crate::diagram::changes(&pinned, &tree);
+                    tree_view::say_changes(ui, state, &changes);
+                    if !changes.is_empty() {
+                        ui.weak("changed nodes are marked *");
+                    }
+                    let titles = [
+                        format!(
                             "pinned: ({}, {}), max depth {}",
                             pinned.pixel[0], pinned.pixel[1], pinned.settings.max_depth
-                        ));
-                        tree_view::tree_list(&mut cols[0], &pinned, state, Some(&tree), "pinned");
-                        cols[1].label(format!("current: max depth {}", tree.settings.max_depth));
-                        tree_view::tree_list(&mut cols[1], &tree, state, Some(&pinned), "current");
-                    });
+                        ),
+                        format!("current: max depth {}", tree.settings.max_depth),
+                    ];
+                    let title = |ui: &mut Ui, text: &str| {
+                        ui.add(egui::Label::new(RichText::new(text).strong()).truncate());
+                    };
+                    if ui.available_width() >= SIDE_BY_SIDE {
+                        ui.columns(2, |cols| {
+                            title(&mut cols[0], &titles[0]);
+                            tree_view::tree_list(
+                                &mut cols[0],
+                                &pinned,
+                                state,
+                                Some(&tree),
+                                "pinned",
+                            );
+                            title(&mut cols[1], &titles[1]);
+                            tree_view::tree_list(
+                                &mut cols[1],
+                                &tree,
+                                state,
+                                Some(&pinned),
+                                "current",
+                            );
+                        });
+                    } else {
+                        // A narrow pane: one above the other, each with the pane's width.
+                        title(ui, &titles[0]);
+                        tree_view::tree_list(ui, &pinned, state, Some(&tree), "pinned");
+                        ui.add_space(4.0);
+                        title(ui, &titles[1]);
+                        tree_view::tree_list(ui, &tree, state, Some(&pinned), "current");
+                    }
                 }
                 None => tree_view::tree_list(ui, &tree, state, None, "current"),
             });
@@ -829,6 +860,10 @@ fn accelerator_line(
         .on_hover_text("drawn as cyan boxes in the scene view (\"visits\")");
     }
 }
+
+/// The least width of the tree list's pane that shows the pinned and current trees side by
+/// side (each table's three columns need about half of it); a narrower one stacks them.
+const SIDE_BY_SIDE: f32 = 560.0;
 
 /// The least height of the tree list's table (its header and about four rows), in points.
 const TABLE_LEAST: f32 = 110.0;
