@@ -697,8 +697,9 @@ fn material_editor(ui: &mut Ui, m: &mut Material) -> bool {
 
 // ---- the ray tree -------------------------------------------------------------------------
 
-/// The clicked pixel's tree: the list (or the pinned and current trees side by side, changed
-/// nodes marked), and the numbers of the selected node.
+/// The clicked pixel's tree: the list (or the pinned and current trees, side by side or in a
+/// narrow pane one above the other, changed nodes marked), and below it the numbers of the
+/// selected node.
 pub fn tree_panel(ui: &mut Ui, selection: &mut TreeSelection, ws: &mut Workspace, tracer: &Tracer) {
     let Some(tree) = selection.tree.clone() else {
         return;
