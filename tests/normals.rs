@@ -103,6 +103,82 @@ fn flat_ignores_vn_and_smooth_splits_at_the_crease_angle() {
     assert!(plain.attributes.is_empty());
 }
 
+/// A shallow roof of four triangles around (0, 0, h), no `vn`: neighbouring faces' normals are
+/// far less than the default crease angle apart. `group` is the `s` statement before the faces.
+fn roof(group: &str) -> String {
+    format!(
+        "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nv 0 0 0.3\n{group}\n\
+         f 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\n"
+    )
+}
+
+/// The shading normal at the apex (vertex 5 is the third corner of the first triangle).
+fn apex_normal(scene: &Scene) -> Option<Vec3> {
+    let a = scene.attributes.first()?;
+    Some(a.normals_of(0)?[2])
+}
+
+#[test]
+fn smoothing_groups_without_vn_shade_smooth_and_say_so() {
+    let load_roof = |group: &str, normals: &str| {
+        let obj = roof(group);
+        let files = move |path: &str| match path {
+            "r.obj" => Ok(obj.clone()),
+            _ => Err(format!("{path}: no such test file")),
+        };
+        load_scene_str_with(
+            &format!("{CAMERA}[[mesh]]\nfile = \"r.obj\"\n{normals}"),
+            "t.toml",
+            &files,
+        )
+        .unwrap_or_else(|e| panic!("{e}"))
+    };
+    // `s 1` (and a named group): the apex's normal is the average of the four faces, +z.
+    for group in ["s 1", "s 7", "s roof"] {
+        let scene = load_roof(group, "");
+        let n = apex_normal(&scene).unwrap_or_else(|| panic!("{group}: no normals kept"));
+        assert!((n - Vec3::Z).length() < 1e-5, "{group}: apex normal {n}");
+        assert_eq!(scene.warnings.len(), 1, "{group}: {:?}", scene.warnings);
+        let w = &scene.warnings[0];
+        assert!(
+            w.starts_with("r.obj: no vertex normals") && w.contains("normals = \"flat\""),
+            "{w}"
+        );
+    }
+    // No group, `s off`, `s 0`, or `normals = "flat"`: flat, nothing kept, nothing said.
+    for (group, normals) in [
+        ("", ""),
+        ("s off", ""),
+        ("s 0", ""),
+        ("s 1", "normals = \"flat\"\n"),
+    ] {
+        let scene = load_roof(group, normals);
+        assert!(
+            scene.attributes.is_empty() && scene.warnings.is_empty(),
+            "{group:?} {normals:?}: {:?}",
+            scene.warnings
+        );
+    }
+    // A file with its own `vn` keeps them whatever its groups.
+    let with_vn = format!("{}s 1\n", TRI);
+    let files = move |path: &str| match path {
+        "t.obj" => Ok(with_vn.clone()),
+        _ => Err(format!("{path}: no such test file")),
+    };
+    let scene = load_scene_str_with(
+        &format!("{CAMERA}[[mesh]]\nfile = \"t.obj\"\n"),
+        "t.toml",
+        &files,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let n = apex_normal(&scene).expect("the file's normals");
+    assert!(
+        (n - Vec3::new(0.0, 0.5, 1.0).normalize()).length() < 1e-5,
+        "{n}"
+    );
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+}
+
 #[test]
 fn normals_keys_are_checked_saved_and_loaded_back() {
     let list: &'static [(&str, &str)] = &[("o.obj", OCTA)];

@@ -723,8 +723,14 @@ pub fn tree_panel(ui: &mut Ui, selection: &mut TreeSelection, ws: &mut Workspace
         let (swatch, response) =
             ui.allocate_exact_size(egui::vec2(side, side), egui::Sense::hover());
         let c = tree.color.clamp(Vec3::ZERO, Vec3::ONE);
-        ui.painter()
-            .rect_filled(swatch, 2.0, egui::Rgba::from_rgb(c.x, c.y, c.z));
+        // Outlined, so a black or background-coloured pixel still shows a swatch.
+        ui.painter().rect(
+            swatch,
+            2.0,
+            egui::Rgba::from_rgb(c.x, c.y, c.z),
+            egui::Stroke::new(1.0, egui::Color32::from_gray(140)),
+            egui::StrokeKind::Inside,
+        );
         response.on_hover_text(numbers);
         ui.weak(format!(
             "{}{}",

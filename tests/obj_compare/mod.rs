@@ -110,8 +110,9 @@ pub fn without_polylines(text: &str) -> String {
 }
 
 /// What the loader's single pass must count, counted line by line here: `v`, `vt`, `vn`,
-/// triangles of `f` (one for a face of fewer than three corners), `l` lines, and the names of
-/// `usemtl` followed by a space or tab.
+/// triangles of `f` (one for a face of fewer than three corners), `l` lines, the names of
+/// `usemtl` followed by a space or tab, and whether an `s` line names a group (not `off`, not
+/// a number equal to 0).
 pub fn facts_by_lines(text: &str) -> raytree::scene::obj::parse::Facts {
     let mut f = raytree::scene::obj::parse::Facts::default();
     for line in text.lines() {
@@ -121,6 +122,13 @@ pub fn facts_by_lines(text: &str) -> raytree::scene::obj::parse::Facts {
             Some("vt") => f.texcoords += 1,
             Some("vn") => f.normals += 1,
             Some("l") => f.polylines += 1,
+            Some("s") => {
+                if let Some(group) = words.next() {
+                    let off = matches!(group.as_bytes(), [b'o' | b'O', b'f' | b'F', b'f' | b'F'])
+                        || group.parse::<u64>().is_ok_and(|n| n == 0);
+                    f.smoothing |= !off;
+                }
+            }
             Some("f") => f.triangles += (words.count() as u64).saturating_sub(2).max(1),
             _ => {}
         }

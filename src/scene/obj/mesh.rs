@@ -25,6 +25,19 @@ const UNNAMED: &str = "unnamed_object";
 /// to `scene`; returns how many triangles were added.
 pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, ObjProblem> {
     let (scanned, fast_corners, facts) = scan(req.text)?;
+    // A file without `vn` whose faces are in smoothing groups (`s 1`) shades as its exporter
+    // meant: smooth, with normals computed as for `normals = "smooth"`.
+    let by_groups = req.normals == NormalsMode::File && facts.normals == 0 && facts.smoothing;
+    let smoothed;
+    let req = if by_groups {
+        smoothed = MeshRequest {
+            normals: NormalsMode::Smooth,
+            ..*req
+        };
+        &smoothed
+    } else {
+        req
+    };
     check_memory(scene, req.text.len(), &facts, req.normals)?;
     let libraries = Libraries::new(req);
     let (models, mtl_materials, fast) =
@@ -32,6 +45,13 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     let face_corners = face_corners(req.text, &models, fast, fast_corners)?;
     let (mut warnings, mtl_texts) = libraries.finish();
     warn_about_reading(req, &facts, &mtl_materials, &mut warnings);
+    if by_groups {
+        warnings.push(format!(
+            "{}: no vertex normals (`vn`), so its smoothing groups (`s`) are shaded with \
+             normals computed across edges under {}° (`normals = \"flat\"` keeps the facets).",
+            req.label, req.crease_angle_deg
+        ));
+    }
 
     let mut build = MeshBuild::new(scene, req, &models, &face_corners, &mtl_materials, warnings);
     for model in &models {

@@ -74,6 +74,8 @@ struct Chunk {
     given: Vec<(u8, usize)>,
     /// `f` lines that give `vt` (`vn`) at some corners but not all.
     partial: [usize; 2],
+    /// An `s` line names a smoothing group ([`smoothing_group`]).
+    smoothing: bool,
 }
 
 /// What to do with polyline (`l`) statements.
@@ -103,6 +105,14 @@ pub struct Facts {
     /// The names of `usemtl` lines that start (after leading whitespace) with `usemtl` and a
     /// space or tab, trimmed, without empty ones.
     pub usemtl: BTreeSet<String>,
+    /// An `s` statement names a smoothing group (a number other than 0, or a name other than
+    /// `off`): the exporter meant those faces to shade smooth.
+    pub smoothing: bool,
+}
+
+/// Whether the word after `s` names a smoothing group: anything but `off` and 0.
+pub(super) fn smoothing_group(word: Option<&str>) -> bool {
+    word.is_some_and(|w| !w.eq_ignore_ascii_case("off") && w.parse::<u64>() != Ok(0))
 }
 
 /// The text read in chunks by [`scan`], not yet made into models.
@@ -189,6 +199,7 @@ pub fn scan(text: &str, polylines: Polylines) -> Option<Scanned> {
         facts.triangles += chunk.face_triangles;
         facts.polylines += chunk.polylines;
         facts.usemtl.extend(std::mem::take(&mut chunk.usemtl));
+        facts.smoothing |= chunk.smoothing;
     }
     facts.vertices = base.1[0] as u64;
     facts.texcoords = base.1[1] as u64;
@@ -443,6 +454,7 @@ fn parse_line<'a>(
         "vt" => numbers(&mut words, 2, &mut chunk.texcoords)?,
         "vn" => numbers(&mut words, 3, &mut chunk.normals)?,
         "l" if polylines == Polylines::Skip => chunk.polylines += 1,
+        "s" => chunk.smoothing |= smoothing_group(words.next()),
         "f" => {
             let before = chunk.corners.len();
             let (corners, given) = face(words, &mut chunk.corners)?;

@@ -197,7 +197,9 @@ pub(super) fn slow_facts(text: &str) -> Facts {
         ..Facts::default()
     };
     for line in text.lines() {
-        match line.split_whitespace().next() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("s") => facts.smoothing |= super::parse::smoothing_group(words.next()),
             Some("vn") => facts.normals += 1,
             Some("vt") => facts.texcoords += 1,
             Some("l") => facts.polylines += 1,
