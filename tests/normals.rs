@@ -112,6 +112,21 @@ fn roof(group: &str) -> String {
     )
 }
 
+/// A scene of the camera above and one mesh, `obj` as `r.obj`, with the `[[mesh]]` keys
+/// `keys`.
+fn load_obj(obj: String, keys: &str) -> Scene {
+    let files = move |path: &str| match path {
+        "r.obj" => Ok(obj.clone()),
+        _ => Err(format!("{path}: no such test file")),
+    };
+    load_scene_str_with(
+        &format!("{CAMERA}[[mesh]]\nfile = \"r.obj\"\n{keys}"),
+        "t.toml",
+        &files,
+    )
+    .unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// The shading normal at the apex (vertex 5 is the third corner of the first triangle).
 fn apex_normal(scene: &Scene) -> Option<Vec3> {
     let a = scene.attributes.first()?;
@@ -120,19 +135,7 @@ fn apex_normal(scene: &Scene) -> Option<Vec3> {
 
 #[test]
 fn smoothing_groups_without_vn_shade_smooth_and_say_so() {
-    let load_roof = |group: &str, normals: &str| {
-        let obj = roof(group);
-        let files = move |path: &str| match path {
-            "r.obj" => Ok(obj.clone()),
-            _ => Err(format!("{path}: no such test file")),
-        };
-        load_scene_str_with(
-            &format!("{CAMERA}[[mesh]]\nfile = \"r.obj\"\n{normals}"),
-            "t.toml",
-            &files,
-        )
-        .unwrap_or_else(|e| panic!("{e}"))
-    };
+    let load_roof = |group: &str, normals: &str| load_obj(roof(group), normals);
     // `s 1` (and a named group): the apex's normal is the average of the four faces, +z.
     for group in ["s 1", "s 7", "s roof"] {
         let scene = load_roof(group, "");
@@ -159,18 +162,50 @@ fn smoothing_groups_without_vn_shade_smooth_and_say_so() {
             scene.warnings
         );
     }
-    // A file with its own `vn` keeps them whatever its groups.
-    let with_vn = format!("{}s 1\n", TRI);
-    let files = move |path: &str| match path {
-        "t.obj" => Ok(with_vn.clone()),
-        _ => Err(format!("{path}: no such test file")),
+    // Per face: under `s off` a face stays flat, and two groups do not average together. The
+    // roof's first two faces (towards -y and +x) in one group, the other two flat or in a
+    // second group.
+    let mixed = |second: &str| {
+        load_obj(
+            format!(
+                "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nv 0 0 0.3\ns 1\nf 1 2 5\nf 2 3 5\n\
+                 {second}\nf 3 4 5\nf 4 1 5\n"
+            ),
+            "",
+        )
     };
-    let scene = load_scene_str_with(
-        &format!("{CAMERA}[[mesh]]\nfile = \"t.obj\"\n"),
-        "t.toml",
-        &files,
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
+    let face = |a: Vec3, b: Vec3, c: Vec3| (b - a).cross(c - a).normalize();
+    let (v1, v2, v3, v4, apex) = (
+        Vec3::new(-1.0, -1.0, 0.0),
+        Vec3::new(1.0, -1.0, 0.0),
+        Vec3::new(1.0, 1.0, 0.0),
+        Vec3::new(-1.0, 1.0, 0.0),
+        Vec3::new(0.0, 0.0, 0.3),
+    );
+    let (f0, f1, f2) = (face(v1, v2, apex), face(v2, v3, apex), face(v3, v4, apex));
+    // The first group's two faces are equal in area: their apex normal is their mean.
+    let pair = (f0 + f1).normalize();
+    for second in ["s off", "s 2"] {
+        let scene = mixed(second);
+        let a = &scene.attributes[0];
+        let first = a.normals_of(0).expect("normals")[2];
+        assert!(
+            (first - pair).length() < 1e-5,
+            "{second}: {first} vs {pair}"
+        );
+        let third = a.normals_of(2).expect("normals")[2];
+        let want = if second == "s off" {
+            f2
+        } else {
+            (f2 + face(v4, v1, apex)).normalize()
+        };
+        assert!(
+            (third - want).length() < 1e-5,
+            "{second}: {third} vs {want}"
+        );
+    }
+    // A file with its own `vn` keeps them whatever its groups.
+    let scene = load_obj(format!("{TRI}s 1\n"), "");
     let n = apex_normal(&scene).expect("the file's normals");
     assert!(
         (n - Vec3::new(0.0, 0.5, 1.0).normalize()).length() < 1e-5,

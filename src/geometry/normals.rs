@@ -9,12 +9,16 @@ use glam::Vec3;
 /// corner, the sum of the cross products (twice the area times the unit normal) of the
 /// triangles that share the corner's position and whose normal is within `crease_angle_deg` of
 /// this triangle's, normalised. Corners are shared by position, so a mesh split into groups or
-/// materials is still smooth across them. Returns the normals and each triangle's indices.
+/// materials is still smooth across them. With `groups` (an OBJ's smoothing groups, one per
+/// triangle), a triangle averages only with triangles of its own group, and one of group 0
+/// keeps its own normal (flat). Returns the normals and each triangle's indices.
 pub fn smooth_normals<T>(
     triangles: &[T],
     vertices: impl Fn(&T) -> [Vec3; 3],
     crease_angle_deg: f32,
+    groups: Option<&[u32]>,
 ) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let group = |k: usize| groups.map_or(1, |g| g.get(k).copied().unwrap_or(1));
     let key = |p: Vec3| p.to_array().map(|x| (x + 0.0).to_bits());
     let mut ids: HashMap<[u32; 3], u32> = HashMap::with_capacity(triangles.len());
     let corner_ids: Vec<[u32; 3]> = triangles
@@ -58,8 +62,11 @@ pub fn smooth_normals<T>(
         for (slot, &id) in idx.iter_mut().zip(c) {
             let (a, b) = (start[id as usize] as usize, start[id as usize + 1] as usize);
             let mut sum = Vec3::ZERO;
+            let own = group(k);
             for &other in &around[a..b] {
-                if unit[k].dot(unit[other as usize]) >= cos_crease {
+                let other_group = group(other as usize);
+                let joined = other as usize == k || (own != 0 && other_group == own);
+                if joined && unit[k].dot(unit[other as usize]) >= cos_crease {
                     sum += weighted[other as usize];
                 }
             }

@@ -56,6 +56,7 @@ pub(super) fn finish_attributes(
     mut attrs: MeshAttributes,
     mut corners: Corners,
     textured: bool,
+    groups: Option<&[u32]>,
     warnings: &mut Vec<String>,
 ) {
     let first = attrs.first_triangle as usize;
@@ -81,6 +82,7 @@ pub(super) fn finish_attributes(
                 &scene.triangles[first..],
                 |t| t.vertices,
                 req.crease_angle_deg,
+                groups,
             );
             attrs.normals = normals;
             attrs.normal_indices = indices;

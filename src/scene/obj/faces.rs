@@ -22,7 +22,7 @@ pub(super) struct Faces<'a> {
 }
 
 /// The material of a placed triangle until its model's material is known.
-const PLACED: MaterialId = MaterialId(u32::MAX);
+pub(super) const PLACED: MaterialId = MaterialId(u32::MAX);
 /// The material of a triangle to drop: zero area or not finite.
 const DEGENERATE: MaterialId = MaterialId(u32::MAX - 1);
 /// The material of a triangle to drop: beyond the scene-size limit.

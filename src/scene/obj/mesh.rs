@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use super::attributes::{Corners, finish_attributes};
 use super::corners::{self, FaceCorners};
-use super::faces::{Faces, Given, dropped, keep_placed};
+use super::faces::{Faces, Given, PLACED, dropped, keep_placed};
 use super::memory::check_memory;
 use super::mtl::{Libraries, mtl_material, warn_unknown_usemtl};
 use super::parse::Facts;
@@ -47,13 +47,17 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     warn_about_reading(req, &facts, &mtl_materials, &mut warnings);
     if by_groups {
         warnings.push(format!(
-            "{}: no vertex normals (`vn`), so its smoothing groups (`s`) are shaded with \
-             normals computed across edges under {}° (`normals = \"flat\"` keeps the facets).",
+            "{}: no vertex normals (`vn`), so the faces of its smoothing groups (`s`) are shaded \
+             with normals computed within each group across edges under {}° (`normals = \"flat\"` \
+             keeps the facets).",
             req.label, req.crease_angle_deg
         ));
     }
 
     let mut build = MeshBuild::new(scene, req, &models, &face_corners, &mtl_materials, warnings);
+    if by_groups {
+        build.read_groups(req.text, &models);
+    }
     for model in &models {
         let start = scene.triangles.len();
         build.add_model(scene, &model.mesh, &mtl_texts);
@@ -163,6 +167,10 @@ struct MeshBuild<'a> {
     attrs: MeshAttributes,
     corners: Corners,
     warnings: Vec<String>,
+    /// The smoothing group of each triangle read (file order), when the mesh is shaded by its
+    /// groups ([`MeshBuild::read_groups`]), and of each triangle kept.
+    file_groups: Option<Vec<u32>>,
+    groups: Vec<u32>,
 }
 
 impl<'a> MeshBuild<'a> {
@@ -202,7 +210,18 @@ impl<'a> MeshBuild<'a> {
             },
             corners: Corners::default(),
             warnings,
+            file_groups: None,
+            groups: Vec::new(),
         }
+    }
+
+    /// Reads the smoothing group of every face, for a mesh shaded smooth by its groups. Should
+    /// the count differ from the triangles read (it does not for a file the readers take), the
+    /// groups are left out and every face is smoothed alike.
+    fn read_groups(&mut self, text: &str, models: &[tobj::Model]) {
+        let groups = super::parse::smoothing_groups(text);
+        let read: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+        self.file_groups = (groups.len() == read).then_some(groups);
     }
 
     /// Adds one model's faces: placed, with their normal and texture-coordinate indices and
@@ -230,6 +249,15 @@ impl<'a> MeshBuild<'a> {
         self.corners.bad_uvs += given.unusable(&uv_ids, corners::ALL_UVS);
         self.triangle_read += count;
         let (degenerate, far) = dropped(&scene.triangles[start..]);
+        if let Some(file_groups) = &self.file_groups {
+            let first = self.triangle_read - count;
+            let placed = scene.triangles[start..].iter().enumerate();
+            self.groups.extend(
+                placed
+                    .filter(|(_, t)| t.material == PLACED)
+                    .map(|(k, _)| file_groups[first + k]),
+            );
+        }
         self.dropped += degenerate;
         self.too_far += far;
         let kept = count - degenerate - far;
@@ -324,7 +352,8 @@ impl<'a> MeshBuild<'a> {
         corners.partial_normals = face_corners.partial_normals * usize::from(self.file_normals);
         corners.partial_uvs = face_corners.partial_uvs;
         let warnings = &mut self.warnings;
-        finish_attributes(scene, req, self.attrs, corners, textured, warnings);
+        let groups = self.file_groups.is_some().then_some(&self.groups[..]);
+        finish_attributes(scene, req, self.attrs, corners, textured, groups, warnings);
         let (dropped, too_far) = (self.dropped, self.too_far);
         if dropped > 0 {
             let s = if dropped == 1 { "" } else { "s" };

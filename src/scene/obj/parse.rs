@@ -110,6 +110,38 @@ pub struct Facts {
     pub smoothing: bool,
 }
 
+/// The smoothing group of every triangle of the `f` lines, in the file's order (tobj's
+/// triangles are in that order too): 0 under `s off` or `s 0` and before any `s`, else an id
+/// for the group's number or name. One serial pass, made only for a file without `vn` that
+/// has groups ([`Facts::smoothing`]).
+pub(crate) fn smoothing_groups(text: &str) -> Vec<u32> {
+    let mut ids: std::collections::HashMap<&str, u32> = Default::default();
+    let mut current = 0;
+    let mut out = Vec::new();
+    for line in text.lines() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("s") => {
+                let word = words.next();
+                current = match word {
+                    Some(w) if smoothing_group(Some(w)) => {
+                        let next = ids.len() as u32 + 1;
+                        *ids.entry(w).or_insert(next)
+                    }
+                    _ => 0,
+                };
+            }
+            Some("f") => {
+                // Fanned as tobj fans them: a face of fewer than three corners is one triangle.
+                let triangles = words.count().saturating_sub(2).max(1);
+                out.extend(std::iter::repeat_n(current, triangles));
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
 /// Whether the word after `s` names a smoothing group: anything but `off` and 0.
 pub(super) fn smoothing_group(word: Option<&str>) -> bool {
     word.is_some_and(|w| !w.eq_ignore_ascii_case("off") && w.parse::<u64>() != Ok(0))
