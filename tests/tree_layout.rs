@@ -55,6 +55,24 @@ fn click_glass(h: &mut Window) {
     assert!(h.state().selection.tree.is_some(), "a tree after the click");
 }
 
+/// Where the root's detail starts (its summary, "primary d0 · …"): the one of the nodes so
+/// labelled that is laid out.
+fn root_detail(h: &Window) -> egui::Rect {
+    h.query_all_by_label_contains("primary d0 · ")
+        .map(|n| n.rect())
+        .find(|r| r.is_finite())
+        .expect("the root's detail is shown")
+}
+
+/// Opens the default scene in a `size` window with the glass sphere's tree in the list.
+fn list_of_glass(size: [f32; 2]) -> Window {
+    let mut h = window(small("default"), size);
+    follow_pane(&mut h);
+    click_glass(&mut h);
+    show_tab(&mut h, "Tree list");
+    h
+}
+
 fn show_tab(h: &mut Window, title: &str) {
     h.get_by_role_and_label(Role::Button, title).click();
     h.run_steps(3);
@@ -96,11 +114,7 @@ fn the_diagram_and_the_list_are_readable_at_common_sizes() {
         }
         // The table has the room: at least four of its rows above the selected node's
         // detail (which starts with the root's summary, "primary d0 · …").
-        let detail = h
-            .query_all_by_label_contains("primary d0 · ")
-            .map(|n| n.rect())
-            .find(|r| r.is_finite())
-            .expect("the root's detail is shown");
+        let detail = root_detail(&h);
         let rows = h
             .query_all_by(|n| {
                 let label = n.value().unwrap_or_default();
@@ -122,10 +136,7 @@ fn the_diagram_and_the_list_are_readable_at_common_sizes() {
 /// colour column stays in view.
 #[test]
 fn the_list_columns_follow_a_narrowed_pane() {
-    let mut h = window(small("default"), [1600.0, 1000.0]);
-    follow_pane(&mut h);
-    click_glass(&mut h);
-    show_tab(&mut h, "Tree list");
+    let mut h = list_of_glass([1600.0, 1000.0]);
     // Where the colour column starts, as a share of the pane (the list is the rightmost pane;
     // its "ray" header starts at the pane's left edge).
     let share = |h: &Window| {
@@ -147,6 +158,25 @@ fn the_list_columns_follow_a_narrowed_pane() {
         "the colour column starts {:.0} % into the narrowed pane ({:.0} % in the wide one)",
         narrow * 100.0,
         wide * 100.0
+    );
+}
+
+/// The detail below the list keeps its share of the pane when the window grows.
+#[test]
+fn the_detail_keeps_its_share_when_the_window_grows() {
+    let mut h = list_of_glass([1024.0, 640.0]);
+    let detail_height = |h: &Window| {
+        let top = root_detail(h).min.y;
+        let bottom = h.get_by_label_contains("spp").rect().min.y;
+        bottom - top
+    };
+    let small_detail = detail_height(&h);
+    h.set_size(egui::vec2(1600.0, 1000.0));
+    h.run_steps(4);
+    let large_detail = detail_height(&h);
+    assert!(
+        large_detail >= 1.3 * small_detail,
+        "the detail is {large_detail:.0} points tall at 1600x1000, {small_detail:.0} at 1024x640"
     );
 }
 

@@ -770,7 +770,17 @@ pub fn tree_panel(ui: &mut Ui, selection: &mut TreeSelection, ws: &mut Workspace
     // between them drags (and is remembered).
     let room = ui.available_height();
     let detail_most = (room - TABLE_LEAST).max(DETAIL_LEAST);
-    egui::Panel::bottom("tree detail pane")
+    // When the pane's height changes by more than a tenth (a resized window), the divider
+    // starts again from its share: a new panel id, so its height kept in points is not
+    // carried from a small pane to a large one.
+    let split_id = ui.scope_id().with("tree detail split");
+    let (mut base, mut generation): (f32, u32) =
+        ui.data(|d| d.get_temp(split_id)).unwrap_or((room, 0));
+    if (room - base).abs() > 0.1 * base.max(1.0) {
+        (base, generation) = (room, generation + 1);
+    }
+    ui.data_mut(|d| d.insert_temp(split_id, (base, generation)));
+    egui::Panel::bottom(("tree detail pane", generation))
         .resizable(true)
         .frame(egui::Frame::NONE.inner_margin(egui::Margin {
             top: 4,
