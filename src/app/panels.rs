@@ -773,13 +773,7 @@ pub fn tree_panel(ui: &mut Ui, selection: &mut TreeSelection, ws: &mut Workspace
     // When the pane's height changes by more than a tenth (a resized window), the divider
     // starts again from its share: a new panel id, so its height kept in points is not
     // carried from a small pane to a large one.
-    let split_id = ui.scope_id().with("tree detail split");
-    let (mut base, mut generation): (f32, u32) =
-        ui.data(|d| d.get_temp(split_id)).unwrap_or((room, 0));
-    if (room - base).abs() > 0.1 * base.max(1.0) {
-        (base, generation) = (room, generation + 1);
-    }
-    ui.data_mut(|d| d.insert_temp(split_id, (base, generation)));
+    let generation = tree_view::resize_generation(ui, "tree detail split", room);
     egui::Panel::bottom(("tree detail pane", generation))
         .resizable(true)
         .frame(egui::Frame::NONE.inner_margin(egui::Margin {

@@ -1013,6 +1013,20 @@ fn met(node: &Node) -> String {
     }
 }
 
+/// A count that goes up each time `size` (a pane's width or height) has moved more than a
+/// tenth away from where it was when the count last went up. Part of a widget's id, it makes
+/// a widget that keeps its sizes in points (a table's columns, a panel's height) start again
+/// from its shares of the new size.
+pub(super) fn resize_generation(ui: &Ui, salt: impl egui::AsIdSalt, size: f32) -> u32 {
+    let id = ui.scope_id().with(salt);
+    let (mut base, mut generation): (f32, u32) = ui.data(|d| d.get_temp(id)).unwrap_or((size, 0));
+    if (size - base).abs() > 0.1 * base.max(1.0) {
+        (base, generation) = (size, generation + 1);
+    }
+    ui.data_mut(|d| d.insert_temp(id, (base, generation)));
+    generation
+}
+
 /// The tree as a table of rows (ray, what it met, colour); `other` marks the rows that differ
 /// from another tree. A row's toggle folds its subtree, here and in the diagram.
 pub fn tree_list(
@@ -1035,14 +1049,9 @@ pub fn tree_list(
     // When the pane's width changes by more than a tenth (a resized window, a moved
     // splitter), the columns start again from their shares of it: widths kept from a wider
     // pane would push the colours out of a narrow one.
-    let width_id = ui.scope_id().with(("tree list width", salt));
-    let before: Option<f32> = ui.data(|d| d.get_temp(width_id));
-    ui.data_mut(|d| d.insert_temp(width_id, width));
-    let table = TableBuilder::new(ui).id_salt(("tree list", salt));
-    if before.is_some_and(|b| (width - b).abs() > 0.1 * b) {
-        table.reset();
-    }
-    table
+    let generation = resize_generation(ui, ("tree list width", salt), width);
+    TableBuilder::new(ui)
+        .id_salt(("tree list", salt, generation))
         .striped(true)
         .resizable(true)
         .vscroll(false)

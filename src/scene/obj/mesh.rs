@@ -26,7 +26,7 @@ const UNNAMED: &str = "unnamed_object";
 pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, ObjProblem> {
     let (scanned, fast_corners, facts) = scan(req.text)?;
     // A file without `vn` whose faces are in smoothing groups (`s 1`) shades as its exporter
-    // meant: smooth, with normals computed as for `normals = "smooth"`.
+    // meant: smooth, with normals computed as for `normals = "smooth"` within each group.
     let by_groups = req.normals == NormalsMode::File && facts.normals == 0 && facts.smoothing;
     let smoothed;
     let req = if by_groups {
@@ -45,18 +45,15 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     let face_corners = face_corners(req.text, &models, fast, fast_corners)?;
     let (mut warnings, mtl_texts) = libraries.finish();
     warn_about_reading(req, &facts, &mtl_materials, &mut warnings);
+    let mut build = MeshBuild::new(scene, req, &models, &face_corners, &mtl_materials, warnings);
     if by_groups {
-        warnings.push(format!(
+        build.read_groups(req.text, &models);
+        build.warnings.push(format!(
             "{}: no vertex normals (`vn`), so the faces of its smoothing groups (`s`) are shaded \
              with normals computed within each group across edges under {}° (`normals = \"flat\"` \
              keeps the facets).",
             req.label, req.crease_angle_deg
         ));
-    }
-
-    let mut build = MeshBuild::new(scene, req, &models, &face_corners, &mtl_materials, warnings);
-    if by_groups {
-        build.read_groups(req.text, &models);
     }
     for model in &models {
         let start = scene.triangles.len();
