@@ -204,6 +204,13 @@ fn smoothing_groups_without_vn_shade_smooth_and_say_so() {
             "{second}: {third} vs {want}"
         );
     }
+    // A group is its number, however written: `s 01` goes on with `s 1`, so all four faces
+    // average to +z at the apex.
+    let scene = mixed("s 01");
+    for face in [0, 2] {
+        let n = scene.attributes[0].normals_of(face).expect("normals")[2];
+        assert!((n - Vec3::Z).length() < 1e-5, "face {face}: {n}");
+    }
     // A file with its own `vn` keeps them whatever its groups.
     let scene = load_obj(format!("{TRI}s 1\n"), "");
     let n = apex_normal(&scene).expect("the file's normals");

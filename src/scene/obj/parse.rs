@@ -112,10 +112,10 @@ pub struct Facts {
 
 /// The smoothing group of every triangle of the `f` lines, in the file's order (tobj's
 /// triangles are in that order too): 0 under `s off` or `s 0` and before any `s`, else an id
-/// for the group's number or name. One serial pass, made only for a file without `vn` that
-/// has groups ([`Facts::smoothing`]).
+/// for the group's number (so `s 01` is `s 1`) or name. One serial pass, made only for a file
+/// without `vn` that has groups ([`Facts::smoothing`]).
 pub(crate) fn smoothing_groups(text: &str) -> Vec<u32> {
-    let mut ids: std::collections::HashMap<&str, u32> = Default::default();
+    let mut ids: std::collections::HashMap<Result<u64, &str>, u32> = Default::default();
     let mut current = 0;
     let mut out = Vec::new();
     for line in text.lines() {
@@ -126,7 +126,7 @@ pub(crate) fn smoothing_groups(text: &str) -> Vec<u32> {
                 current = match word {
                     Some(w) if smoothing_group(Some(w)) => {
                         let next = ids.len() as u32 + 1;
-                        *ids.entry(w).or_insert(next)
+                        *ids.entry(w.parse::<u64>().map_err(|_| w)).or_insert(next)
                     }
                     _ => 0,
                 };
