@@ -203,7 +203,7 @@ impl Tile<'_> {
         }
         let mut rays = [crate::geometry::Ray::new(Vec3::ZERO, Vec3::Z); PACKET_RAYS];
         let mut out = [(Vec3::ZERO, SampleInfo::default()); PACKET_RAYS];
-        let mut scratch = PacketScratch::default();
+        let mut scratch = PacketScratch::take();
         for by in (0..rect.height).step_by(bh as usize) {
             for bx in (0..rect.width).step_by(bw as usize) {
                 // The block's pixels inside the rect, row-major: (index in `sums`, x, y).
@@ -222,7 +222,7 @@ impl Tile<'_> {
                 let active = u32::MAX >> (32 - n);
                 for s in samples.clone() {
                     primary_rays(frame, &xy, n, s, &mut rays);
-                    tracer.trace_packet(&rays, active, counts, &mut out, &mut scratch);
+                    tracer.trace_packet(&rays, active, counts, &mut out, &mut *scratch);
                     for (&(at, _, _), &(c, info)) in pixels[..n].iter().zip(&out[..n]) {
                         sums[at] += c;
                         if s == 0
@@ -234,6 +234,7 @@ impl Tile<'_> {
                 }
             }
         }
+        PacketScratch::keep(scratch);
     }
 }
 
@@ -281,7 +282,7 @@ pub fn preview_tile(
     preview_with(frame, rect, block, |centres, out| {
         let mut rays = [crate::geometry::Ray::new(Vec3::ZERO, Vec3::Z); PACKET_RAYS];
         let mut traced = [(Vec3::ZERO, SampleInfo::default()); PACKET_RAYS];
-        let mut scratch = PacketScratch::default();
+        let mut scratch = PacketScratch::take();
         for (chunk, outs) in centres.chunks(PACKET_RAYS).zip(out.chunks_mut(PACKET_RAYS)) {
             for (ray, &(x, y)) in rays.iter_mut().zip(chunk) {
                 *ray = primary_ray(frame, x, y, 0);
@@ -290,6 +291,7 @@ pub fn preview_tile(
             tracer.trace_packet(&rays, active, counts, &mut traced, &mut scratch);
             outs.copy_from_slice(&traced[..chunk.len()]);
         }
+        PacketScratch::keep(scratch);
     })
 }
 

@@ -62,6 +62,34 @@ impl<const K: usize> Default for PacketScratch<K> {
     }
 }
 
+thread_local! {
+    /// Each thread's [`PacketScratch`], kept from one tile to the next.
+    static SCRATCH: std::cell::RefCell<Option<Box<PacketScratch<MAX_PACKET>>>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+impl PacketScratch<MAX_PACKET> {
+    /// This thread's scratch, kept by [`PacketScratch::keep`] after its last tile (a fresh
+    /// one the first time).
+    pub fn take() -> Box<Self> {
+        SCRATCH
+            .try_with(|cell| cell.try_borrow_mut().ok().and_then(|mut slot| slot.take()))
+            .ok()
+            .flatten()
+            .unwrap_or_default()
+    }
+
+    /// Keeps `scratch` for this thread's next [`PacketScratch::take`] (dropped if the thread
+    /// is ending).
+    pub fn keep(scratch: Box<Self>) {
+        let _ = SCRATCH.try_with(|cell| {
+            if let Ok(mut slot) = cell.try_borrow_mut() {
+                *slot = Some(scratch);
+            }
+        });
+    }
+}
+
 /// Lights whose shadow-ray setup a packet keeps for shading (the rest are set up again).
 const GIVEN_LIGHTS: usize = 4;
 
