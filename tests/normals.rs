@@ -222,6 +222,46 @@ fn smoothing_groups_without_vn_shade_smooth_and_say_so() {
 }
 
 #[test]
+fn faces_without_vn_in_a_file_with_vn_shade_by_their_groups() {
+    // The roof's first two faces give `vn` (all +x, so they can be told apart); the other two
+    // give none. In one group, the two without `vn` take the normals computed within it: the
+    // apex averages all four faces, +z. Under `s off` they stay flat.
+    let roof = |group: &str| {
+        format!(
+            "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nv 0 0 0.3\nvn 1 0 0\ns 1\n\
+             f 1//1 2//1 5//1\nf 2//1 3//1 5//1\n{group}\nf 3 4 5\nf 4 1 5\n"
+        )
+    };
+    let scene = load_obj(roof("s 1"), "");
+    let a = &scene.attributes[0];
+    for face in [0, 1] {
+        let kept = a.normals_of(face).expect("the file's normals");
+        assert!(
+            kept.iter().all(|n| (*n - Vec3::X).length() < 1e-5),
+            "{kept:?}"
+        );
+    }
+    for face in [2, 3] {
+        let n = a.normals_of(face).expect("computed normals")[2];
+        assert!((n - Vec3::Z).length() < 1e-5, "face {face}: apex {n}");
+    }
+    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    let w = &scene.warnings[0];
+    assert!(
+        w.starts_with("r.obj: the faces without vertex normals (`vn`) in its smoothing groups (`s`) are shaded"),
+        "{w}"
+    );
+    // Under `s off` the two stay flat (no normals of their own), and nothing is said.
+    let scene = load_obj(roof("s off"), "");
+    let a = &scene.attributes[0];
+    assert!(a.normals_of(2).is_none() && a.normals_of(3).is_none());
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    // `normals = "flat"` keeps every facet.
+    let scene = load_obj(roof("s 1"), "normals = \"flat\"\n");
+    assert!(scene.attributes.is_empty() && scene.warnings.is_empty());
+}
+
+#[test]
 fn normals_keys_are_checked_saved_and_loaded_back() {
     let list: &'static [(&str, &str)] = &[("o.obj", OCTA)];
     let bad = load_scene_str_with(

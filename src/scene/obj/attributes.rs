@@ -62,7 +62,8 @@ pub(super) fn finish_attributes(
     let first = attrs.first_triangle as usize;
     let count = scene.triangles.len() - first;
     attrs.triangle_count = count as u32;
-    warn_about_corners(req.label, &corners, textured, warnings);
+    let grouped = groups.is_some() && req.normals == NormalsMode::File;
+    warn_about_corners(req.label, &corners, textured, grouped, warnings);
     for list in [&mut corners.normals, &mut corners.uvs] {
         if !list.is_empty() {
             list.resize(count, [NO_INDEX; 3]);
@@ -71,6 +72,10 @@ pub(super) fn finish_attributes(
     match req.normals {
         NormalsMode::Flat => attrs.normals.clear(),
         NormalsMode::File => {
+            if let Some(groups) = groups {
+                let triangles = &scene.triangles[first..];
+                fill_by_groups(triangles, req, &mut attrs, &mut corners.normals, groups);
+            }
             if corners.normals.iter().any(|n| n[0] != NO_INDEX) {
                 attrs.normal_indices = corners.normals;
             } else {
@@ -100,25 +105,66 @@ pub(super) fn finish_attributes(
     }
 }
 
+/// For a file with `vn` at some faces only: each face without them that is in a smoothing
+/// group (`groups`, one per kept triangle, 0 for none) takes the normals `normals = "smooth"`
+/// computes within its group, added after the file's.
+fn fill_by_groups(
+    triangles: &[crate::scene::Triangle],
+    req: &MeshRequest,
+    attrs: &mut MeshAttributes,
+    indices: &mut Vec<[u32; 3]>,
+    groups: &[u32],
+) {
+    let wanted = |k: usize| groups[k] != 0 && indices.get(k).is_none_or(|n| n[0] == NO_INDEX);
+    if !(0..triangles.len().min(groups.len())).any(wanted) {
+        return;
+    }
+    let (normals, computed) = smooth_normals(
+        triangles,
+        |t| t.vertices,
+        req.crease_angle_deg,
+        Some(groups),
+    );
+    let base = attrs.normals.len() as u32;
+    indices.resize(triangles.len(), [NO_INDEX; 3]);
+    for (k, slot) in indices.iter_mut().enumerate() {
+        if groups.get(k).is_some_and(|&g| g != 0) && slot[0] == NO_INDEX {
+            *slot = computed[k].map(|i| i + base);
+        }
+    }
+    attrs.normals.extend(normals);
+}
+
 /// One warning for each kind of unusable `vn` or `vt` the mesh's faces have (those about `vt`
 /// only when a material of the mesh has a texture).
-fn warn_about_corners(label: &str, corners: &Corners, textured: bool, warnings: &mut Vec<String>) {
+fn warn_about_corners(
+    label: &str,
+    corners: &Corners,
+    textured: bool,
+    grouped: bool,
+    warnings: &mut Vec<String>,
+) {
     // (count, whether it applies, the verb for one face and for several, what those faces do,
     // and what becomes of them), one warning each.
+    let flat = if grouped {
+        "shaded flat unless in a smoothing group"
+    } else {
+        "shaded flat"
+    };
     let problems = [
         (
             corners.bad_normals,
             true,
             ["names", "name"],
             "normals (`vn`) that are out of range, zero or not finite",
-            "shaded flat",
+            flat,
         ),
         (
             corners.partial_normals,
             true,
             ["gives", "give"],
             "normals (`vn`) at some corners only",
-            "shaded flat",
+            flat,
         ),
         (
             corners.partial_uvs,

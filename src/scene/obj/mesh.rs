@@ -45,15 +45,40 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     let face_corners = face_corners(req.text, &models, fast, fast_corners)?;
     let (mut warnings, mtl_texts) = libraries.finish();
     warn_about_reading(req, &facts, &mtl_materials, &mut warnings);
+    // A file with `vn` on some faces only: those of the others in a smoothing group get
+    // normals computed within it.
+    let lacking = |f: u8| f & corners::ALL_NORMALS == 0;
+    let some_lack = req.normals == NormalsMode::File
+        && facts.smoothing
+        && face_corners.triangles.iter().any(|&f| lacking(f));
     let mut build = MeshBuild::new(scene, req, &models, &face_corners, &mtl_materials, warnings);
-    if by_groups {
+    if by_groups || some_lack {
         build.read_groups(req.text, &models);
-        build.warnings.push(format!(
-            "{}: no vertex normals (`vn`), so the faces of its smoothing groups (`s`) are shaded \
-             with normals computed within each group across edges under {}° (`normals = \"flat\"` \
-             keeps the facets).",
-            req.label, req.crease_angle_deg
-        ));
+        let grouped_without_vn = match &build.file_groups {
+            Some(groups) if !by_groups => face_corners
+                .triangles
+                .iter()
+                .zip(groups)
+                .filter(|&(&f, &g)| lacking(f) && g != 0)
+                .count(),
+            _ => 0,
+        };
+        let which: Option<&str> = if by_groups {
+            Some("no vertex normals (`vn`), so the faces of its smoothing groups (`s`) are")
+        } else if grouped_without_vn > 0 {
+            Some("the faces without vertex normals (`vn`) in its smoothing groups (`s`) are")
+        } else {
+            // None of the faces without `vn` is in a group: nothing to compute.
+            build.file_groups = None;
+            None
+        };
+        if let Some(which) = which {
+            build.warnings.push(format!(
+                "{}: {which} shaded with normals computed within each group across edges under \
+                 {}° (`normals = \"flat\"` keeps the facets).",
+                req.label, req.crease_angle_deg
+            ));
+        }
     }
     for model in &models {
         let start = scene.triangles.len();
