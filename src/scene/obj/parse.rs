@@ -113,7 +113,7 @@ pub struct Facts {
 /// The smoothing group of every triangle of the `f` lines, in the file's order (tobj's
 /// triangles are in that order too): 0 under `s off` or `s 0` and before any `s`, else an id
 /// for the group's number (so `s 01` is `s 1`) or name. One serial pass, made only for a file
-/// without `vn` that has groups ([`Facts::smoothing`]).
+/// with groups ([`Facts::smoothing`]) and faces without `vn`.
 pub(crate) fn smoothing_groups(text: &str) -> Vec<u32> {
     let mut ids: std::collections::HashMap<Result<u64, &str>, u32> = Default::default();
     let mut current = 0;
