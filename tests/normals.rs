@@ -245,6 +245,9 @@ fn faces_without_vn_in_a_file_with_vn_shade_by_their_groups() {
         let n = a.normals_of(face).expect("computed normals")[2];
         assert!((n - Vec3::Z).length() < 1e-5, "face {face}: apex {n}");
     }
+    // The file's one normal, and the computed ones those two faces take at their four
+    // distinct corners, no more.
+    assert!(a.normals.len() <= 1 + 4, "{} normals kept", a.normals.len());
     assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
     let w = &scene.warnings[0];
     assert!(

@@ -107,7 +107,7 @@ pub(super) fn finish_attributes(
 
 /// For a file with `vn` at some faces only: each face without them that is in a smoothing
 /// group (`groups`, one per kept triangle, 0 for none) takes the normals `normals = "smooth"`
-/// computes within its group, added after the file's.
+/// computes within its group, added after the file's (only those taken).
 fn fill_by_groups(
     triangles: &[crate::scene::Triangle],
     req: &MeshRequest,
@@ -125,14 +125,22 @@ fn fill_by_groups(
         req.crease_angle_deg,
         Some(groups),
     );
-    let base = attrs.normals.len() as u32;
+    // Only the computed normals a face takes are kept, each value once, after the file's.
+    let mut kept: std::collections::HashMap<[u32; 3], u32> = Default::default();
     indices.resize(triangles.len(), [NO_INDEX; 3]);
     for (k, slot) in indices.iter_mut().enumerate() {
         if groups.get(k).is_some_and(|&g| g != 0) && slot[0] == NO_INDEX {
-            *slot = computed[k].map(|i| i + base);
+            *slot = computed[k].map(|i| {
+                let n = normals[i as usize];
+                *kept
+                    .entry(n.to_array().map(f32::to_bits))
+                    .or_insert_with(|| {
+                        attrs.normals.push(n);
+                        attrs.normals.len() as u32 - 1
+                    })
+            });
         }
     }
-    attrs.normals.extend(normals);
 }
 
 /// One warning for each kind of unusable `vn` or `vt` the mesh's faces have (those about `vt`
