@@ -11,7 +11,12 @@ use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
 use serde::Serialize;
 
+use super::labels;
 use crate::export::{ExportError, write_atomically, write_text};
+
+/// The legend's and the point labels' font sizes.
+const LEGEND_FONT: u32 = 14;
+const LABEL_FONT: u32 = 12;
 
 /// Pixel size of the PNG (and the SVG's view box).
 pub const CHART_SIZE: (u32, u32) = (960, 620);
@@ -283,6 +288,9 @@ where
         .draw()
         .map_err(err)?;
     let mut colour_index = 0;
+    // Every point's pixel, and the labels wanted at them.
+    let mut markers: Vec<(i32, i32)> = Vec::new();
+    let mut wanted: Vec<labels::Wanted> = Vec::new();
     for s in &chart.series {
         let shown: Vec<(usize, (f64, f64))> = s
             .points
@@ -324,21 +332,112 @@ where
             }))
             .map_err(err)?;
         }
-        let labelled = shown
-            .iter()
-            .filter_map(|(i, p)| s.labels.get(*i).map(|l| (*p, l.as_str())));
-        cc.draw_series(labelled.map(|(p, l)| {
-            EmptyElement::at(p) + Text::new(l.to_string(), (7, -16), ("sans-serif", 12))
-        }))
-        .map_err(err)?;
+        markers.extend(shown.iter().map(|(_, p)| cc.backend_coord(p)));
+        let labelled = shown.iter().filter_map(|(i, p)| {
+            s.labels.get(*i).map(|l| labels::Wanted {
+                anchor: cc.backend_coord(p),
+                text: l.clone(),
+            })
+        });
+        // The front's labels first: they get the places next to their points.
+        if s.style == SeriesStyle::Front {
+            wanted.splice(0..0, labelled);
+        } else {
+            wanted.extend(labelled);
+        }
     }
+    let (legend_at, legend_box) = legend_layout(chart, cc.plotting_area(), legend_position)?;
+    draw_labels(root, &wanted, &markers, legend_box, cc.plotting_area())?;
     cc.configure_series_labels()
-        .position(legend_position)
+        .position(legend_at)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
-        .label_font(("sans-serif", 14))
+        .label_font(("sans-serif", LEGEND_FONT))
         .draw()
         .map_err(err)?;
+    Ok(())
+}
+
+/// Where the legend goes in `corner` of the plot `area` (as plotters lays it out: its lines,
+/// a 30-pixel sample and 10-pixel margins, 5 pixels from the plot's sides): the position to
+/// give plotters, and its box in the chart's pixels, for the labels to keep clear of.
+fn legend_layout<DB: DrawingBackend, CT: CoordTranslate>(
+    chart: &Chart,
+    area: &DrawingArea<DB, CT>,
+    corner: SeriesLabelPosition,
+) -> Result<(SeriesLabelPosition, labels::Rect), String> {
+    let font: TextStyle = ("sans-serif", LEGEND_FONT).into_font().into();
+    let mut lines = MultiLineText::<_, &str>::new((0, 0), &font);
+    for s in chart.series.iter().filter(|s| !s.name.is_empty()) {
+        lines.push_line(s.name.as_str());
+    }
+    let (w, h) = lines.estimate_dimension().map_err(|e| e.to_string())?;
+    let (w, h) = (w + 30 + 20, h + 20);
+    let (xs, ys) = area.get_pixel_range();
+    let (aw, ah) = (xs.end - xs.start, ys.end - ys.start);
+    let (x, y) = match corner {
+        SeriesLabelPosition::UpperLeft => (5, 5),
+        SeriesLabelPosition::LowerLeft => (5, ah - h - 5),
+        SeriesLabelPosition::LowerRight => (aw - w - 5, ah - h - 5),
+        _ => (aw - w - 5, 5),
+    };
+    let rect = labels::Rect {
+        x0: xs.start + x,
+        y0: ys.start + y,
+        x1: xs.start + x + w + 1,
+        y1: ys.start + y + h + 1,
+    };
+    Ok((SeriesLabelPosition::Coordinate(x, y), rect))
+}
+
+/// The point labels, merged where points share a spot and placed clear of one another, of the
+/// markers and of the legend ([`labels::place`]), with a grey leader line where a label had
+/// to move away from its point.
+fn draw_labels<DB: DrawingBackend, CT: CoordTranslate>(
+    root: &DrawingArea<DB, Shift>,
+    wanted: &[labels::Wanted],
+    markers: &[(i32, i32)],
+    legend: labels::Rect,
+    area: &DrawingArea<DB, CT>,
+) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let font: TextStyle = ("sans-serif", LABEL_FONT).into_font().into();
+    // The width as laid out; the height a whole line's (the glyphs' own box is shorter, and
+    // the text drawn reaches past it).
+    let line = LABEL_FONT as i32 + 3;
+    let size = |t: &str| {
+        root.estimate_text_size(t, &font)
+            .map_or((7 * t.chars().count() as i32, line), |(w, _)| {
+                (w as i32 + 1, line)
+            })
+    };
+    let (xs, ys) = area.get_pixel_range();
+    let plot = labels::Rect {
+        x0: xs.start,
+        y0: ys.start,
+        x1: xs.end,
+        y1: ys.end,
+    };
+    let merged = labels::merge(wanted);
+    for p in labels::place(&merged, size, markers, &[legend], plot) {
+        if let Some(end) = p.leader_to {
+            // From the marker's edge, not its centre, so the point stays readable.
+            let (dx, dy) = ((end.0 - p.anchor.0) as f64, (end.1 - p.anchor.1) as f64);
+            let len = dx.hypot(dy).max(1.0);
+            let edge = (labels::MARKER_PX - 1) as f64 / len;
+            let start = (
+                p.anchor.0 + (dx * edge).round() as i32,
+                p.anchor.1 + (dy * edge).round() as i32,
+            );
+            root.draw(&PathElement::new(
+                vec![start, end],
+                RGBColor(150, 150, 150).stroke_width(1),
+            ))
+            .map_err(err)?;
+        }
+        root.draw(&Text::new(p.text, (p.rect.x0, p.rect.y0), font.clone()))
+            .map_err(err)?;
+    }
     Ok(())
 }
 

@@ -13,9 +13,11 @@
 //!   JSON;
 //! - [`metrics`]: image error (FLIP, RMSE, PSNR, differing pixels);
 //! - [`chart`]: charts as plain data, drawn to SVG and PNG;
+//! - [`labels`]: where a chart's point labels go, clear of one another;
 //! - [`meshes`]: procedural closed meshes (random numbers from [`crate::rng`]).
 
 pub mod chart;
+pub mod labels;
 pub mod measure;
 pub mod meshes;
 pub mod metrics;
