@@ -332,13 +332,18 @@ where
             }))
             .map_err(err)?;
         }
-        markers.extend(shown.iter().map(|(_, p)| cc.backend_coord(p)));
-        let labelled = shown.iter().filter_map(|(i, p)| {
-            s.labels.get(*i).map(|l| labels::Wanted {
-                anchor: cc.backend_coord(p),
-                text: l.clone(),
-            })
-        });
+        let first_marker = markers.len();
+        markers.extend(points.iter().map(|p| cc.backend_coord(p)));
+        let labelled =
+            shown
+                .iter()
+                .zip(&markers[first_marker..])
+                .filter_map(|((i, _), &anchor)| {
+                    s.labels.get(*i).map(|l| labels::Wanted {
+                        anchor,
+                        text: l.clone(),
+                    })
+                });
         // The front's labels first: they get the places next to their points.
         if s.style == SeriesStyle::Front {
             wanted.splice(0..0, labelled);

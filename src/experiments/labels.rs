@@ -68,6 +68,11 @@ pub struct Placed {
 /// Points closer than this (in pixels, on both axes) are one spot: their labels are one.
 pub const SAME_SPOT_PX: i32 = 4;
 
+/// Whether two points are one spot.
+fn same_spot(a: (i32, i32), b: (i32, i32)) -> bool {
+    (a.0 - b.0).abs() <= SAME_SPOT_PX && (a.1 - b.1).abs() <= SAME_SPOT_PX
+}
+
 /// Half the side of the box a point's marker covers (the front's ring has radius 7).
 pub const MARKER_PX: i32 = 8;
 
@@ -78,10 +83,10 @@ pub const MARKER_PX: i32 = 8;
 pub fn merge(wanted: &[Wanted]) -> Vec<Wanted> {
     let mut groups: Vec<(Wanted, Vec<String>)> = Vec::new();
     for w in wanted {
-        let near = |a: (i32, i32)| {
-            (a.0 - w.anchor.0).abs() <= SAME_SPOT_PX && (a.1 - w.anchor.1).abs() <= SAME_SPOT_PX
-        };
-        match groups.iter_mut().find(|(g, _)| near(g.anchor)) {
+        match groups
+            .iter_mut()
+            .find(|(g, _)| same_spot(g.anchor, w.anchor))
+        {
             Some((_, texts)) => texts.push(w.text.clone()),
             None => groups.push((w.clone(), vec![w.text.clone()])),
         }
@@ -126,19 +131,17 @@ pub fn place(
     let mut placed: Vec<Placed> = Vec::new();
     for w in wanted {
         let (tw, th) = size(&w.text);
-        let own = |m: &(i32, i32)| {
-            (m.0 - w.anchor.0).abs() <= SAME_SPOT_PX && (m.1 - w.anchor.1).abs() <= SAME_SPOT_PX
-        };
         let blockers: Vec<Rect> = markers
             .iter()
-            .filter(|m| !own(m))
+            .filter(|&&m| !same_spot(m, w.anchor))
             .map(|&m| Rect::around(m, MARKER_PX))
             .chain(obstacles.iter().copied())
             .chain(placed.iter().map(|p| p.rect.grown(2)))
             .collect();
         let overlaps = |r: &Rect| blockers.iter().filter(|b| b.overlaps(r)).count();
+        let candidates = candidates(w.anchor, (tw, th));
         let mut best: Option<(usize, Rect, bool)> = None;
-        for (rect, away) in candidates(w.anchor, (tw, th)) {
+        for &(rect, away) in &candidates {
             if !rect.inside(&area) {
                 continue;
             }
@@ -151,10 +154,7 @@ pub fn place(
             }
         }
         // Nothing inside the plot at all (a label wider than it): next to the point.
-        let (rect, away) = best.map_or_else(
-            || (candidates(w.anchor, (tw, th))[0].0, false),
-            |(_, r, a)| (r, a),
-        );
+        let (rect, away) = best.map_or((candidates[0].0, false), |(_, r, a)| (r, a));
         placed.push(Placed {
             anchor: w.anchor,
             text: w.text.clone(),
