@@ -7,7 +7,7 @@ use glam::Vec3;
 use super::diag::{SceneError, list_and, short};
 use super::obj::{MeshPlacement, MeshRequest, add_mesh, file_stem};
 use super::resolve::{ResolveBytesFn, ResolveFn};
-use super::rules::check_camera;
+use super::rules::{MAX_COORDINATE, check_camera};
 use super::{
     Camera, DEFAULT_CREASE_ANGLE_DEG, Light, NormalsMode, Object, ObjectId, ObjectSource, Scene,
     Triangle,
@@ -56,9 +56,7 @@ pub(crate) fn load_obj_scene(
         SceneError(format!("{label}{at}: cannot load the OBJ: {}.", p.reason))
     })?;
     if added == 0 {
-        return Err(SceneError(format!(
-            "{label}: the OBJ has no triangles to show (it has no faces, or only degenerate ones)."
-        )));
+        return Err(SceneError(nothing_to_show(label, text)));
     }
     // A readable first look: a low ambient light, so that Blender's `Ka 1` does
     // not wash everything out, and such an ambient read as the diffuse colour.
@@ -616,4 +614,46 @@ fn morton_order(triangles: &[Triangle]) -> Vec<u32> {
         .collect();
     keyed.par_sort_unstable();
     keyed.into_iter().map(|k| k as u32).collect()
+}
+
+/// The error for an OBJ none of whose faces can be shown, saying why: no faces at all, or
+/// the first vertex (line and axis) that is not finite or lies beyond the scene-size limit,
+/// or else faces of zero area. Only called on that error, so it reads the text once more.
+fn nothing_to_show(label: &str, text: &str) -> String {
+    let lead = "the OBJ has no triangles to show";
+    let lines_of = |keyword: &'static str| {
+        text.lines().enumerate().filter_map(move |(i, l)| {
+            let mut words = l.split_whitespace();
+            (words.next() == Some(keyword)).then_some((i + 1, words))
+        })
+    };
+    let faces = lines_of("f").count();
+    if faces == 0 {
+        return format!("{label}: {lead}: it has no faces (`f` lines).");
+    }
+    let mut far = None;
+    for (line, words) in lines_of("v") {
+        for (axis, word) in ["x", "y", "z"].into_iter().zip(words) {
+            let Ok(x) = word.parse::<f32>() else { continue };
+            if !x.is_finite() {
+                return format!(
+                    "{label}:{line}: {lead}: vertex {axis} is `{word}`, not a finite 32-bit number, and every face is degenerate or uses such a vertex."
+                );
+            }
+            if far.is_none() && x.abs() > MAX_COORDINATE {
+                far = Some((line, axis, word.to_string()));
+            }
+        }
+    }
+    match far {
+        Some((line, axis, word)) => format!(
+            "{label}:{line}: {lead}: vertex {axis} is `{word}`, beyond ±1e15 (raytree's limit on scene size), and every face is degenerate or beyond it."
+        ),
+        None if faces == 1 => {
+            format!("{label}: {lead}: its one face has zero area or fewer than three corners.")
+        }
+        None => format!(
+            "{label}: {lead}: its {faces} faces all have zero area or fewer than three corners."
+        ),
+    }
 }
