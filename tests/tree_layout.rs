@@ -132,6 +132,41 @@ fn the_diagram_and_the_list_are_readable_at_common_sizes() {
     }
 }
 
+/// A deep tree in the narrow list of a small window keeps every ray label whole: the rows are
+/// indented less, not elided.
+#[test]
+fn a_deep_tree_keeps_its_ray_labels_whole_in_a_narrow_list() {
+    let mut scene = small("default");
+    scene.render.max_depth = 12;
+    let mut h = window(scene, [1024.0, 640.0]);
+    follow_pane(&mut h);
+    click_glass(&mut h);
+    show_tab(&mut h, "Tree list");
+    fn deepest(n: &raytree::ray_tree::Node) -> u32 {
+        n.children.iter().map(deepest).max().unwrap_or(n.depth)
+    }
+    let tree = h.state().selection.tree.clone().expect("a tree");
+    let depth = deepest(&tree.root);
+    assert!(depth >= 8, "the glass sphere's tree is only {depth} deep");
+    let cells = h.state().selection.tree_state.drawn.cells.clone();
+    assert!(
+        !cells.is_empty() && cells.len() % 3 == 0,
+        "{} list cells, not rows of three",
+        cells.len()
+    );
+    // Each row's first cell is its ray label ("T d9").
+    for (row, c) in cells.chunks(3).enumerate() {
+        let ray = &c[0];
+        assert!(
+            !ray.elided && ray.shown + 0.5 >= ray.full,
+            "row {row}'s ray label is cut to {:.0} of {:.0} pt in a {:.0} pt column",
+            ray.shown,
+            ray.full,
+            ray.column
+        );
+    }
+}
+
 /// Columns sized in a wide pane start again from their shares when the pane narrows, so the
 /// colour column stays in view.
 #[test]

@@ -950,8 +950,24 @@ pub fn detail(ui: &mut Ui, tree: &RayTree, path: &[usize]) {
 
 /// Height of a table row: one line of body text.
 const ROW_H: f32 = 20.0;
-/// Points a row is indented per generation in the list's first column.
+/// Points a row is indented per generation in the list's first column, when the deepest row
+/// leaves its label room; a deep tree in a narrow column is indented less, down to
+/// [`MIN_INDENT`], so that its labels stay whole.
 const INDENT: f32 = 10.0;
+/// The least indentation per generation: the generations still apart.
+const MIN_INDENT: f32 = 3.0;
+/// Width kept in the first column for the fold toggle (or the space in its place).
+const TOGGLE_W: f32 = 16.0;
+
+/// Indentation per generation in a first column `column` points wide whose deepest row is
+/// `deepest` generations down and whose widest label is `label` points.
+fn list_indent(column: f32, deepest: u32, label: f32) -> f32 {
+    if deepest == 0 {
+        return INDENT;
+    }
+    ((column - TOGGLE_W - label) / deepest as f32).clamp(MIN_INDENT, INDENT)
+}
+
 /// The colour of rows and values that differ from the other tree.
 const LIST_CHANGED: Color32 = Color32::from_rgb(255, 150, 50);
 
@@ -964,10 +980,9 @@ fn kind_name(kind: RayKind) -> &'static str {
     }
 }
 
-/// One cell's text, elided to its column with the full text on hover; recorded in `cells`.
-fn cell(ui: &mut Ui, text: RichText, cells: &mut Vec<Cell>) -> Response {
-    let column = ui.available_width();
-    let full = egui::WidgetText::from(text.clone())
+/// Width in points of `text` on one line in the body style.
+fn text_width(ui: &Ui, text: impl Into<egui::WidgetText>) -> f32 {
+    text.into()
         .into_galley(
             ui,
             Some(egui::TextWrapMode::Extend),
@@ -975,7 +990,13 @@ fn cell(ui: &mut Ui, text: RichText, cells: &mut Vec<Cell>) -> Response {
             egui::TextStyle::Body,
         )
         .size()
-        .x;
+        .x
+}
+
+/// One cell's text, elided to its column with the full text on hover; recorded in `cells`.
+fn cell(ui: &mut Ui, text: RichText, cells: &mut Vec<Cell>) -> Response {
+    let column = ui.available_width();
+    let full = text_width(ui, text.clone());
     let r = ui.add(egui::Label::new(text).truncate().selectable(false));
     cells.push(Cell {
         full,
@@ -1050,6 +1071,14 @@ pub fn tree_list(
     // splitter), the columns start again from their shares of it: widths kept from a wider
     // pane would push the colours out of a narrow one.
     let generation = resize_generation(ui, ("tree list width", salt), width);
+    // The deepest row and the widest label it can have set how far each generation is
+    // indented.
+    let deepest = list.iter().map(|(_, n)| n.depth).max().unwrap_or(0);
+    let label_w = [RayKind::Reflected, RayKind::Refracted, RayKind::Shadow]
+        .map(|k| format!("* {} d{deepest}", kind_name(k)))
+        .into_iter()
+        .map(|text| text_width(ui, text))
+        .fold(0.0, f32::max);
     TableBuilder::new(ui)
         .id_salt(("tree list", salt, generation))
         .striped(true)
@@ -1090,9 +1119,10 @@ pub fn tree_list(
                     row.set_selected(state.selected.as_ref() == Some(path));
                     row.set_hovered(state.hovered.as_ref() == Some(path));
                     row.col(|ui| {
-                        ui.add_space(node.depth as f32 * INDENT);
+                        let indent = list_indent(ui.available_width(), deepest, label_w);
+                        ui.add_space(node.depth as f32 * indent);
                         if node.children.is_empty() {
-                            ui.add_space(16.0);
+                            ui.add_space(TOGGLE_W);
                         } else {
                             let folded = state.is_folded(path);
                             let toggle = ui
