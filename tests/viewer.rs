@@ -352,6 +352,55 @@ fn drag(h: &mut Window, from: egui::Pos2, by: egui::Vec2, modifiers: egui::Modif
     h.step();
 }
 
+/// The scene view's picture follows the render camera where it shows it: the walls of a room
+/// cut away for where the render camera stands (out of the room none, back in the same ones
+/// again), and a headlight's light. A move with neither leaves the picture alone.
+#[test]
+fn the_scene_view_follows_the_render_camera_where_it_shows_it() {
+    use raytree::app::Command;
+    fn move_camera(h: &mut Window, position: glam::Vec3) {
+        h.state_mut().working.scene.camera.position = position;
+        h.state_mut().command(Command::MoveCamera);
+        h.step();
+        settle(h);
+    }
+    let mut h = harness(small("box"));
+    settle(&mut h);
+    let cut = h.state().scene_view.walls_cut();
+    assert!(cut > 0, "the box's near walls are not cut from outside it");
+    let inside = h.state().scene().camera.position;
+    let before = h.state().scene_view.generation();
+    move_camera(&mut h, glam::Vec3::new(0.0, 1.8, 40.0));
+    assert_eq!(
+        h.state().scene_view.walls_cut(),
+        0,
+        "walls stay cut with the render camera out of the room"
+    );
+    assert!(
+        h.state().scene_view.generation() > before,
+        "the view did not restart"
+    );
+    move_camera(&mut h, inside);
+    assert_eq!(h.state().scene_view.walls_cut(), cut);
+
+    for headlight in [false, true] {
+        let mut scene = small("default");
+        scene.lights[0].follow_camera = headlight;
+        scene.place_lights();
+        let mut h = harness(scene);
+        settle(&mut h);
+        let before = h.state().scene_view.generation();
+        let mut at = h.state().scene().camera.position;
+        at.x += 0.5;
+        move_camera(&mut h, at);
+        assert_eq!(
+            h.state().scene_view.generation() > before,
+            headlight,
+            "with a headlight {headlight}, the scene view's restart"
+        );
+    }
+}
+
 #[test]
 fn orbiting_the_scene_view_leaves_the_tree_and_the_render_unchanged() {
     let mut h = harness(small("default"));

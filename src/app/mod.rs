@@ -325,7 +325,9 @@ impl ViewerApp {
         let old = self.render.install(tracer.clone());
         // The trees follow the scene: re-traced with the new settings.
         self.selection.follow(&tracer, old);
-        if reach == Reach::RenderAndSceneView {
+        if reach == Reach::RenderAndSceneView
+            || self.scene_view.follows_render_camera(&tracer.scene)
+        {
             if let Err(e) = self.scene_view.set_threads(self.working.settings.threads) {
                 self.messages.error(e);
             }

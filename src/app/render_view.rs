@@ -26,8 +26,9 @@ pub const PANE_SIZE_DEBOUNCE: Duration = Duration::from_millis(250);
 /// Which views a new generation restarts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Reach {
-    /// The render only: the scene view's picture (which does not depend on the render
-    /// camera) stays.
+    /// The render only: the scene view's picture stays, unless it depends on the render
+    /// camera (a headlight, walls cut away around it: see
+    /// [`super::scene_pane::SceneView::follows_render_camera`]).
     Render,
     /// The render and the scene view.
     RenderAndSceneView,

@@ -16,7 +16,8 @@
 //! Inside a closed model (a room around the render camera) the view cuts away the walls
 //! between its eye and the render camera ([`crate::scene_view::cutaway`]): the session then
 //! renders a copy of the scene with those walls left out, rebuilt only when the walls cut
-//! change (and not during a drag, which keeps the last cut until the pointer lets go).
+//! change (and not during a drag, which keeps the last cut until the pointer lets go). The cut
+//! follows the render camera: a move of it restarts this view when the walls cut change.
 
 use std::sync::{Arc, Mutex, Weak};
 use std::time::{Duration, Instant};
@@ -78,9 +79,13 @@ pub struct SceneView {
     level_cache: Option<(Weak<Accel>, u32, Arc<LevelSegments>)>,
     /// When walls are cut away.
     pub cutaway: Cutaway,
-    /// The tracer of the scene with walls cut, the tracer it was cut from and which
-    /// triangles were cut: kept while the same walls are cut (most camera moves).
-    cut_cache: Option<(Weak<Tracer>, Vec<u32>, Arc<Tracer>)>,
+    /// The tracer of the scene with walls cut, the accelerator of the geometry it was cut
+    /// from and which triangles were cut: kept while the same walls of the same geometry are
+    /// cut (most camera moves, and edits of lights or materials, which take the cut geometry
+    /// and its accelerator into a tracer of the edited scene).
+    cut_cache: Option<(Weak<Accel>, Vec<u32>, Arc<Tracer>)>,
+    /// The triangles cut away in the picture shown (none when nothing is cut).
+    shown_cut: Vec<u32>,
     /// Whether the camera is being dragged: the cut then keeps its last walls.
     moving: bool,
 }
@@ -106,6 +111,7 @@ impl SceneView {
             level_cache: None,
             cutaway: Cutaway::Auto,
             cut_cache: None,
+            shown_cut: Vec::new(),
             moving: false,
         })
     }
@@ -203,33 +209,64 @@ impl SceneView {
         self.cutaway.active(scene, self.camera.position)
     }
 
+    /// Whether the picture shown would change with the render camera of `scene`: a
+    /// headlight moves with it, and so do the walls cut away when it steps into or about a
+    /// room. A move of the render camera alone restarts the view only then.
+    pub fn follows_render_camera(&self, scene: &Scene) -> bool {
+        if scene.lights.iter().any(|l| l.follow_camera) {
+            return true;
+        }
+        let walls = if self.cuts(scene) {
+            cut_triangles(scene, self.camera.position)
+        } else {
+            Vec::new()
+        };
+        walls != self.shown_cut
+    }
+
     /// The tracer the view renders: `tracer` itself, or one of its scene with the walls
     /// between this view's eye and the render camera cut away when the cut-away is active.
     fn view_tracer(&mut self, tracer: &Arc<Tracer>) -> Arc<Tracer> {
+        let (seen, walls) = self.cut_tracer(tracer);
+        self.shown_cut = walls;
+        seen
+    }
+
+    /// The tracer [`Self::view_tracer`] gives and the triangles it leaves out.
+    fn cut_tracer(&mut self, tracer: &Arc<Tracer>) -> (Arc<Tracer>, Vec<u32>) {
         if !self.cuts(&tracer.scene) {
-            return tracer.clone();
+            return (tracer.clone(), Vec::new());
         }
-        let same_source = |of: &Weak<Tracer>| std::ptr::eq(of.as_ptr(), Arc::as_ptr(tracer));
-        if self.moving
-            && let Some((of, _, cut)) = &self.cut_cache
-            && same_source(of)
-        {
-            return cut.clone();
-        }
-        let walls = cut_triangles(&tracer.scene, self.camera.position);
+        let same_source = |of: &Weak<Accel>| std::ptr::eq(of.as_ptr(), Arc::as_ptr(&tracer.accel));
+        let walls = match &self.cut_cache {
+            // A drag keeps the last walls cut.
+            Some((of, was, _)) if self.moving && same_source(of) => was.clone(),
+            _ => cut_triangles(&tracer.scene, self.camera.position),
+        };
         if walls.is_empty() {
-            return tracer.clone();
+            return (tracer.clone(), walls);
         }
-        if let Some((of, was, cut)) = &self.cut_cache
+        if let Some((of, was, cut)) = &mut self.cut_cache
             && same_source(of)
             && *was == walls
         {
-            return cut.clone();
+            // The same geometry, perhaps in an edited scene (camera, lights, materials): the
+            // cut triangles and their accelerator go into a tracer of it.
+            let scene = Scene {
+                triangles: cut.scene.triangles.clone(),
+                ..(*tracer.scene).clone()
+            };
+            *cut = Arc::new(Tracer::with_accel(
+                Arc::new(scene),
+                tracer.settings,
+                cut.accel.clone(),
+            ));
+            return (cut.clone(), walls);
         }
         let scene = Arc::new(with_cut(&tracer.scene, &walls));
         let cut = Arc::new(Tracer::new(scene, tracer.settings));
-        self.cut_cache = Some((Arc::downgrade(tracer), walls, cut.clone()));
-        cut
+        self.cut_cache = Some((Arc::downgrade(&tracer.accel), walls.clone(), cut.clone()));
+        (cut, walls)
     }
 
     /// Takes the tiles that arrived, within a time budget.
@@ -781,6 +818,16 @@ impl SceneView {
     /// Whether the view's render reached its samples (or stopped).
     pub fn is_finished(&self) -> bool {
         self.finished
+    }
+
+    /// How many triangles the picture shown leaves out (walls cut away).
+    pub fn walls_cut(&self) -> usize {
+        self.shown_cut.len()
+    }
+
+    /// The view's render generation: it grows with every restart.
+    pub fn generation(&self) -> u64 {
+        self.generation
     }
 }
 
