@@ -142,11 +142,8 @@ fn a_deep_tree_keeps_its_ray_labels_whole_in_a_narrow_list() {
     follow_pane(&mut h);
     click_glass(&mut h);
     show_tab(&mut h, "Tree list");
-    fn deepest(n: &raytree::ray_tree::Node) -> u32 {
-        n.children.iter().map(deepest).max().unwrap_or(n.depth)
-    }
     let tree = h.state().selection.tree.clone().expect("a tree");
-    let depth = deepest(&tree.root);
+    let depth = raytree::app::scene_pane::deepest([&tree]);
     assert!(depth >= 8, "the glass sphere's tree is only {depth} deep");
     let cells = h.state().selection.tree_state.drawn.cells.clone();
     assert!(
