@@ -75,6 +75,15 @@ fn quick_bench_writes_csv_and_charts() {
     );
     assert!(stdout.contains("Pareto-optimal settings"), "{stdout}");
     assert!(stdout.contains("0 differing pixels"), "{stdout}");
+    // One sentence per pair of accelerators, over the sizes both were run at.
+    for pair in [
+        "none against grid, 1–",
+        "none against bvh, 1–",
+        "grid against bvh, 1–",
+    ] {
+        assert_eq!(stdout.matches(pair).count(), 1, "{pair}: {stdout}");
+    }
+    assert!(stdout.contains("(level: "), "{stdout}");
 
     let (header, rows) = read_csv(&dir.path().join("bench.csv"));
     // Each knob is a column of its own too (the value every point was rendered with).
@@ -150,6 +159,8 @@ fn quick_bench_writes_csv_and_charts() {
             "accel",
             "build_secs",
             "render_secs",
+            "total_min_secs",
+            "total_max_secs",
             "memory_bytes",
             "note",
         ],
@@ -158,6 +169,10 @@ fn quick_bench_writes_csv_and_charts() {
         assert!(rows.iter().any(|r| r["accel"] == accel), "{accel}");
     }
     assert!(rows.iter().any(|r| num(r, "triangles") >= 8000.0));
+    for r in rows.iter().filter(|r| r["note"].is_empty()) {
+        let (min, max) = (num(r, "total_min_secs"), num(r, "total_max_secs"));
+        assert!(min > 0.0 && min <= max, "{r:?}");
+    }
     assert_chart(dir.path(), "scaling");
 }
 

@@ -137,6 +137,7 @@ pub fn run_bench(args: &BenchArgs) -> Result<()> {
         for line in report::crossover_lines(&points) {
             out!("  {line}");
         }
+        out!("  {}", report::level_note());
     }
     if !changed.is_empty() {
         bail!("an accelerator changed the image: {}", changed.join(", "));

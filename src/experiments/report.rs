@@ -6,7 +6,7 @@ use std::path::Path;
 use super::chart::{Chart, Series, SeriesStyle, write_chart};
 use super::measure::value_name;
 use super::pareto::same_image;
-use super::scaling::{ScalingOptions, ScalingPoint, crossovers};
+use super::scaling::{LEVEL_WITHIN, ScalingOptions, ScalingPoint, Verdict, crossovers};
 use super::sweep::{BenchPoint, BenchReport, Knob};
 use crate::accel::AccelKind;
 use crate::export::{ExportError, write_text};
@@ -125,16 +125,19 @@ pub fn bench_chart(report: &BenchReport, scene_name: &str) -> Chart {
 /// The scaling sweep as CSV.
 pub fn scaling_csv(points: &[ScalingPoint]) -> String {
     let mut s = String::from(
-        "triangles,accel,build_secs,render_secs,total_secs,memory_bytes,bytes_per_triangle,rays,note\n",
+        "triangles,accel,build_secs,render_secs,total_secs,total_min_secs,total_max_secs,\
+         memory_bytes,bytes_per_triangle,rays,note\n",
     );
     for p in points {
         s.push_str(&format!(
-            "{},{},{:.6},{:.6},{:.6},{},{:.1},{},{}\n",
+            "{},{},{:.6},{:.6},{:.6},{:.6},{:.6},{},{:.1},{},{}\n",
             p.triangles,
             value_name(&p.accel),
             p.build_secs,
             p.render_secs,
             p.total_secs(),
+            p.total_min_secs,
+            p.total_max_secs,
             p.memory_bytes,
             p.memory_bytes as f64 / p.triangles.max(1) as f64,
             p.rays,
@@ -205,27 +208,66 @@ pub fn pareto_lines(report: &BenchReport) -> Vec<String> {
         .collect()
 }
 
-/// The crossovers as sentences.
+/// The crossovers as sentences, one per pair of accelerators: which is faster over which
+/// sizes, differences within [`LEVEL_WITHIN`] or the runs' spread called level, and where the
+/// times cross. [`level_note`] says what level means.
 pub fn crossover_lines(points: &[ScalingPoint]) -> Vec<String> {
-    let smallest = points.iter().map(|p| p.triangles).min().unwrap_or(0);
     crossovers(points)
         .iter()
-        .map(|(first, other, changes)| {
-            let mut line = format!(
-                "{} is faster than {} at {smallest} triangles",
-                value_name(first),
-                value_name(other)
-            );
-            for c in changes {
-                line.push_str(&format!(
-                    "; {} is faster from about {:.0}",
-                    value_name(&c.faster),
-                    c.triangles
-                ));
-            }
-            line
+        .filter_map(|pair| {
+            let (first, last) = (pair.stretches.first()?, pair.stretches.last()?);
+            let whole = pair.stretches.len() == 1;
+            let parts: Vec<String> = pair
+                .stretches
+                .iter()
+                .map(|s| {
+                    let who = match s.verdict {
+                        Verdict::Faster(k) => format!("{} faster", value_name(&k)),
+                        Verdict::Level => "level".to_string(),
+                    };
+                    let span = if whole {
+                        "at every size".to_string()
+                    } else if s.from == s.to {
+                        format!("at {}", s.from)
+                    } else if s.to == last.to {
+                        format!("from {} on", s.from)
+                    } else {
+                        format!("from {} to {}", s.from, s.to)
+                    };
+                    let cross = s
+                        .crosses_at
+                        .map(|n| format!(" (the times cross at about {})", two_figures(n)))
+                        .unwrap_or_default();
+                    format!("{who} {span}{cross}")
+                })
+                .collect();
+            Some(format!(
+                "{} against {}, {}–{}: {}",
+                value_name(&pair.a),
+                value_name(&pair.b),
+                first.from,
+                crate::plural::count(last.to, "triangle"),
+                parts.join("; ")
+            ))
         })
         .collect()
+}
+
+/// What "level" means in [`crossover_lines`].
+pub fn level_note() -> String {
+    format!(
+        "(level: the runs' ranges overlap or the medians are within {:.0} %)",
+        LEVEL_WITHIN * 100.0
+    )
+}
+
+/// `x` rounded to two significant figures: an interpolated crossing is no more precise.
+fn two_figures(x: f64) -> u64 {
+    if !x.is_finite() || x <= 0.0 {
+        return 0;
+    }
+    let step = 10f64.powi((x.log10().floor() as i32 - 1).max(0));
+    ((x / step).round() * step) as u64
 }
 
 #[cfg(test)]
@@ -234,22 +276,40 @@ mod tests {
 
     #[test]
     fn one_crossover_line_per_pair_of_accelerators() {
-        // Seconds of none, grid and BVH at 10 and at 1000 triangles.
+        // Seconds of none, grid and BVH at 10, 1000 and 100 000 triangles (none not run there).
         let kinds = [AccelKind::None, AccelKind::Grid, AccelKind::Bvh];
-        let pts: Vec<ScalingPoint> = [(10, [1.0, 1.0, 2.0]), (1000, [4.0, 1.0, 2.0])]
-            .into_iter()
-            .flat_map(|(n, secs)| {
-                kinds
-                    .into_iter()
-                    .zip(secs)
-                    .map(move |(k, s)| ScalingPoint::timed(n, k, s))
-            })
-            .collect();
+        let pts: Vec<ScalingPoint> = [
+            (10, [1.0, 1.02, 2.0]),
+            (1000, [4.0, 1.0, 2.0]),
+            (100_000, [f64::NAN, 1.0, 0.5]),
+        ]
+        .into_iter()
+        .flat_map(|(n, secs)| {
+            kinds
+                .into_iter()
+                .zip(secs)
+                .filter(|(_, s)| !s.is_nan())
+                .map(move |(k, s)| ScalingPoint::timed(n, k, s))
+        })
+        .collect();
         let lines = crossover_lines(&pts);
-        assert_eq!(lines.len(), 3);
         assert_eq!(
-            lines[1],
-            "none is faster than bvh at 10 triangles; bvh is faster from about 100"
+            lines,
+            [
+                "none against grid, 10–1000 triangles: level at 10; grid faster at 1000",
+                "none against bvh, 10–1000 triangles: none faster at 10; \
+                 bvh faster at 1000 (the times cross at about 100)",
+                "grid against bvh, 10–100000 triangles: grid faster from 10 to 1000; \
+                 bvh faster at 100000 (the times cross at about 10000)",
+            ]
         );
+    }
+
+    #[test]
+    fn a_crossing_is_given_to_two_figures() {
+        assert_eq!(two_figures(1_289_774.0), 1_300_000);
+        assert_eq!(two_figures(15.4), 15);
+        assert_eq!(two_figures(1.03), 1);
+        assert_eq!(two_figures(987.0), 990);
     }
 }

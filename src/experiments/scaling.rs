@@ -1,6 +1,6 @@
 //! The accelerator scaling sweep: [`run_scaling`] times building and rendering a tessellated
-//! sphere of 1 to 2M triangles with each accelerator; [`crossovers`] finds where one becomes
-//! faster than another, which is what `AccelKind::Auto` uses.
+//! sphere of 1 to 2M triangles with each accelerator; [`crossovers`] says which is faster
+//! where, which is what `AccelKind::Auto` was set from.
 //!
 //! Like [`super::sweep`] it takes a progress callback and a cancel flag and returns plain data;
 //! the files and lines made of it are [`super::report`]'s.
@@ -70,8 +70,13 @@ impl ScalingOptions {
 pub struct ScalingPoint {
     pub triangles: usize,
     pub accel: AccelKind,
+    /// Medians of the runs.
     pub build_secs: f64,
     pub render_secs: f64,
+    /// The fastest and slowest run's build + render: the spread [`crossovers`] weighs a
+    /// difference against.
+    pub total_min_secs: f64,
+    pub total_max_secs: f64,
     /// The accelerator's own memory ([`crate::accel::Accel::memory_bytes`]).
     pub memory_bytes: usize,
     pub rays: u64,
@@ -92,10 +97,19 @@ impl ScalingPoint {
             accel,
             build_secs: 0.0,
             render_secs: secs,
+            total_min_secs: secs,
+            total_max_secs: secs,
             memory_bytes: 0,
             rays: 0,
             skipped: None,
         }
+    }
+
+    /// [`Self::timed`] with its runs spread from `min` to `max` seconds.
+    #[cfg(test)]
+    pub(super) fn spread(mut self, min: f64, max: f64) -> Self {
+        (self.total_min_secs, self.total_max_secs) = (min, max);
+        self
     }
 }
 
@@ -176,6 +190,8 @@ pub fn run_scaling(
                         accel: kind,
                         build_secs: 0.0,
                         render_secs: 0.0,
+                        total_min_secs: 0.0,
+                        total_max_secs: 0.0,
                         memory_bytes: 0,
                         rays: 0,
                         skipped: Some(format!(
@@ -188,6 +204,7 @@ pub fn run_scaling(
             }
             let mut builds = Vec::new();
             let mut renders = Vec::new();
+            let mut totals = Vec::new();
             let mut rays = 0;
             let mut memory = 0;
             for _ in 0..opts.runs.max(1) {
@@ -201,6 +218,7 @@ pub fn run_scaling(
                 let (_, stats) = render(&tracer, 1, opts.threads, &|_, _| {})?;
                 builds.push(stats.build_secs);
                 renders.push(stats.render_secs);
+                totals.push(stats.build_secs + stats.render_secs);
                 rays = stats.rays.total();
                 memory = tracer.accel.memory_bytes();
             }
@@ -209,6 +227,8 @@ pub fn run_scaling(
                 accel: kind,
                 build_secs: median(builds),
                 render_secs: median(renders),
+                total_min_secs: totals.iter().copied().fold(f64::INFINITY, f64::min),
+                total_max_secs: totals.iter().copied().fold(0.0, f64::max),
                 memory_bytes: memory,
                 rays,
                 skipped: None,
@@ -222,19 +242,43 @@ pub fn run_scaling(
     Ok(out)
 }
 
-/// A change of the faster accelerator between two sizes: from about `triangles` on, `faster`
-/// takes less time (build + render) than `slower`. The count is interpolated log-linearly
-/// between the two measured sizes around the change.
+/// Two accelerators count as level at a size when their medians are closer than this (as a
+/// share of the faster) or when the ranges of their runs overlap: a frame of a few
+/// milliseconds varies by tens of per cent between runs, so such a difference says nothing
+/// about which is faster.
+pub const LEVEL_WITHIN: f64 = 0.10;
+
+/// What one stretch of sizes says of a pair of accelerators.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct Crossover {
-    pub faster: AccelKind,
-    pub slower: AccelKind,
-    pub triangles: f64,
+pub enum Verdict {
+    /// This one took less time (build + render) by more than [`LEVEL_WITHIN`].
+    Faster(AccelKind),
+    /// The two were within [`LEVEL_WITHIN`] of each other, or their runs overlapped.
+    Level,
 }
 
-/// For the pairs none/grid, none/BVH and grid/BVH: which is faster at the smallest size
-/// measured, and every crossover after it, in order of size.
-pub fn crossovers(points: &[ScalingPoint]) -> Vec<(AccelKind, AccelKind, Vec<Crossover>)> {
+/// Consecutive measured sizes, `from` to `to` triangles, with one [`Verdict`]. `crosses_at` is
+/// set where the faster one changes straight from the other accelerator to this one: the count
+/// where the time ratio passes 1, interpolated log-linearly between the two sizes around it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Stretch {
+    pub verdict: Verdict,
+    pub from: usize,
+    pub to: usize,
+    pub crosses_at: Option<f64>,
+}
+
+/// Two accelerators compared over the sizes where both were measured, smallest first.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PairComparison {
+    pub a: AccelKind,
+    pub b: AccelKind,
+    pub stretches: Vec<Stretch>,
+}
+
+/// For the pairs none/grid, none/BVH and grid/BVH: which is faster where, size by size, with
+/// differences within [`LEVEL_WITHIN`] or within the runs' spread counted as level.
+pub fn crossovers(points: &[ScalingPoint]) -> Vec<PairComparison> {
     let pairs = [
         (AccelKind::None, AccelKind::Grid),
         (AccelKind::None, AccelKind::Bvh),
@@ -243,8 +287,8 @@ pub fn crossovers(points: &[ScalingPoint]) -> Vec<(AccelKind, AccelKind, Vec<Cro
     pairs
         .iter()
         .map(|&(a, b)| {
-            // (ln n, ln(t_b / t_a)) per size where both were measured.
-            let mut ratios: Vec<(f64, f64)> = Vec::new();
+            // (n, ln(t_b / t_a), runs overlap) per size where both were measured.
+            let mut ratios: Vec<(usize, f64, bool)> = Vec::new();
             for p in points
                 .iter()
                 .filter(|p| p.accel == a && p.skipped.is_none())
@@ -254,27 +298,50 @@ pub fn crossovers(points: &[ScalingPoint]) -> Vec<(AccelKind, AccelKind, Vec<Cro
                     .find(|q| q.accel == b && q.triangles == p.triangles && q.skipped.is_none())
                 {
                     let r = (q.total_secs().max(1e-9) / p.total_secs().max(1e-9)).ln();
-                    ratios.push(((p.triangles as f64).ln(), r));
+                    let overlap = p.total_min_secs <= q.total_max_secs
+                        && q.total_min_secs <= p.total_max_secs;
+                    ratios.push((p.triangles, r, overlap));
                 }
             }
-            let first_faster = match ratios.first() {
-                Some(&(_, r)) if r < 0.0 => b,
-                _ => a,
+            ratios.sort_by_key(|&(n, _, _)| n);
+            let level = (1.0 + LEVEL_WITHIN).ln();
+            let verdict = |r: f64, overlap: bool| {
+                if overlap || r.abs() < level {
+                    Verdict::Level
+                } else if r < 0.0 {
+                    Verdict::Faster(b)
+                } else {
+                    Verdict::Faster(a)
+                }
             };
-            let mut changes = Vec::new();
-            for w in ratios.windows(2) {
-                let ((x0, r0), (x1, r1)) = (w[0], w[1]);
-                if (r0 < 0.0) != (r1 < 0.0) {
-                    let f = r0 / (r0 - r1);
-                    let (faster, slower) = if r1 < 0.0 { (b, a) } else { (a, b) };
-                    changes.push(Crossover {
-                        faster,
-                        slower,
-                        triangles: (x0 + f * (x1 - x0)).exp(),
-                    });
+            let mut stretches: Vec<Stretch> = Vec::new();
+            let mut before: Option<(usize, f64)> = None;
+            for &(n, r, overlap) in &ratios {
+                let v = verdict(r, overlap);
+                match stretches.last_mut() {
+                    Some(last) if last.verdict == v => last.to = n,
+                    last => {
+                        let crosses_at = match (last.map(|l| l.verdict), before) {
+                            (Some(Verdict::Faster(_)), Some((n0, r0)))
+                                if v != Verdict::Level && (r0 < 0.0) != (r < 0.0) =>
+                            {
+                                let (x0, x1) = ((n0 as f64).ln(), (n as f64).ln());
+                                let f = r0 / (r0 - r);
+                                Some((x0 + f * (x1 - x0)).exp())
+                            }
+                            _ => None,
+                        };
+                        stretches.push(Stretch {
+                            verdict: v,
+                            from: n,
+                            to: n,
+                            crosses_at,
+                        });
+                    }
                 }
+                before = Some((n, r));
             }
-            (first_faster, if first_faster == a { b } else { a }, changes)
+            PairComparison { a, b, stretches }
         })
         .collect()
 }
@@ -284,31 +351,43 @@ mod tests {
     use super::*;
 
     #[test]
-    fn crossover_is_interpolated_between_sizes() {
+    fn crossover_is_interpolated_between_sizes_and_small_differences_are_level() {
         let p = ScalingPoint::timed;
         let pts = vec![
             p(10, AccelKind::None, 1.0),
-            p(10, AccelKind::Grid, 1.0),
+            p(10, AccelKind::Grid, 1.05),
             p(10, AccelKind::Bvh, 2.0),
             p(1000, AccelKind::None, 4.0),
             p(1000, AccelKind::Grid, 1.0),
             p(1000, AccelKind::Bvh, 2.0),
             p(100_000, AccelKind::Grid, 1.0),
             p(100_000, AccelKind::Bvh, 0.5),
+            // 30 % apart but the runs overlap: level.
+            p(200_000, AccelKind::Grid, 1.0).spread(0.9, 1.4),
+            p(200_000, AccelKind::Bvh, 1.3).spread(1.2, 1.5),
         ];
         let c = crossovers(&pts);
-        let (first, other, changes) = &c[1];
-        assert_eq!((*first, *other), (AccelKind::None, AccelKind::Bvh));
+        let none_bvh = &c[1];
+        assert_eq!((none_bvh.a, none_bvh.b), (AccelKind::None, AccelKind::Bvh));
+        assert_eq!(none_bvh.stretches.len(), 2, "{none_bvh:?}");
+        let (first, then) = (none_bvh.stretches[0], none_bvh.stretches[1]);
+        assert_eq!(first.verdict, Verdict::Faster(AccelKind::None));
+        assert_eq!((first.from, first.to, first.crosses_at), (10, 10, None));
+        assert_eq!(then.verdict, Verdict::Faster(AccelKind::Bvh));
         // ln ratio goes from ln 2 to −ln 2: halfway in log space, at 100.
-        assert_eq!(changes.len(), 1);
-        assert_eq!(changes[0].faster, AccelKind::Bvh);
-        assert!((changes[0].triangles - 100.0).abs() < 1e-6, "{changes:?}");
-        // Grid against BVH: grid first, BVH from 10 000 on (ln 2 to −ln 2 over 1e3…1e5).
-        let (first, _, changes) = &c[2];
-        assert_eq!(*first, AccelKind::Grid);
-        assert!(
-            (changes[0].triangles - 10_000.0).abs() < 1e-6,
-            "{changes:?}"
-        );
+        let at = then.crosses_at.expect("a crossing");
+        assert!((at - 100.0).abs() < 1e-6, "{then:?}");
+        // None against grid: 5 % apart at 10 is level, not a win; grid from 1000, no crossing.
+        let none_grid = &c[0].stretches;
+        assert_eq!(none_grid[0].verdict, Verdict::Level);
+        assert_eq!(none_grid[1].verdict, Verdict::Faster(AccelKind::Grid));
+        assert_eq!(none_grid[1].crosses_at, None);
+        // Grid against BVH: grid first (10 and 1000), BVH from about 10 000 on.
+        let grid_bvh = &c[2].stretches;
+        assert_eq!((grid_bvh[0].from, grid_bvh[0].to), (10, 1000));
+        let at = grid_bvh[1].crosses_at.expect("a crossing");
+        assert!((at - 10_000.0).abs() < 1e-6, "{grid_bvh:?}");
+        assert_eq!(grid_bvh[2].verdict, Verdict::Level, "{grid_bvh:?}");
+        assert_eq!(grid_bvh[2].from, 200_000);
     }
 }
