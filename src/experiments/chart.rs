@@ -290,6 +290,7 @@ where
     let mut colour_index = 0;
     // Every point's pixel, and the labels wanted at them.
     let mut markers: Vec<(i32, i32)> = Vec::new();
+    let mut lines: Vec<labels::Segment> = Vec::new();
     let mut wanted: Vec<labels::Wanted> = Vec::new();
     for s in &chart.series {
         let shown: Vec<(usize, (f64, f64))> = s
@@ -334,6 +335,9 @@ where
         }
         let first_marker = markers.len();
         markers.extend(points.iter().map(|p| cc.backend_coord(p)));
+        if s.style != SeriesStyle::Points {
+            lines.extend(markers[first_marker..].windows(2).map(|w| (w[0], w[1])));
+        }
         let labelled =
             shown
                 .iter()
@@ -352,7 +356,14 @@ where
         }
     }
     let (legend_at, legend_box) = legend_layout(chart, cc.plotting_area(), legend_position)?;
-    draw_labels(root, &wanted, &markers, legend_box, cc.plotting_area())?;
+    draw_labels(
+        root,
+        &wanted,
+        &markers,
+        &lines,
+        legend_box,
+        cc.plotting_area(),
+    )?;
     cc.configure_series_labels()
         .position(legend_at)
         .background_style(WHITE.mix(0.85))
@@ -396,12 +407,13 @@ fn legend_layout<DB: DrawingBackend, CT: CoordTranslate>(
 }
 
 /// The point labels, merged where points share a spot and placed clear of one another, of the
-/// markers and of the legend ([`labels::place`]), with a grey leader line where a label had
+/// markers, of the legend and where they can of the series' lines ([`labels::place`]), with a grey leader line where a label had
 /// to move away from its point.
 fn draw_labels<DB: DrawingBackend, CT: CoordTranslate>(
     root: &DrawingArea<DB, Shift>,
     wanted: &[labels::Wanted],
     markers: &[(i32, i32)],
+    lines: &[labels::Segment],
     legend: labels::Rect,
     area: &DrawingArea<DB, CT>,
 ) -> Result<(), String> {
@@ -424,7 +436,7 @@ fn draw_labels<DB: DrawingBackend, CT: CoordTranslate>(
         y1: ys.end,
     };
     let merged = labels::merge(wanted);
-    for p in labels::place(&merged, size, markers, &[legend], plot) {
+    for p in labels::place(&merged, size, markers, &[legend], lines, plot) {
         if let Some(end) = p.leader_to {
             // From the marker's edge, not its centre, so the point stays readable.
             let (dx, dy) = ((end.0 - p.anchor.0) as f64, (end.1 - p.anchor.1) as f64);

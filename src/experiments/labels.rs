@@ -1,8 +1,9 @@
 //! Where a chart's point labels go ([`place`]): beside their points, clear of one another, of
 //! every other point's marker and of the legend, inside the plot. Labels of points that fall
 //! on one spot become one label ([`merge`]); a label with no room next to its point moves
-//! further out along one of eight directions and gets a leader line back to it. Pixel
-//! coordinates throughout, `y` down.
+//! further out along one of eight directions and gets a leader line back to it. A label
+//! also keeps off the series' lines where it can: crossing a line is allowed only where every
+//! other place is worse. Pixel coordinates throughout, `y` down.
 
 /// A pixel rectangle, `[x0, x1) × [y0, y1)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -41,11 +42,45 @@ impl Rect {
         }
     }
 
+    /// Whether the segment from `a` to `b` passes through the rectangle (Liang–Barsky
+    /// clipping against its four sides).
+    pub fn crossed_by(&self, (a, b): Segment) -> bool {
+        let (x0, y0) = (a.0 as f64, a.1 as f64);
+        let (dx, dy) = ((b.0 - a.0) as f64, (b.1 - a.1) as f64);
+        let (mut t0, mut t1) = (0.0f64, 1.0f64);
+        for (p, q) in [
+            (-dx, x0 - self.x0 as f64),
+            (dx, (self.x1 - 1) as f64 - x0),
+            (-dy, y0 - self.y0 as f64),
+            (dy, (self.y1 - 1) as f64 - y0),
+        ] {
+            if p == 0.0 {
+                if q < 0.0 {
+                    return false;
+                }
+            } else {
+                let t = q / p;
+                if p < 0.0 {
+                    t0 = t0.max(t);
+                } else {
+                    t1 = t1.min(t);
+                }
+                if t0 > t1 {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
     /// The point of the rectangle nearest to `p`.
     fn nearest(&self, (x, y): (i32, i32)) -> (i32, i32) {
         (x.clamp(self.x0, self.x1 - 1), y.clamp(self.y0, self.y1 - 1))
     }
 }
+
+/// A straight piece of a series' line, between two of its points' pixels.
+pub type Segment = ((i32, i32), (i32, i32));
 
 /// A label wanted at a point (its pixel).
 #[derive(Clone, Debug, PartialEq)]
@@ -116,16 +151,18 @@ pub fn merge(wanted: &[Wanted]) -> Vec<Wanted> {
 /// Where each label goes, in the order given (put the most important first: earlier labels
 /// get the places next to their points). `size(text)` is a text's width and height in pixels;
 /// `markers` are every point's pixel (a label covers none but its own); `obstacles` are
-/// further boxes to keep clear (the legend); `area` is the plot. Each label takes the first
-/// candidate that is inside `area` and clear of everything placed so far, trying the eight
-/// places next to its point, then the eight directions at growing distances (with a leader
-/// line); where none is clear it takes the candidate inside `area` with the fewest overlaps,
-/// so every label is drawn.
+/// further boxes to keep clear (the legend); `lines` are the series' lines; `area` is the
+/// plot. Each label takes the first candidate that is inside `area` and clear of everything
+/// placed so far and of the lines, trying the eight places next to its point, then the eight
+/// directions at growing distances (with a leader line); where none is clear it takes the
+/// candidate inside `area` that covers the fewest boxes and, of those, crosses the fewest
+/// lines, so every label is drawn.
 pub fn place(
     wanted: &[Wanted],
     size: impl Fn(&str) -> (i32, i32),
     markers: &[(i32, i32)],
     obstacles: &[Rect],
+    lines: &[Segment],
     area: Rect,
 ) -> Vec<Placed> {
     let mut placed: Vec<Placed> = Vec::new();
@@ -138,7 +175,12 @@ pub fn place(
             .chain(obstacles.iter().copied())
             .chain(placed.iter().map(|p| p.rect.grown(2)))
             .collect();
-        let overlaps = |r: &Rect| blockers.iter().filter(|b| b.overlaps(r)).count();
+        // Boxes covered weigh more than any number of lines crossed.
+        let overlaps = |r: &Rect| {
+            let grown = r.grown(1);
+            blockers.iter().filter(|b| b.overlaps(r)).count() * 10_000
+                + lines.iter().filter(|&&l| grown.crossed_by(l)).count()
+        };
         let candidates = candidates(w.anchor, (tw, th));
         let mut best: Option<(usize, Rect, bool)> = None;
         for &(rect, away) in &candidates {
@@ -174,7 +216,8 @@ fn candidates((ax, ay): (i32, i32), (w, h): (i32, i32)) -> Vec<(Rect, bool)> {
         x1: x0 + w,
         y1: y0 + h,
     };
-    let gap = MARKER_PX - 1;
+    // Clear of the point's own ring (radius 7, 2 pixels wide) by a pixel.
+    let gap = MARKER_PX + 1;
     // Next to the point: above right (where a reader looks first), below right, above left,
     // below left, above, below, right, left.
     let mut out = vec![
@@ -293,7 +336,7 @@ mod tests {
             .zip(texts)
             .map(|(&p, t)| wanted(p, t))
             .collect();
-        let placed = place(&w, size, &points, &[legend], AREA);
+        let placed = place(&w, size, &points, &[legend], &[], AREA);
         assert_eq!(placed.len(), texts.len(), "every label is drawn");
         for (i, p) in placed.iter().enumerate() {
             assert_eq!(p.text, texts[i]);
@@ -327,8 +370,55 @@ mod tests {
     #[test]
     fn a_label_at_the_plot_edge_turns_inwards() {
         let p = (795, 3);
-        let placed = place(&[wanted(p, "samples 64")], size, &[p], &[], AREA);
+        let placed = place(&[wanted(p, "samples 64")], size, &[p], &[], &[], AREA);
         assert!(placed[0].rect.inside(&AREA));
         assert_eq!(placed[0].leader_to, None, "room next to it, below left");
+    }
+
+    #[test]
+    fn a_segment_crosses_a_box_only_where_it_passes_through() {
+        let r = Rect {
+            x0: 10,
+            y0: 10,
+            x1: 20,
+            y1: 20,
+        };
+        assert!(r.crossed_by(((0, 15), (30, 15))), "straight across");
+        assert!(r.crossed_by(((12, 12), (14, 14))), "inside");
+        assert!(r.crossed_by(((0, 0), (30, 30))), "the diagonal");
+        assert!(!r.crossed_by(((0, 25), (30, 25))), "below");
+        assert!(!r.crossed_by(((0, 12), (8, 0))), "beside a corner");
+        assert!(!r.crossed_by(((22, 0), (22, 30))), "right of it");
+        assert!(!r.crossed_by(((0, 9), (9, 0))), "past the corner");
+    }
+
+    #[test]
+    fn a_label_keeps_off_its_own_series_lines() {
+        // A point with its line leaving up-right and down-right, as a series' corner: the
+        // two right-hand places are crossed, so the label goes left, still next to it.
+        let p = (400, 250);
+        let lines = [(p, (500, 150)), (p, (500, 350))];
+        let placed = place(&[wanted(p, "max_depth 1")], size, &[p], &[], &lines, AREA);
+        let r = placed[0].rect;
+        assert_eq!(placed[0].leader_to, None, "{r:?}");
+        assert!(r.x1 <= p.0, "{r:?}");
+        for l in lines {
+            assert!(!r.crossed_by(l), "{r:?} crosses {l:?}");
+        }
+        // Where every place is crossed, the label is still drawn next to its point.
+        let star: Vec<Segment> = (0..16)
+            .map(|i| {
+                let a = i as f64 * std::f64::consts::TAU / 16.0;
+                (
+                    p,
+                    (
+                        p.0 + (300.0 * a.cos()) as i32,
+                        p.1 + (300.0 * a.sin()) as i32,
+                    ),
+                )
+            })
+            .collect();
+        let placed = place(&[wanted(p, "samples 4")], size, &[p], &[], &star, AREA);
+        assert!(placed[0].rect.inside(&AREA));
     }
 }
