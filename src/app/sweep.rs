@@ -409,7 +409,7 @@ impl SweepWindow {
             }
         };
         Plot::new("sweep")
-            .legend(Legend::default())
+            .legend(Legend::default().position(legend_corner(report)))
             .x_axis_label("time per image (log scale)")
             .y_axis_label("mean FLIP error (log scale)")
             .x_grid_spacer(log_ticks)
@@ -460,6 +460,36 @@ impl SweepWindow {
                 }
             });
         chosen
+    }
+}
+
+/// The corner of the plot where its legend (about 0.4 of the plot's width and 0.55 of its
+/// height, with the nine series' names) covers the fewest points.
+fn legend_corner(report: &BenchReport) -> egui_plot::Corner {
+    use crate::experiments::chart::{Corner, emptiest_corner};
+    let pts: Vec<[f64; 2]> = report
+        .points
+        .iter()
+        .map(|p| [log(p.secs), log(p.error.mean_flip)])
+        .filter(|p| p[0].is_finite() && p[1].is_finite())
+        .collect();
+    let span = |k: usize| {
+        let lo = pts.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
+        let hi = pts.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
+        // The plot's own margin about its data, as egui_plot bounds it.
+        let pad = 0.05 * (hi - lo).max(1e-9);
+        (lo - pad, hi + pad)
+    };
+    let ((x0, x1), (y0, y1)) = (span(0), span(1));
+    let shares: Vec<(f64, f64)> = pts
+        .iter()
+        .map(|p| ((p[0] - x0) / (x1 - x0), (p[1] - y0) / (y1 - y0)))
+        .collect();
+    match emptiest_corner(&shares, (0.4, 0.55)) {
+        Corner::UpperRight => egui_plot::Corner::RightTop,
+        Corner::UpperLeft => egui_plot::Corner::LeftTop,
+        Corner::LowerRight => egui_plot::Corner::RightBottom,
+        Corner::LowerLeft => egui_plot::Corner::LeftBottom,
     }
 }
 

@@ -208,8 +208,46 @@ fn drawable(chart: &Chart, p: &(f64, f64)) -> bool {
     p.0.is_finite() && p.1.is_finite() && (!chart.x_log || p.0 > 0.0) && (!chart.y_log || p.1 > 0.0)
 }
 
-/// The corner of the plot where the legend covers the fewest points (upper right on a tie,
-/// then upper left, lower right, lower left).
+/// A corner of a plot, for its legend.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Corner {
+    UpperRight,
+    UpperLeft,
+    LowerRight,
+    LowerLeft,
+}
+
+/// The corner where a legend of `size` (its width and height as shares of the plot's) covers
+/// the fewest of `points` (each as shares of the plot's width and height from the lower left,
+/// 0 to 1): upper right on a tie, then upper left, lower right, lower left. Both the exported
+/// charts and the viewer's plot place their legend so.
+pub fn emptiest_corner(points: &[(f64, f64)], (w, h): (f64, f64)) -> Corner {
+    let corners = [
+        (Corner::UpperRight, true, true),
+        (Corner::UpperLeft, false, true),
+        (Corner::LowerRight, true, false),
+        (Corner::LowerLeft, false, false),
+    ];
+    let covered = |right: bool, upper: bool| {
+        points
+            .iter()
+            .filter(|&&(px, py)| {
+                (if right { px >= 1.0 - w } else { px <= w })
+                    && (if upper { py >= 1.0 - h } else { py <= h })
+            })
+            .count()
+    };
+    let mut best = (Corner::UpperRight, usize::MAX);
+    for (corner, right, upper) in corners {
+        let n = covered(right, upper);
+        if n < best.1 {
+            best = (corner, n);
+        }
+    }
+    best.0
+}
+
+/// The corner of the plot where the legend covers the fewest points ([`emptiest_corner`]).
 fn legend_corner(chart: &Chart, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPosition {
     // Where a value falls along an axis, 0 to 1.
     let along = |v: f64, (lo, hi): (f64, f64), log: bool| {
@@ -227,30 +265,12 @@ fn legend_corner(chart: &Chart, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPosi
         .map(|p| (along(p.0, x, chart.x_log), along(p.1, y, chart.y_log)))
         .collect();
     // The legend box is about this much of the plot's width and height.
-    let (w, h) = (0.4, 0.35);
-    let corners = [
-        (SeriesLabelPosition::UpperRight, true, true),
-        (SeriesLabelPosition::UpperLeft, false, true),
-        (SeriesLabelPosition::LowerRight, true, false),
-        (SeriesLabelPosition::LowerLeft, false, false),
-    ];
-    let covered = |right: bool, upper: bool| {
-        points
-            .iter()
-            .filter(|&&(px, py)| {
-                (if right { px >= 1.0 - w } else { px <= w })
-                    && (if upper { py >= 1.0 - h } else { py <= h })
-            })
-            .count()
-    };
-    let mut best = (SeriesLabelPosition::UpperRight, usize::MAX);
-    for (position, right, upper) in corners {
-        let n = covered(right, upper);
-        if n < best.1 {
-            best = (position, n);
-        }
+    match emptiest_corner(&points, (0.4, 0.35)) {
+        Corner::UpperRight => SeriesLabelPosition::UpperRight,
+        Corner::UpperLeft => SeriesLabelPosition::UpperLeft,
+        Corner::LowerRight => SeriesLabelPosition::LowerRight,
+        Corner::LowerLeft => SeriesLabelPosition::LowerLeft,
     }
-    best.0
 }
 
 fn plot<DB, X, Y>(
@@ -498,6 +518,24 @@ mod tests {
             corner(&high),
             SeriesLabelPosition::LowerRight | SeriesLabelPosition::LowerLeft
         ));
+    }
+
+    #[test]
+    fn the_emptiest_corner_is_the_one_with_fewest_points_under_a_legend_of_its_size() {
+        // A sweep's shape: a cluster upper left, a front falling to the lower right.
+        let mut points = vec![
+            (0.05, 0.95),
+            (0.1, 0.8),
+            (0.12, 0.7),
+            (0.3, 0.7),
+            (0.45, 0.7),
+        ];
+        points.extend((0..6).map(|i| (0.5 + 0.1 * i as f64, 0.6 - 0.1 * i as f64)));
+        // A short legend fits in the upper right; a tall one (the viewer's nine series) would
+        // reach down to the front there, and goes lower left.
+        assert_eq!(emptiest_corner(&points, (0.4, 0.35)), Corner::UpperRight);
+        assert_eq!(emptiest_corner(&points, (0.4, 0.55)), Corner::LowerLeft);
+        assert_eq!(emptiest_corner(&[], (0.4, 0.55)), Corner::UpperRight);
     }
 
     #[test]
