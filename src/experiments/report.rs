@@ -108,7 +108,7 @@ pub fn bench_chart(report: &BenchReport, scene_name: &str) -> Chart {
     series.push(Series::new("Pareto front", front).styled(SeriesStyle::Front, labels));
     Chart {
         title: format!(
-            "{scene_name}: error against time ({}x{}, reference {} spp, depth {})",
+            "{scene_name}: error against time ({}×{}, reference {} spp, depth {})",
             report.reference.width,
             report.reference.height,
             report.reference.samples,
@@ -174,7 +174,7 @@ pub fn scaling_chart(points: &[ScalingPoint], width: u32, height: u32) -> Chart 
         }
     }
     Chart {
-        title: format!("Tessellated sphere, {width}x{height}, 1 spp: time against triangle count"),
+        title: format!("Tessellated sphere, {width}×{height}, 1 spp: time against triangle count"),
         x_label: "triangles".into(),
         y_label: "seconds".into(),
         x_log: true,
