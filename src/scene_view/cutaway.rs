@@ -249,8 +249,8 @@ fn kept_whole(scene: &Scene) -> Vec<bool> {
 }
 
 /// The indices of the triangles of `scene` cut away for a view from `eye`, in order: those
-/// between the eye and the inside ([`is_cut`]), except the faces of solid things standing
-/// apart from the render camera ([`kept_whole`]).
+/// between the eye and the inside (the module's first rule), except the faces of solid things
+/// standing apart from the render camera ([`SOLID_SHARE`]).
 pub fn cut_triangles(scene: &Scene, eye: Vec3) -> Vec<u32> {
     let camera = scene.camera.position;
     let mut kept: Option<Vec<bool>> = None;
