@@ -225,28 +225,37 @@ pub fn crossover_lines(points: &[ScalingPoint]) -> Vec<String> {
                         Verdict::Faster(k) => format!("{} faster", value_name(&k)),
                         Verdict::Level => "level".to_string(),
                     };
-                    let span = if whole {
-                        "at every size".to_string()
+                    let span = if first.from == last.to {
+                        String::new()
+                    } else if whole {
+                        " at every size".to_string()
                     } else if s.from == s.to {
-                        format!("at {}", s.from)
+                        format!(" at {}", s.from)
                     } else if s.to == last.to {
-                        format!("from {} on", s.from)
+                        format!(" from {} on", s.from)
                     } else {
-                        format!("from {} to {}", s.from, s.to)
+                        format!(" from {} to {}", s.from, s.to)
                     };
                     let cross = s
                         .crosses_at
                         .map(|n| format!(" (the times cross at about {})", two_figures(n)))
                         .unwrap_or_default();
-                    format!("{who} {span}{cross}")
+                    format!("{who}{span}{cross}")
                 })
                 .collect();
+            let sizes = if first.from == last.to {
+                crate::plural::count(last.to, "triangle")
+            } else {
+                format!(
+                    "{}–{}",
+                    first.from,
+                    crate::plural::count(last.to, "triangle")
+                )
+            };
             Some(format!(
-                "{} against {}, {}–{}: {}",
+                "{} against {}, {sizes}: {}",
                 value_name(&pair.a),
                 value_name(&pair.b),
-                first.from,
-                crate::plural::count(last.to, "triangle"),
                 parts.join("; ")
             ))
         })
@@ -302,6 +311,18 @@ mod tests {
                 "grid against bvh, 10–100000 triangles: grid faster from 10 to 1000; \
                  bvh faster at 100000 (the times cross at about 10000)",
             ]
+        );
+    }
+
+    #[test]
+    fn one_size_is_named_once() {
+        let pts = [
+            ScalingPoint::timed(1, AccelKind::None, 1.0),
+            ScalingPoint::timed(1, AccelKind::Bvh, 3.0),
+        ];
+        assert_eq!(
+            crossover_lines(&pts),
+            ["none against bvh, 1 triangle: none faster"]
         );
     }
 
