@@ -42,35 +42,15 @@ impl Rect {
         }
     }
 
-    /// Whether the segment from `a` to `b` passes through the rectangle (Liang–Barsky
-    /// clipping against its four sides).
+    /// Whether the segment from `a` to `b` passes through the rectangle (clipped as the scene
+    /// view clips its rays to the image).
     pub fn crossed_by(&self, (a, b): Segment) -> bool {
-        let (x0, y0) = (a.0 as f64, a.1 as f64);
-        let (dx, dy) = ((b.0 - a.0) as f64, (b.1 - a.1) as f64);
-        let (mut t0, mut t1) = (0.0f64, 1.0f64);
-        for (p, q) in [
-            (-dx, x0 - self.x0 as f64),
-            (dx, (self.x1 - 1) as f64 - x0),
-            (-dy, y0 - self.y0 as f64),
-            (dy, (self.y1 - 1) as f64 - y0),
-        ] {
-            if p == 0.0 {
-                if q < 0.0 {
-                    return false;
-                }
-            } else {
-                let t = q / p;
-                if p < 0.0 {
-                    t0 = t0.max(t);
-                } else {
-                    t1 = t1.min(t);
-                }
-                if t0 > t1 {
-                    return false;
-                }
-            }
-        }
-        true
+        let at = |(x, y): (i32, i32)| glam::Vec2::new((x - self.x0) as f32, (y - self.y0) as f32);
+        let (w, h) = (
+            (self.x1 - 1 - self.x0) as f32,
+            (self.y1 - 1 - self.y0) as f32,
+        );
+        crate::scene_view::occlusion::clip_to_rect(at(a), at(b), w, h).is_some()
     }
 
     /// The point of the rectangle nearest to `p`.
