@@ -557,3 +557,52 @@ fn a_wide_model_fills_the_frame_and_nothing_is_cut_off() {
         "cut off at the top or bottom"
     );
 }
+
+/// A Blender export with many materials (a city of 40, say) names them in one short sentence:
+/// "all N materials" when every one had `Ka 1`, five names and a count when most did.
+#[test]
+fn many_blender_materials_make_one_short_warning() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut obj = String::from("mtllib city.mtl\n");
+    let mut base = 0;
+    for i in 0..12 {
+        obj += &format!("usemtl m{i}\n");
+        let x = 2.0 * i as f32;
+        cuboid(
+            &mut obj,
+            &mut base,
+            Vec3::new(x, 0.0, 0.0),
+            Vec3::new(x + 1.0, 1.0 + i as f32, 1.0),
+            false,
+            &[],
+        );
+    }
+    let blender = |i: usize, ka: f32| {
+        format!(
+            "newmtl m{i}\nKa {ka} {ka} {ka}\nKd 0.8 0.8 0.8\nKs 0.5 0.5 0.5\nNs 225\nillum 2\n\n"
+        )
+    };
+    for (name, plain) in [("all.obj", None), ("most.obj", Some(3))] {
+        let mtl: String = (0..12)
+            .map(|i| blender(i, if Some(i) == plain { 0.0 } else { 1.0 }))
+            .collect();
+        std::fs::write(dir.path().join("city.mtl"), mtl).expect("write");
+        let scene = load(dir.path(), name, &obj);
+        let warning = scene
+            .warnings
+            .iter()
+            .find(|w| w.contains("`Ka 1`"))
+            .unwrap_or_else(|| panic!("{name}: no `Ka 1` warning in {:?}", scene.warnings));
+        let expected = if plain.is_none() {
+            "`Ka 1` (Blender's default) in all 12 materials taken as"
+        } else {
+            "`Ka 1` (Blender's default) in `m0`, `m1`, `m2`, `m4`, `m5` and 6 more taken as"
+        };
+        assert!(warning.contains(expected), "{name}: {warning}");
+        assert_eq!(
+            material(&scene, "/m11").ambient,
+            material(&scene, "/m11").diffuse,
+            "{name}: the last material is washed too"
+        );
+    }
+}

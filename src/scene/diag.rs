@@ -114,9 +114,39 @@ pub(crate) fn list_and(items: &[String]) -> String {
     }
 }
 
+/// How many names a warning spells out before it counts the rest.
+const NAMED_AT_MOST: usize = 5;
+
+/// Like [`list_and`], but past [`NAMED_AT_MOST`] items the rest are counted, so that a
+/// warning about a file with forty materials stays one readable sentence:
+/// `a`, `b`, `c`, `d`, `e` and 35 more.
+pub(crate) fn list_some(items: &[String]) -> String {
+    if items.len() <= NAMED_AT_MOST {
+        return list_and(items);
+    }
+    let mut named = items[..NAMED_AT_MOST].to_vec();
+    named.push(format!("{} more", items.len() - NAMED_AT_MOST));
+    list_and(&named)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn long_lists_name_five_and_count_the_rest() {
+        let names = |n: usize| (1..=n).map(|i| format!("`m{i}`")).collect::<Vec<_>>();
+        assert_eq!(list_some(&names(1)), "`m1`");
+        assert_eq!(
+            list_some(&names(5)),
+            "`m1`, `m2`, `m3`, `m4` and `m5`",
+            "five are all named"
+        );
+        assert_eq!(
+            list_some(&names(40)),
+            "`m1`, `m2`, `m3`, `m4`, `m5` and 35 more"
+        );
+    }
 
     #[test]
     fn line_col_counts_characters_from_one() {

@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 
-use super::diag::{SceneError, list_and, short};
+use super::diag::{SceneError, list_some, short};
 use super::obj::{MeshPlacement, MeshRequest, add_mesh, file_stem};
 use super::resolve::{ResolveBytesFn, ResolveFn};
 use super::rules::{MAX_COORDINATE, check_camera};
@@ -61,17 +61,28 @@ pub(crate) fn load_obj_scene(
     // A readable first look: a low ambient light, so that Blender's `Ka 1` does
     // not wash everything out, and such an ambient read as the diffuse colour.
     scene.render.ambient_light = Vec3::splat(BARE_OBJ_AMBIENT);
+    let prefix = format!("{name}/");
+    let own = scene
+        .materials
+        .iter()
+        .filter(|m| m.name.starts_with(&prefix))
+        .count();
     let mut washed = Vec::new();
     for m in &mut scene.materials {
-        if m.ambient == Vec3::ONE && m.name.starts_with(&format!("{name}/")) {
+        if m.ambient == Vec3::ONE && m.name.starts_with(&prefix) {
             m.ambient = m.diffuse;
-            washed.push(format!("`{}`", short(&m.name[name.len() + 1..])));
+            washed.push(format!("`{}`", short(&m.name[prefix.len()..])));
         }
     }
     if !washed.is_empty() {
+        // Blender writes `Ka 1` on every material: "all 40 materials" says more than forty names.
+        let which = if washed.len() == own && own > 2 {
+            format!("all {own} materials")
+        } else {
+            list_some(&washed)
+        };
         scene.warnings.push(format!(
-            "{label}: `Ka 1` (Blender's default) in {} taken as the diffuse colour `Kd`, under an ambient light of {BARE_OBJ_AMBIENT}.",
-            list_and(&washed)
+            "{label}: `Ka 1` (Blender's default) in {which} taken as the diffuse colour `Kd`, under an ambient light of {BARE_OBJ_AMBIENT}."
         ));
     }
     // A material black in every colour it shows (`Kd 0` and `Ka 0` without a texture, neither
@@ -86,10 +97,10 @@ pub(crate) fn load_obj_scene(
             && m.ambient_map.is_none()
             && m.reflectivity == Vec3::ZERO
             && m.transparency == Vec3::ZERO;
-        if shows_nothing && m.name.starts_with(&format!("{name}/")) {
+        if shows_nothing && m.name.starts_with(&prefix) {
             m.diffuse = grey.diffuse;
             m.ambient = grey.diffuse;
-            black.push(format!("`{}`", short(&m.name[name.len() + 1..])));
+            black.push(format!("`{}`", short(&m.name[prefix.len()..])));
         }
     }
     if !black.is_empty() {
@@ -98,7 +109,7 @@ pub(crate) fn load_obj_scene(
             if black.len() == 1 {
                 format!("material {} is", black[0])
             } else {
-                format!("materials {} are", list_and(&black))
+                format!("materials {} are", list_some(&black))
             }
         ));
     }

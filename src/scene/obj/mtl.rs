@@ -12,7 +12,7 @@ use super::maps::load_texture;
 use super::parse::Facts;
 use super::paths::sibling;
 use super::request::MeshRequest;
-use crate::scene::diag::{list_and, short, short_path};
+use crate::scene::diag::{list_some, short, short_path};
 use crate::scene::{Material, MaterialId, Scene};
 
 /// The material libraries (`mtllib`) of one OBJ as tobj asks for them: each read next to the
@@ -137,18 +137,10 @@ pub(super) fn warn_unknown_usemtl(
         .filter(|name| !known.iter().any(|m| m.name == *name))
         .collect();
     if !unknown.is_empty() {
-        // A handful of names, so that the warning stays one readable sentence.
-        let mut names: Vec<String> = unknown
-            .iter()
-            .take(5)
-            .map(|n| format!("`{}`", short(n)))
-            .collect();
-        if unknown.len() > 5 {
-            names.push(format!("{} more", unknown.len() - 5));
-        }
+        let names: Vec<String> = unknown.iter().map(|n| format!("`{}`", short(n))).collect();
         warnings.push(format!(
             "{label}: `usemtl` names materials that no material library defines ({}); their faces use the default material.",
-            list_and(&names)
+            list_some(&names)
         ));
     }
 }
