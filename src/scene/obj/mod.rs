@@ -15,6 +15,7 @@
 
 mod attributes;
 mod corners;
+mod explain;
 mod faces;
 mod maps;
 mod memory;

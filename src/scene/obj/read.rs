@@ -55,10 +55,13 @@ pub(super) fn read_models(
 ) -> Result<(Vec<tobj::Model>, Vec<tobj::Material>, bool), ObjProblem> {
     match load_obj(text, scanned, load_mtl) {
         Ok((Ok((models, materials)), fast)) => Ok((models, materials.unwrap_or_default(), fast)),
-        Ok((Err(e), _)) => Err(ObjProblem {
-            line: error_line(text),
-            reason: e.to_string(),
-        }),
+        Ok((Err(e), _)) => {
+            let line = error_line(text);
+            Err(ObjProblem {
+                line,
+                reason: super::explain::explain(&e, text, line),
+            })
+        }
         Err(reason) => Err(ObjProblem { line: None, reason }),
     }
 }
