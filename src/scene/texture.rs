@@ -1,5 +1,5 @@
-//! Image textures for MTL `map_Kd` and `map_Ka` (docs/design.md, "Scene files"): PNG and JPEG
-//! through the `image` crate, decoded once from sRGB to linear RGB, checked against the memory
+//! Image textures for MTL `map_Kd` and `map_Ka` (docs/design.md, "Scene files"): PNG, JPEG,
+//! TGA, BMP and TIFF (the formats real models' MTL files name) through the `image` crate, decoded once from sRGB to linear RGB, checked against the memory
 //! budget from the image's header before any texel is decoded. Sampling (bilinear, wrapping) is
 //! [`super::Texture::sample`].
 
@@ -23,22 +23,33 @@ fn srgb_to_linear(code: u8) -> f32 {
     }
 }
 
-/// Decodes PNG or JPEG `bytes` into a linear texture named `name`, or says why not in a phrase
-/// ("it is not a PNG or JPEG image", "its 40000x40000 texels would need ..."). `limit` is the
-/// memory still available: a texture larger than it is refused from its header, before a texel
-/// is decoded. A JPEG cut short (no end-of-image marker after its last scan) is refused too:
-/// the decoder would fill the missing part with grey and say nothing.
+/// What [`decode_texture`] says of a file in none of the formats it reads.
+pub const NOT_AN_IMAGE: &str = "it is not a PNG, JPEG, TGA, BMP or TIFF image";
+
+/// Decodes PNG, JPEG, TGA, BMP or TIFF `bytes` into a linear texture named `name`, or says why
+/// not in a phrase ([`NOT_AN_IMAGE`], "its 40000x40000 texels would need ..."). The format is
+/// read from the bytes, and for TGA (which has no signature) from a `.tga` ending of `name`.
+/// `limit` is the memory still available: a texture larger than it is refused from its header,
+/// before a texel is decoded. A JPEG cut short (no end-of-image marker after its last scan) is
+/// refused too: the decoder would fill the missing part with grey and say nothing.
 pub fn decode_texture(name: &str, bytes: &[u8], limit: &MemoryLimit) -> Result<Texture, String> {
-    let reader = image::ImageReader::new(Cursor::new(bytes))
+    use image::ImageFormat;
+    let mut reader = image::ImageReader::new(Cursor::new(bytes))
         .with_guessed_format()
         .map_err(|e| format!("cannot read it ({})", one_line(&e)))?;
+    let tga = std::path::Path::new(name)
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("tga"));
+    if reader.format().is_none() && tga {
+        reader.set_format(ImageFormat::Tga);
+    }
     match reader.format() {
-        Some(image::ImageFormat::Png) => {}
-        Some(image::ImageFormat::Jpeg) if !jpeg_is_whole(bytes) => {
+        Some(ImageFormat::Png | ImageFormat::Tga | ImageFormat::Bmp | ImageFormat::Tiff) => {}
+        Some(ImageFormat::Jpeg) if !jpeg_is_whole(bytes) => {
             return Err("it is cut short (a JPEG without its end-of-image marker)".into());
         }
-        Some(image::ImageFormat::Jpeg) => {}
-        _ => return Err("it is not a PNG or JPEG image".into()),
+        Some(ImageFormat::Jpeg) => {}
+        _ => return Err(NOT_AN_IMAGE.into()),
     }
     let mut decoder = reader
         .into_decoder()
@@ -201,7 +212,12 @@ mod tests {
             decode_texture("x", b"not an image", &limit)
                 .err()
                 .as_deref(),
-            Some("it is not a PNG or JPEG image")
+            Some(NOT_AN_IMAGE)
+        );
+        let e = decode_texture("x.tga", b"", &limit).expect_err("no header");
+        assert!(
+            e.starts_with("cannot read its size"),
+            "an empty `.tga` is read as TGA and refused for its missing header: {e}"
         );
         let bytes = png(4, 4, &[7; 48]);
         let e = decode_texture("x", &bytes[..bytes.len() / 2], &limit).expect_err("truncated");
@@ -230,6 +246,39 @@ mod tests {
         assert_eq!(
             e,
             "it is cut short (a JPEG without its end-of-image marker)"
+        );
+    }
+
+    /// The formats real models name besides PNG and JPEG (Sponza's TGA, old exports' BMP,
+    /// Blender's and 3ds Max's TIFF) decode to the same linear texels as the PNG of the image.
+    #[test]
+    fn tga_bmp_and_tiff_decode_like_png() {
+        let rgb = [255, 0, 0, 0, 128, 255, 10, 20, 30, 255, 255, 255];
+        let image = image::RgbImage::from_raw(2, 2, rgb.to_vec()).expect("2x2");
+        let reference = decode_texture("t.png", &png(2, 2, &rgb), &roomy()).expect("png");
+        for (name, format) in [
+            ("t.tga", image::ImageFormat::Tga),
+            ("T.TGA", image::ImageFormat::Tga),
+            ("t.bmp", image::ImageFormat::Bmp),
+            ("t.tif", image::ImageFormat::Tiff),
+        ] {
+            let mut bytes = Vec::new();
+            image
+                .write_to(&mut Cursor::new(&mut bytes), format)
+                .expect("encodes");
+            let t =
+                decode_texture(name, &bytes, &roomy()).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!((t.width, t.height), (2, 2), "{name}");
+            assert_eq!(t.texels, reference.texels, "{name}");
+        }
+        // A TGA is known by its name only: under another name it is not an image.
+        let mut tga = Vec::new();
+        image
+            .write_to(&mut Cursor::new(&mut tga), image::ImageFormat::Tga)
+            .expect("encodes");
+        assert_eq!(
+            decode_texture("t.png", &tga, &roomy()).err().as_deref(),
+            Some(NOT_AN_IMAGE)
         );
     }
 }
