@@ -728,3 +728,66 @@ fn an_error_names_a_material_or_light_by_its_name() {
     let err = load_err("[[material]]\nior = \"high\"\n");
     assert!(err.contains("material 1"), "{err}");
 }
+
+/// A model copied from another machine: its MTL names textures by that machine's paths (a
+/// Windows path, a relative path with `\`, another user's absolute path) and in another case
+/// than the files have. Each is found next to the OBJ, with one note listing them; a texture
+/// that is nowhere is the usual warning.
+#[test]
+fn textures_named_by_another_machine_are_found_next_to_the_obj() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let checker = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models/checker.png");
+    std::fs::create_dir(dir.path().join("Tex")).expect("folder");
+    std::fs::copy(&checker, dir.path().join("Tex/Wood.png")).expect("copy");
+    std::fs::copy(&checker, dir.path().join("stone.png")).expect("copy");
+    std::fs::write(
+        dir.path().join("m.mtl"),
+        "newmtl a\nmap_Kd C:\\Users\\me\\Desktop\\house\\tex\\wood.PNG\n\
+         newmtl b\nmap_Kd Tex\\Wood.png\n\
+         newmtl c\nmap_Kd /home/someone/house/stone.png\n\
+         newmtl d\nmap_Kd TEX/WOOD.PNG\n\
+         newmtl e\nmap_Kd nowhere/gone.png\n",
+    )
+    .expect("write");
+    let mut obj = String::from("mtllib m.mtl\nvt 0 0\nvt 1 0\nvt 0 1\n");
+    for (i, m) in ["a", "b", "c", "d", "e"].iter().enumerate() {
+        let x = 2.0 * i as f32;
+        obj += &format!(
+            "usemtl {m}\nv {x} 0 0\nv {} 0 0\nv {x} 1 0\nf {}/1 {}/2 {}/3\n",
+            x + 1.0,
+            3 * i + 1,
+            3 * i + 2,
+            3 * i + 3
+        );
+    }
+    let path = dir.path().join("m.obj");
+    std::fs::write(&path, obj).expect("write");
+    let scene = load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
+    for m in ["a", "b", "c", "d"] {
+        assert!(
+            material(&scene, &format!("m/{m}")).diffuse_map.is_some(),
+            "material {m} has its texture; warnings {:?}",
+            scene.warnings
+        );
+    }
+    assert!(material(&scene, "m/e").diffuse_map.is_none());
+    // Wood in four spellings and stone, a copy of the same image: one texture in memory.
+    assert_eq!(scene.textures.len(), 1, "{:?}", scene.warnings);
+    let noted: Vec<&String> = (scene.warnings.iter())
+        .filter(|w| w.contains("not where the material library says"))
+        .collect();
+    assert_eq!(noted.len(), 1, "{:?}", scene.warnings);
+    assert!(
+        noted[0].contains("3 textures are not where the material library says but next to the OBJ: `C:\\Users\\me\\Desktop\\house\\tex\\wood.PNG` as `tex/wood.PNG` and 2 more"),
+        "{}",
+        noted[0]
+    );
+    assert!(
+        scene
+            .warnings
+            .iter()
+            .any(|w| w.contains("cannot use the texture `nowhere/gone.png`")),
+        "{:?}",
+        scene.warnings
+    );
+}

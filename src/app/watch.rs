@@ -79,7 +79,8 @@ fn absolute(p: &Path) -> PathBuf {
 }
 
 /// The files a scene loaded from `source` reads: itself, its meshes and the textures it uses
-/// (their MTL paths are relative to the mesh's folder, or absolute).
+/// (their MTL paths are relative to the mesh's folder, or absolute; a name in another case than
+/// the file's is the file on disk, as the loader found it).
 pub fn scene_files(scene: &Scene, source: &Path) -> Vec<PathBuf> {
     let folder = source.parent().unwrap_or(Path::new(""));
     let mut out = vec![source.to_path_buf()];
@@ -95,7 +96,7 @@ pub fn scene_files(scene: &Scene, source: &Path) -> Vec<PathBuf> {
         out.extend(
             mesh_folders
                 .iter()
-                .map(|f| f.join(&texture.name))
+                .map(|f| crate::scene::files::ignoring_case(&f.join(&texture.name)))
                 .filter(|p| p.is_file()),
         );
     }

@@ -20,6 +20,7 @@ pub(crate) const ALL_NORMALS: u8 = 1;
 pub(crate) const ALL_UVS: u8 = 2;
 
 use rayon::prelude::*;
+use tobj::LoadError;
 
 /// What [`face_corners`] found.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -53,7 +54,7 @@ impl FaceCorners {
 }
 
 /// The corners of every face of `text` (OBJ, polylines already removed, read by tobj without
-/// an error), or the 1-based line and tobj's words for the first `vt` or `vn` index of 0 or
+/// an error), or the 1-based line and tobj's error for the first `vt` or `vn` index of 0 or
 /// before the first one. `has_uvs`, `has_normals`: whether the file has any `vt`, `vn` (tobj
 /// ignores the indices into a list the file does not have, and so does this). Chunks of lines
 /// are read in parallel; a relative index is checked against the entries before it once the
@@ -62,7 +63,7 @@ pub(crate) fn face_corners(
     text: &str,
     has_uvs: bool,
     has_normals: bool,
-) -> Result<FaceCorners, (usize, &'static str)> {
+) -> Result<FaceCorners, (usize, LoadError)> {
     let chunks = split_lines(text, CHUNK_BYTES);
     let parts: Vec<Part> = chunks
         .par_iter()
@@ -73,7 +74,7 @@ pub(crate) fn face_corners(
     for part in &parts {
         for &(line, list, relative) in &part.suspects {
             if relative.is_none_or(|r| counts[list] + r < 0) {
-                return Err((lines + line, WORDS[list]));
+                return Err((lines + line, ERRORS[list]));
             }
         }
         lines += part.lines;
@@ -93,10 +94,10 @@ pub(crate) fn face_corners(
 /// Bytes of text per chunk read in parallel.
 const CHUNK_BYTES: usize = 4 << 20;
 
-/// tobj's words for an index out of range, for `vt` and for `vn`.
-const WORDS: [&str; 2] = [TEXCOORD, NORMAL];
-const TEXCOORD: &str = "face texcoord index out of bounds";
-const NORMAL: &str = "face normal index out of bounds";
+/// tobj's errors for an index out of range, for `vt` and for `vn`.
+const ERRORS: [LoadError; 2] = [TEXCOORD, NORMAL];
+const TEXCOORD: LoadError = LoadError::FaceTexCoordOutOfBounds;
+const NORMAL: LoadError = LoadError::FaceNormalOutOfBounds;
 
 /// `text` cut after line ends into pieces of about `bytes` each.
 fn split_lines(text: &str, bytes: usize) -> Vec<&str> {

@@ -16,6 +16,7 @@ use super::mtl::{Libraries, mtl_material, warn_unknown_usemtl};
 use super::parse::Facts;
 use super::read::{ObjProblem, read_models, scan};
 use super::request::MeshRequest;
+use crate::scene::diag::short_path;
 use crate::scene::{MaterialId, MeshAttributes, MeshPart, NormalsMode, Scene};
 
 /// The name tobj gives the faces before any `o` or `g` (and an `o` or `g` without a name).
@@ -133,12 +134,14 @@ fn face_corners(
     Ok(match (uvs_in_file || normals_in_file, fast_corners) {
         (false, _) => Default::default(),
         (true, Some(found)) if fast => found.only(uvs_in_file, normals_in_file),
-        (true, _) => corners::face_corners(text, uvs_in_file, normals_in_file).map_err(
-            |(line, reason)| ObjProblem {
-                line: Some(line),
-                reason: reason.into(),
-            },
-        )?,
+        (true, _) => {
+            corners::face_corners(text, uvs_in_file, normals_in_file).map_err(|(line, error)| {
+                ObjProblem {
+                    line: Some(line),
+                    reason: super::explain::explain(&error, text, Some(line)),
+                }
+            })?
+        }
     })
 }
 
@@ -189,6 +192,8 @@ struct MeshBuild<'a> {
     attrs: MeshAttributes,
     corners: Corners,
     warnings: Vec<String>,
+    /// Textures not where the MTL says but found next to the OBJ: (as written, as found).
+    textures_elsewhere: Vec<(String, String)>,
     /// The smoothing group of each triangle read (file order), when the mesh is shaded by its
     /// groups ([`MeshBuild::read_groups`]), and of each triangle kept.
     file_groups: Option<Vec<u32>>,
@@ -232,6 +237,7 @@ impl<'a> MeshBuild<'a> {
             },
             corners: Corners::default(),
             warnings,
+            textures_elsewhere: Vec::new(),
             file_groups: None,
             groups: Vec::new(),
         }
@@ -351,6 +357,7 @@ impl<'a> MeshBuild<'a> {
                         &mtl_materials[i],
                         mtl_texts,
                         &mut self.warnings,
+                        &mut self.textures_elsewhere,
                     )
                 })
             }
@@ -389,6 +396,21 @@ impl<'a> MeshBuild<'a> {
             warnings.push(format!(
                 "{}: dropped {too_far} triangle{s} placed beyond ±1e15, raytree's limit on scene size.",
                 req.label
+            ));
+        }
+        if let Some((written, found)) = self.textures_elsewhere.first() {
+            let n = self.textures_elsewhere.len();
+            let more = match n {
+                1 => String::new(),
+                2 => " and 1 more".into(),
+                n => format!(" and {} more", n - 1),
+            };
+            warnings.push(format!(
+                "{}: {} not where the material library says but next to the OBJ: `{}` as `{}`{more}.",
+                req.label,
+                if n == 1 { "a texture is".to_string() } else { format!("{n} textures are") },
+                short_path(written),
+                short_path(found),
             ));
         }
         scene.warnings.extend(self.warnings);

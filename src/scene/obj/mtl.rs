@@ -153,6 +153,7 @@ pub(super) fn mtl_material(
     m: &tobj::Material,
     mtl_texts: &[(String, String)],
     warnings: &mut Vec<String>,
+    textures_elsewhere: &mut Vec<(String, String)>,
 ) -> MaterialId {
     let name = format!("{}/{}", req.object_name, m.name);
     let id = match scene.materials.iter().position(|x| x.name == name) {
@@ -167,7 +168,16 @@ pub(super) fn mtl_material(
     // colours (a scene file has no texture keys, so a saved scene keeps its textures).
     let mut texture = |key: &str, file: &Option<String>| {
         let file = file.as_deref()?;
-        load_texture(scene, req, &m.name, key, file, mtl_texts, warnings)
+        load_texture(
+            scene,
+            req,
+            &m.name,
+            key,
+            file,
+            mtl_texts,
+            warnings,
+            textures_elsewhere,
+        )
     };
     let diffuse = texture("map_Kd", &m.diffuse_texture);
     let ambient = texture("map_Ka", &m.ambient_texture);
