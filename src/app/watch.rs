@@ -96,7 +96,7 @@ pub fn scene_files(scene: &Scene, source: &Path) -> Vec<PathBuf> {
         out.extend(
             mesh_folders
                 .iter()
-                .map(|f| crate::scene::files::ignoring_case(&f.join(&texture.name)))
+                .map(|f| crate::scene::disk_names::ignoring_case(&f.join(&texture.name)))
                 .filter(|p| p.is_file()),
         );
     }

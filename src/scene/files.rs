@@ -116,55 +116,15 @@ pub fn load_scene_str(text: &str, name: &str) -> Result<Scene, SceneError> {
 }
 
 /// A resolver reading files relative to `folder`; a name not found as written is matched
-/// regardless of case ([`ignoring_case`]).
+/// regardless of case (`disk_names::ignoring_case`).
 pub fn fs_resolver(folder: PathBuf) -> impl Fn(&str) -> Result<String, String> {
     move |path: &str| {
-        read_text(&ignoring_case(&folder.join(path)), MAX_MESH_FILE_BYTES)
-            .map_err(|reason| format!("{}: {reason}", short_path(path)))
+        read_text(
+            &super::disk_names::ignoring_case(&folder.join(path)),
+            MAX_MESH_FILE_BYTES,
+        )
+        .map_err(|reason| format!("{}: {reason}", short_path(path)))
     }
-}
-
-/// `path` itself when it exists, else the one file or folder on disk that matches it with each
-/// missing name compared regardless of case (`Tex/Wood.PNG` for `tex/wood.png`, as a model
-/// written on Windows or macOS names its files), else `path` unchanged (and the read that
-/// follows says it is not there). Of several matches in one folder the first in sorted order.
-pub fn ignoring_case(path: &Path) -> PathBuf {
-    use std::path::Component;
-    if path.exists() {
-        return path.to_path_buf();
-    }
-    let mut found = PathBuf::new();
-    for part in path.components() {
-        let Component::Normal(name) = part else {
-            found.push(part);
-            continue;
-        };
-        let exact = found.join(name);
-        if exact.exists() {
-            found = exact;
-            continue;
-        }
-        let folder = if found.as_os_str().is_empty() {
-            Path::new(".")
-        } else {
-            &found
-        };
-        let wanted = name.to_string_lossy().to_lowercase();
-        let Ok(entries) = std::fs::read_dir(folder) else {
-            return path.to_path_buf();
-        };
-        let mut matches: Vec<_> = entries
-            .filter_map(Result::ok)
-            .map(|e| e.file_name())
-            .filter(|n| n.to_string_lossy().to_lowercase() == wanted)
-            .collect();
-        matches.sort();
-        match matches.first() {
-            Some(m) => found.push(m),
-            None => return path.to_path_buf(),
-        }
-    }
-    found
 }
 
 /// Reads a text file of at most `max_bytes`, tolerating stray non-UTF-8 bytes (old MTL files
@@ -236,26 +196,5 @@ fn os_reason(e: &std::io::Error) -> String {
     match text.find(" (os error") {
         Some(i) => text[..i].to_string(),
         None => text,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn names_not_found_as_written_match_regardless_of_case() {
-        let dir = tempfile::tempdir().expect("temp dir");
-        std::fs::create_dir(dir.path().join("Tex")).expect("folder");
-        std::fs::write(dir.path().join("Tex/Wood.PNG"), b"x").expect("write");
-        let found = dir.path().join("Tex/Wood.PNG");
-        assert_eq!(ignoring_case(&dir.path().join("tex/wood.png")), found);
-        assert_eq!(ignoring_case(&found), found, "an exact path stays");
-        let missing = dir.path().join("tex/stone.png");
-        assert_eq!(
-            ignoring_case(&missing),
-            missing,
-            "nothing matches: unchanged"
-        );
     }
 }

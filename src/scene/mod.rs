@@ -10,6 +10,7 @@ pub mod budget;
 pub mod builtin;
 pub mod camera;
 pub mod diag;
+pub(crate) mod disk_names;
 pub mod files;
 pub mod first_look;
 pub mod names;

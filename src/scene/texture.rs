@@ -113,11 +113,11 @@ fn jpeg_is_whole(bytes: &[u8]) -> bool {
 /// A resolver of binary files (textures) relative to `folder`: regular files only (a folder,
 /// a device such as `/dev/zero` or a pipe is refused with a phrase), at most
 /// [`MAX_TEXTURE_FILE_BYTES`]; a name not found as written is matched regardless of case
-/// ([`super::files::ignoring_case`]).
+/// (`disk_names::ignoring_case`).
 pub fn fs_bytes_resolver(folder: std::path::PathBuf) -> impl Fn(&str) -> Result<Vec<u8>, String> {
     move |path: &str| {
         read_bytes(
-            &super::files::ignoring_case(&folder.join(path)),
+            &super::disk_names::ignoring_case(&folder.join(path)),
             MAX_TEXTURE_FILE_BYTES,
         )
     }
