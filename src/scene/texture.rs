@@ -1,6 +1,7 @@
 //! Image textures for MTL `map_Kd` and `map_Ka` (docs/design.md, "Scene files"): PNG, JPEG,
-//! TGA, BMP and TIFF (the formats real models' MTL files name) through the `image` crate, decoded once from sRGB to linear RGB, checked against the memory
-//! budget from the image's header before any texel is decoded. Sampling (bilinear, wrapping) is
+//! TGA, BMP and TIFF (the formats real models' MTL files name) through the `image` crate,
+//! decoded once from sRGB to linear RGB, checked against the memory budget from the image's
+//! header before any texel is decoded. Sampling (bilinear, wrapping) is
 //! [`super::Texture::sample`].
 
 use std::io::Cursor;

@@ -402,7 +402,6 @@ impl<'a> MeshBuild<'a> {
             let n = self.textures_elsewhere.len();
             let more = match n {
                 1 => String::new(),
-                2 => " and 1 more".into(),
                 n => format!(" and {} more", n - 1),
             };
             warnings.push(format!(
