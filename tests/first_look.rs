@@ -11,6 +11,7 @@ use std::sync::Arc;
 use glam::Vec3;
 use raytree::render::render;
 use raytree::scene::{Material, Scene, load_scene_file};
+use raytree::scene_view::cutaway::encloses_render_camera;
 use raytree::trace::{TraceSettings, Tracer};
 
 /// The walls of a closed box `[-3, 3] × [0, 4] × [-4, 4]`, counter-clockwise seen from inside,
@@ -385,6 +386,65 @@ fn a_box_open_on_one_side_is_seen_through_its_opening_without_clipping_white() {
     let key = scene.lights[0].position;
     assert!(inside(key, &scene), "key light at {key}, outside the box");
     assert_readable(&scene, "cornell.obj", 0.15..0.75, 0.01);
+}
+
+#[test]
+fn a_room_with_a_hole_in_half_a_wall_is_seen_from_the_hole() {
+    // A closed room whose +z wall is missing on its −x half (a hole, as in convector's
+    // `suzannes_in_box.obj`), with a block in the middle. Framed from outside as an open box,
+    // the picture was mostly the wall beside the hole.
+    let (lo, hi) = (Vec3::new(-4.0, 0.0, -4.0), Vec3::new(4.0, 3.0, 4.0));
+    let mut text = String::new();
+    let mut base = 0;
+    cuboid(&mut text, &mut base, lo, hi, true, &[5]);
+    // The +z wall's +x half, facing in (towards −z).
+    text += "v 0 0 4\nv 4 0 4\nv 4 3 4\nv 0 3 4\n";
+    let b = base;
+    text += &format!(
+        "f {} {} {}\nf {} {} {}\n",
+        b + 1,
+        b + 3,
+        b + 2,
+        b + 1,
+        b + 4,
+        b + 3
+    );
+    base += 4;
+    cuboid(
+        &mut text,
+        &mut base,
+        Vec3::new(-0.7, 0.0, -0.7),
+        Vec3::new(0.7, 1.2, 0.7),
+        false,
+        &[],
+    );
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = load(dir.path(), "holed.obj", &text);
+    assert_warned(&scene, "holed.obj", &["opening", "stands in it"]);
+    let eye = scene.camera.position;
+    assert!(
+        eye.z < hi.z && eye.z > hi.z - 0.5 && eye.x > -4.0 && eye.x < 0.0,
+        "camera at {eye}, not in the hole (x in −4..0, just inside z = 4)"
+    );
+    // Inside the bounds, so the scene view seen from outside cuts the walls away.
+    assert!(
+        encloses_render_camera(&scene, Vec3::new(0.0, 10.0, 20.0)),
+        "camera at {eye}: the cut-away would not engage"
+    );
+    assert!(
+        eye.y > 0.0 && eye.y < 3.0,
+        "camera at {eye}, above or below the hole"
+    );
+    assert!(forward(&scene).z < -0.7, "looks in: {}", forward(&scene));
+    // Most of the picture is the room (its back wall, the floor, the block), not the outside.
+    let image = pixels(&scene);
+    let lit = image.iter().filter(|c| c.max_element() > 0.02).count();
+    assert!(
+        lit * 10 >= image.len() * 9,
+        "{lit} of {} pixels show the room",
+        image.len()
+    );
+    assert_readable(&scene, "holed.obj", 0.15..0.75, 0.01);
 }
 
 /// An octagonal prism around the `up` axis (a corner, not a face, towards the other

@@ -791,3 +791,46 @@ fn textures_named_by_another_machine_are_found_next_to_the_obj() {
         scene.warnings
     );
 }
+
+#[test]
+fn git_lfs_pointers_in_place_of_a_model_or_a_texture_are_named_as_such() {
+    // A repository cloned without `git lfs` leaves these three lines where each file should be.
+    let pointer = "version https://git-lfs.github.com/spec/v1\n\
+        oid sha256:df14845c86933fbf75aa31c04c62ad78d18e5f1a72e43cf4d30c6d7353c12bcc\n\
+        size 22342871\n";
+    let dir = tempfile::tempdir().expect("temp dir");
+    std::fs::write(dir.path().join("big.obj"), pointer).expect("write");
+    std::fs::write(dir.path().join("wood.png"), pointer).expect("write");
+    std::fs::write(
+        dir.path().join("q.mtl"),
+        "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd wood.png\n",
+    )
+    .expect("write");
+    std::fs::write(
+        dir.path().join("q.obj"),
+        "mtllib q.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\nf 1/1 2/2 3/3\n",
+    )
+    .expect("write");
+    std::fs::write(dir.path().join("s.toml"), "[[mesh]]\nfile = \"big.obj\"\n").expect("write");
+    let lfs = "it is a Git LFS pointer, not the file itself: the file (21.3 MiB) was never \
+        downloaded; `git lfs pull` in its repository fetches it";
+    // The model itself, opened directly and through a scene file: refused, saying why.
+    for name in ["big.obj", "s.toml"] {
+        let err = load_scene_file(&dir.path().join(name))
+            .err()
+            .unwrap_or_else(|| panic!("{name} loaded from a pointer"))
+            .to_string();
+        assert!(err.contains(lfs), "{name}: {err}");
+    }
+    // A texture: the model loads, the material keeps its flat colour, the warning says why.
+    let scene = load_scene_file(&dir.path().join("q.obj")).unwrap_or_else(|e| panic!("{e}"));
+    assert!(material(&scene, "q/a").diffuse_map.is_none());
+    assert!(
+        scene
+            .warnings
+            .iter()
+            .any(|w| w.contains("`wood.png`") && w.contains(lfs)),
+        "{:?}",
+        scene.warnings
+    );
+}

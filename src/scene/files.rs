@@ -184,6 +184,9 @@ fn read_text_watched(
     if bytes.len() as u64 > max_bytes {
         return Err(too_big(bytes.len() as u64));
     }
+    if let Some(reason) = super::lfs::pointer_reason(&bytes) {
+        return Err(reason);
+    }
     // Valid UTF-8 is taken as it is, without the copy `from_utf8_lossy` would make.
     Ok(Some(String::from_utf8(bytes).unwrap_or_else(|e| {
         String::from_utf8_lossy(e.as_bytes()).into_owned()

@@ -175,10 +175,12 @@ pub(crate) fn load_obj_scene(
     if let Some(room) = look.room {
         scene.warnings.push(format!(
             "{label}: the model is closed around its middle (a room): {}.",
-            if room.open_side {
-                "it is open on one side, so the camera looks in through the opening"
-            } else {
-                "the camera starts inside it"
+            match room.entry {
+                Entry::OpenSide =>
+                    "it is open on one side, so the camera looks in through the opening",
+                Entry::Doorway =>
+                    "one wall has an opening, so the camera stands in it and looks in",
+                Entry::Inside => "the camera starts inside it",
             }
         ));
     }
@@ -254,10 +256,34 @@ struct FirstView {
 struct Room {
     /// The key light's position, under the ceiling and not inside anything.
     light: Vec3,
-    /// The room has no wall on one side (a Cornell box, a stage set): the camera stands in
-    /// the opening.
-    open_side: bool,
+    /// Where the camera stands.
+    entry: Entry,
 }
+
+/// Where a room's first look stands.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Entry {
+    /// Most of one wall is missing (a Cornell box, a stage set): in front of the opening, the
+    /// whole room in view.
+    OpenSide,
+    /// Part of one wall is open (a door, a window, a hole): in the opening, looking in.
+    Doorway,
+    /// Inside, near one wall.
+    Inside,
+}
+
+/// The fraction of a wall that must be open for the room to be framed from outside, as a
+/// Cornell box is; below it the camera stands in the opening.
+const OPEN_SIDE: f32 = 0.6;
+
+/// The fraction of a wall that must be open for it to count as an opening at all (below it,
+/// a chink between badly joined walls).
+const MIN_OPENING: f32 = 0.04;
+
+/// Rays from outside that run more than this fraction of the room's depth past the bounds
+/// before meeting anything pass through an opening (nearer, they met the wall, or something
+/// standing out of it).
+const WALL_DEPTH: f32 = 0.1;
 
 /// How many directions each probe point sends rays in.
 const PROBE_DIRS: usize = 48;
@@ -273,8 +299,6 @@ struct Probe {
     /// to the model's bounds: the walls of a room are its outer shell, where a hole through a
     /// part or a pocket of a solid is close around the point.
     far: usize,
-    /// The sum of the directions of the rays that met nothing (where the room is open).
-    open: Vec3,
     /// Per direction, whether its ray met anything.
     met: Vec<bool>,
 }
@@ -328,13 +352,12 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
         }
     }
     let probes = probe_points(triangles, &curve, &points, &dirs, (lo, hi));
-    let room_probe = probes.iter().find(|p| p.in_room());
-    let Some(room_probe) = room_probe else {
+    if !probes.iter().any(|p| p.in_room()) {
         return FirstView {
             camera: frame_outside(triangles, center, up, front, 0.3, aspect),
             room: None,
         };
-    };
+    }
     // Open above (walls without a ceiling, a stage set): seen from outside and higher up, so
     // the key light above shines in and the inside shows.
     let skyward = dirs.iter().filter(|d| d.dot(up) > 0.5).count();
@@ -350,25 +373,21 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
             room: None,
         };
     }
-    // Which wall the camera stands at: the open side if there is one (the sum of the escaping
-    // directions points mostly one horizontal way), else the far end of the longer
-    // horizontal axis, looking along it.
+    // Which wall the camera stands at: the most open one if a wall has an opening, else the
+    // far end of the longer horizontal axis, looking along it.
     let walls = [side, -side, front, -front];
-    let open = room_probe.open - up * room_probe.open.dot(up);
-    let escaped = PROBE_DIRS - room_probe.hits();
-    let open_wall = (escaped >= 3 && open.length() >= 0.3 * escaped as f32).then(|| {
-        walls
-            .into_iter()
-            .max_by(|a, b| a.dot(open).total_cmp(&b.dot(open)))
-            .unwrap_or(front)
-    });
+    let open_wall = walls
+        .into_iter()
+        .map(|w| (w, opening(triangles, &curve, w, (lo, hi))))
+        .filter(|(_, (fraction, _))| *fraction >= MIN_OPENING)
+        .max_by(|a, b| a.1.0.total_cmp(&b.1.0));
     let long = if extent(front) >= extent(side) {
         front
     } else {
         side
     };
     let order: Vec<Vec3> = match open_wall {
-        Some(w) => vec![w, -w, long, -long],
+        Some((w, _)) => vec![w, -w, long, -long],
         None => vec![long, -long, long.cross(up), -long.cross(up)],
     };
     // Camera candidates, best first: in the opening (or near the wall), then closer in. Each
@@ -395,16 +414,39 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
         .find(|(_, p)| p.free())
         .map(|(l, _)| *l)
         .unwrap_or(center);
-    if let Some(wall) = open_wall {
-        // Open on one side (a Cornell box, a stage set): seen through the opening, level, the
-        // whole room in view, as the Cornell box's own camera does.
-        return FirstView {
-            camera: frame_outside(triangles, center, up, wall, 0.0, aspect),
-            room: Some(Room {
-                light,
-                open_side: true,
-            }),
-        };
+    if let Some((wall, (fraction, door))) = open_wall {
+        if fraction >= OPEN_SIDE {
+            // Open on one side (a Cornell box, a stage set): seen through the opening, level,
+            // the whole room in view, as the Cornell box's own camera does.
+            return FirstView {
+                camera: frame_outside(triangles, center, up, wall, 0.0, aspect),
+                room: Some(Room {
+                    light,
+                    entry: Entry::OpenSide,
+                }),
+            };
+        }
+        // A door or a hole in part of the wall: framing the box from outside would show
+        // mostly the wall beside it, so the camera stands in the opening, looking at the
+        // middle of the room, if nothing stands right in front of it.
+        if let Some(door) = door {
+            let toward = (center - door).normalize_or_zero();
+            let sight = nearest(triangles, &curve, &[(door, toward)])[0].0;
+            if toward != Vec3::ZERO && sight >= 0.5 * door.distance(center) {
+                return FirstView {
+                    camera: Camera {
+                        position: door,
+                        look_at: center,
+                        up,
+                        fov_y_deg: 60.0,
+                    },
+                    room: Some(Room {
+                        light,
+                        entry: Entry::Doorway,
+                    }),
+                };
+            }
+        }
     }
     let views: Vec<(Vec3, Vec3)> = candidates.clone();
     let ahead = nearest(triangles, &curve, &views);
@@ -431,9 +473,59 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
         },
         room: Some(Room {
             light,
-            open_side: false,
+            entry: Entry::Inside,
         }),
     }
+}
+
+/// How open the bounds' face towards `wall` (a horizontal axis, signed) is: the fraction of a
+/// grid of rays sent in from just outside it, square to it, that pass [`WALL_DEPTH`] of the
+/// room's depth without meeting anything; and where to stand in the opening, the open grid
+/// point nearest the open points' centroid, just inside the face (none when nothing is open).
+fn opening(
+    triangles: &[Triangle],
+    order: &[u32],
+    wall: Vec3,
+    (lo, hi): (Vec3, Vec3),
+) -> (f32, Option<Vec3>) {
+    const GRID: usize = 16;
+    let axis = wall.abs().max_position();
+    let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+    let depth = hi[axis] - lo[axis];
+    let face = if wall[axis] > 0.0 { hi[axis] } else { lo[axis] };
+    let outside = 0.01 * depth;
+    let points: Vec<Vec3> = (0..GRID * GRID)
+        .map(|k| {
+            let (i, j) = (k % GRID, k / GRID);
+            let mut p = Vec3::ZERO;
+            p[axis] = face;
+            p[u] = lo[u] + (hi[u] - lo[u]) * (i as f32 + 0.5) / GRID as f32;
+            p[v] = lo[v] + (hi[v] - lo[v]) * (j as f32 + 0.5) / GRID as f32;
+            p
+        })
+        .collect();
+    let rays: Vec<(Vec3, Vec3)> = points
+        .iter()
+        .map(|&p| (p + wall * outside, -wall))
+        .collect();
+    let open: Vec<Vec3> = nearest(triangles, order, &rays)
+        .iter()
+        .zip(&points)
+        .filter(|((dist, _), _)| *dist > outside + WALL_DEPTH * depth)
+        .map(|(_, &p)| p)
+        .collect();
+    if open.is_empty() {
+        return (0.0, None);
+    }
+    let centroid = open.iter().sum::<Vec3>() / open.len() as f32;
+    // Just inside the face, so the camera is within the model's bounds (the scene view cuts
+    // the walls away around a camera inside them).
+    let door = open
+        .iter()
+        .copied()
+        .min_by(|a, b| a.distance(centroid).total_cmp(&b.distance(centroid)))
+        .map(|p| p - wall * (0.02 * depth));
+    (open.len() as f32 / points.len() as f32, door)
 }
 
 /// The camera in front of the model (from `front`, raised by `elevation`: 0.3 is about 17°), aimed
@@ -515,8 +607,9 @@ fn probe_points(
             for (&(dist, facing), &d) in per_point.iter().zip(dirs) {
                 probe.met.push(dist.is_finite());
                 if !dist.is_finite() {
-                    probe.open += d;
-                } else if facing {
+                    continue;
+                }
+                if facing {
                     probe.front += 1;
                     // How far the ray runs inside the bounds from `p`.
                     let to_wall = (0..3)

@@ -13,6 +13,7 @@ pub mod diag;
 pub(crate) mod disk_names;
 pub mod files;
 pub mod first_look;
+pub(crate) mod lfs;
 pub mod names;
 pub mod obj;
 pub mod procedural;

@@ -155,6 +155,9 @@ fn read_bytes(path: &std::path::Path, max_bytes: u64) -> Result<Vec<u8>, String>
     if bytes.len() as u64 > max_bytes {
         return Err(too_big);
     }
+    if let Some(reason) = super::lfs::pointer_reason(&bytes) {
+        return Err(reason);
+    }
     Ok(bytes)
 }
 
