@@ -834,3 +834,49 @@ fn git_lfs_pointers_in_place_of_a_model_or_a_texture_are_named_as_such() {
         scene.warnings
     );
 }
+
+#[test]
+fn a_material_library_named_by_another_machine_is_found_next_to_the_obj() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    std::fs::write(
+        dir.path().join("house.mtl"),
+        "newmtl brick\nKd 0.7 0.2 0.1\n",
+    )
+    .expect("write");
+    std::fs::write(
+        dir.path().join("house.obj"),
+        "mtllib C:\\Users\\me\\Desktop\\house\\House.MTL\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl brick\nf 1 2 3\n",
+    )
+    .expect("write");
+    let scene = load_scene_file(&dir.path().join("house.obj")).unwrap_or_else(|e| panic!("{e}"));
+    let brick = material(&scene, "house/brick");
+    assert!(
+        (brick.diffuse - glam::Vec3::new(0.7, 0.2, 0.1))
+            .abs()
+            .max_element()
+            < 1e-6,
+        "{brick:?}; warnings {:?}",
+        scene.warnings
+    );
+    assert!(
+        scene.warnings.iter().any(|w| w.contains(
+            "the material library `C:\\Users\\me\\Desktop\\house\\House.MTL` is not where the OBJ says but next to it, as `House.MTL`"
+        )),
+        "{:?}",
+        scene.warnings
+    );
+    // One that is nowhere keeps the reason of the name as written.
+    std::fs::write(
+        dir.path().join("lost.obj"),
+        "mtllib D:\\gone\\lost.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .expect("write");
+    let lost = load_scene_file(&dir.path().join("lost.obj")).unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        lost.warnings.iter().any(|w| w
+            .contains("cannot read the material library `D:\\gone\\lost.mtl` (")
+            && w.contains("No such file")),
+        "{:?}",
+        lost.warnings
+    );
+}

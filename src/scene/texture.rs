@@ -24,12 +24,36 @@ fn srgb_to_linear(code: u8) -> f32 {
     }
 }
 
+/// Whether `bytes` start with a header only a TGA file has: a colour map flag of 0 or 1, one of
+/// the six image types (colour-mapped, true-colour or grey, raw or run-length), a size, a pixel
+/// depth of 8, 15, 16, 24 or 32 bits, and nothing in the descriptor's unused bits; with room
+/// for the header and its id field. Other files (text, other formats) fail it at once: a TGA's
+/// second and third bytes, say, are never printable text.
+fn looks_like_tga(bytes: &[u8]) -> bool {
+    let [id_len, map_type, image_type, ..] = *bytes else {
+        return false;
+    };
+    if bytes.len() < 18 + usize::from(id_len) {
+        return false;
+    }
+    let word = |i: usize| u16::from_le_bytes([bytes[i], bytes[i + 1]]);
+    let (width, height, depth, descriptor) = (word(12), word(14), bytes[16], bytes[17]);
+    map_type <= 1
+        && matches!(image_type, 1 | 2 | 3 | 9 | 10 | 11)
+        && (image_type % 8 == 1) == (map_type == 1)
+        && width > 0
+        && height > 0
+        && matches!(depth, 8 | 15 | 16 | 24 | 32)
+        && descriptor & 0xC0 == 0
+}
+
 /// What [`decode_texture`] says of a file in none of the formats it reads.
 pub const NOT_AN_IMAGE: &str = "it is not a PNG, JPEG, TGA, BMP or TIFF image";
 
 /// Decodes PNG, JPEG, TGA, BMP or TIFF `bytes` into a linear texture named `name`, or says why
 /// not in a phrase ([`NOT_AN_IMAGE`], "its 40000x40000 texels would need ..."). The format is
-/// read from the bytes, and for TGA (which has no signature) from a `.tga` ending of `name`.
+/// read from the bytes, and for TGA (which has no signature) from a `.tga` ending of `name`,
+/// or from a header that can only be a TGA's (a TGA renamed `.png` by an exporter).
 /// `limit` is the memory still available: a texture larger than it is refused from its header,
 /// before a texel is decoded. A JPEG cut short (no end-of-image marker after its last scan) is
 /// refused too: the decoder would fill the missing part with grey and say nothing.
@@ -41,7 +65,7 @@ pub fn decode_texture(name: &str, bytes: &[u8], limit: &MemoryLimit) -> Result<T
     let tga = std::path::Path::new(name)
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("tga"));
-    if reader.format().is_none() && tga {
+    if reader.format().is_none() && (tga || looks_like_tga(bytes)) {
         reader.set_format(ImageFormat::Tga);
     }
     match reader.format() {
@@ -259,6 +283,14 @@ mod tests {
         );
     }
 
+    fn tga_bytes(image: image::DynamicImage) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        image
+            .write_to(&mut Cursor::new(&mut bytes), image::ImageFormat::Tga)
+            .expect("encodes");
+        bytes
+    }
+
     /// The formats real models name besides PNG and JPEG (Sponza's TGA, old exports' BMP,
     /// Blender's and 3ds Max's TIFF) decode to the same linear texels as the PNG of the image.
     #[test]
@@ -281,14 +313,40 @@ mod tests {
             assert_eq!((t.width, t.height), (2, 2), "{name}");
             assert_eq!(t.texels, reference.texels, "{name}");
         }
-        // A TGA is known by its name only: under another name it is not an image.
-        let mut tga = Vec::new();
-        image
-            .write_to(&mut Cursor::new(&mut tga), image::ImageFormat::Tga)
-            .expect("encodes");
-        assert_eq!(
-            decode_texture("t.png", &tga, &roomy()).err().as_deref(),
-            Some(NOT_AN_IMAGE)
-        );
+        // A TGA under another name (an exporter's `.png`) is known by its header, raw or
+        // run-length encoded, grey or colour.
+        for (what, bytes) in [
+            (
+                "raw colour",
+                tga_bytes(image::DynamicImage::ImageRgb8(image.clone())),
+            ),
+            (
+                "grey",
+                tga_bytes(image::DynamicImage::ImageLuma8(
+                    image::DynamicImage::ImageRgb8(image.clone()).to_luma8(),
+                )),
+            ),
+        ] {
+            let t = decode_texture("t.png", &bytes, &roomy())
+                .unwrap_or_else(|e| panic!("{what} TGA named .png: {e}"));
+            assert_eq!((t.width, t.height), (2, 2), "{what}");
+            if what == "raw colour" {
+                assert_eq!(t.texels, reference.texels, "{what}");
+            }
+        }
+        // Text, an empty file and a header of a type TGA does not have are not images.
+        let mut not_tga = tga_bytes(image::DynamicImage::ImageRgb8(image.clone()));
+        not_tga[2] = 4;
+        for (what, bytes) in [
+            ("text", b"newmtl a\nKd 1 1 1\nmap_Kd a.png\n".to_vec()),
+            ("empty", Vec::new()),
+            ("image type 4", not_tga),
+        ] {
+            assert_eq!(
+                decode_texture("t.png", &bytes, &roomy()).err().as_deref(),
+                Some(NOT_AN_IMAGE),
+                "{what}"
+            );
+        }
     }
 }

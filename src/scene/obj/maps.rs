@@ -23,11 +23,12 @@ fn texture_file(value: &str) -> &str {
     }
 }
 
-/// Where to look for the texture file `file` as an MTL names it, best first: as written, then,
+/// Where to look for a file `file` as a model names it (a texture in an MTL, a material
+/// library in an OBJ), best first: as written, then,
 /// for a path written on another machine (`C:\Users\me\model\tex\wood.png`, `tex\wood.png`,
 /// `/home/me/model/tex/wood.png`), with `/` for `\` and each shorter tail of it down to the
 /// file name, each next to the OBJ: a model copied from elsewhere keeps its textures beside it.
-fn candidates(file: &str) -> Vec<String> {
+pub(super) fn candidates(file: &str) -> Vec<String> {
     let mut out = vec![file.to_string()];
     let slashed = file.replace('\\', "/");
     let parts: Vec<&str> = slashed

@@ -8,7 +8,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use super::maps::load_texture;
+use super::maps::{candidates, load_texture};
 use super::parse::Facts;
 use super::paths::sibling;
 use super::request::MeshRequest;
@@ -40,14 +40,37 @@ impl<'r> Libraries<'r> {
         if req.material_override.is_some() {
             return Ok(Default::default());
         }
-        let name = short_path(&path.to_string_lossy());
-        let text = (req.resolve)(&sibling(req.key, &path.to_string_lossy())).map_err(|reason| {
+        let written = path.to_string_lossy();
+        let name = short_path(&written);
+        // As written, else as a texture named by another machine's path is looked for.
+        let mut first_reason = None;
+        let mut found = None;
+        for (i, candidate) in candidates(&written).into_iter().enumerate() {
+            match (req.resolve)(&sibling(req.key, &candidate)) {
+                Ok(text) => {
+                    found = Some((i, candidate, text));
+                    break;
+                }
+                Err(reason) => {
+                    first_reason.get_or_insert(reason);
+                }
+            }
+        }
+        let Some((i, candidate, text)) = found else {
             self.warnings.borrow_mut().push(format!(
-                "{}: cannot read the material library `{name}` ({reason}); its faces use the default material.",
-                req.label
+                "{}: cannot read the material library `{name}` ({}); its faces use the default material.",
+                req.label,
+                first_reason.unwrap_or_default()
             ));
-            tobj::LoadError::OpenFileFailed
-        })?;
+            return Err(tobj::LoadError::OpenFileFailed);
+        };
+        if i > 0 {
+            self.warnings.borrow_mut().push(format!(
+                "{}: the material library `{name}` is not where the OBJ says but next to it, as `{}`.",
+                req.label,
+                short_path(&candidate)
+            ));
+        }
         self.texts.borrow_mut().push((name.clone(), text.clone()));
         let text = mtl_for_tobj(&text).map_err(|(line, reason)| {
             self.warnings.borrow_mut().push(format!(
