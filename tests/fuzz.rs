@@ -11,7 +11,7 @@
 //!   `map_Ka` naming good, truncated, huge-headed, empty, missing and device textures; the
 //!   `[[mesh]]` keys `normals` and `crease_angle` with hostile values), loaded both as a
 //!   `[[mesh]]` of a scene and as a bare `.obj`;
-//! - texture files: PNG and JPEG bytes mutated (bytes flipped, cut short, header sizes
+//! - texture files: PNG, JPEG, TGA and DDS bytes mutated (bytes flipped, cut short, header sizes
 //!   patched), decoded against a small memory budget;
 //! - command lines of the real `raytree` binary (a bounded number of processes).
 //!
@@ -26,6 +26,7 @@
 //! Another seed: `RAYTREE_FUZZ_SEED=7`. A failure prints the shrunk input; add it to
 //! `tests/fixtures/hostile/` (every input that ever crashed is a fixture there).
 
+mod common;
 mod hostile_support;
 mod obj_compare;
 
@@ -939,8 +940,8 @@ fn edit_bytes(mut bytes: Vec<u8>, edits: &[ByteEdit]) -> Vec<u8> {
     bytes
 }
 
-/// PNG and JPEG files (the corpus's good, truncated and huge-headed ones, and larger ones made
-/// here) with bytes flipped, cut, inserted and sizes patched, decoded against a 64 MiB budget:
+/// PNG, JPEG, TGA and DDS files (the corpus's good, truncated and huge-headed ones, and larger
+/// ones made here) with bytes flipped, cut, inserted and sizes patched, decoded against a 64 MiB budget:
 /// never a panic; a texture has the texels its size says, all finite in [0, 1]; a refusal is
 /// one phrase.
 #[test]
@@ -959,7 +960,11 @@ fn fuzz_textures() {
     let gradient = image::RgbaImage::from_fn(24, 16, |x, y| {
         image::Rgba([x as u8 * 10, y as u8 * 15, 99, 200])
     });
-    for format in [image::ImageFormat::Png, image::ImageFormat::Jpeg] {
+    for format in [
+        image::ImageFormat::Png,
+        image::ImageFormat::Jpeg,
+        image::ImageFormat::Tga,
+    ] {
         let mut bytes = Vec::new();
         let img = image::DynamicImage::ImageRgba8(gradient.clone());
         let img = if format == image::ImageFormat::Jpeg {
@@ -970,6 +975,19 @@ fn fuzz_textures() {
         img.write_to(&mut std::io::Cursor::new(&mut bytes), format)
             .expect("encodes");
         seeds.push(bytes);
+    }
+    // DDS: the gradient uncompressed, and BC1 blocks (colours and indices from the gradient).
+    let rgba = gradient.as_raw().clone();
+    let blocks: Vec<u8> = rgba
+        .chunks(4)
+        .take(6 * 4 * 8)
+        .map(|p| p[0] ^ p[1])
+        .collect();
+    for (format, data) in [
+        (image_dds::ddsfile::DxgiFormat::R8G8B8A8_UNorm, rgba),
+        (image_dds::ddsfile::DxgiFormat::BC1_UNorm_sRGB, blocks),
+    ] {
+        seeds.push(common::dds(format, (24, 16), false, data));
     }
     let limit = MemoryLimit {
         bytes: 64 << 20,

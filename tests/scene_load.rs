@@ -2,6 +2,8 @@
 //! value forms, the errors and their places, meshes and their MTL materials, bare OBJ files, the
 //! built-in scenes and the TOML round trip.
 
+mod common;
+
 use std::path::Path;
 
 use glam::Vec3;
@@ -878,5 +880,92 @@ fn a_material_library_named_by_another_machine_is_found_next_to_the_obj() {
             && w.contains("No such file")),
         "{:?}",
         lost.warnings
+    );
+}
+
+/// Game assets' textures: DDS files named by an MTL load, uncompressed to the texels a PNG of
+/// the same image gives, BC1 to the colours its blocks hold, and a cube map as its first face;
+/// one cut short is a warning with a reason, the flat colour staying.
+#[test]
+fn dds_textures_load_uncompressed_bc1_and_a_cube_maps_first_face() {
+    use image_dds::ddsfile::DxgiFormat;
+    let dir = tempfile::tempdir().expect("temp dir");
+    let rgb = [255u8, 0, 0, 0, 128, 255, 10, 20, 30, 255, 255, 255];
+    let png = image::RgbImage::from_raw(2, 2, rgb.to_vec()).expect("2x2");
+    png.save(dir.path().join("plain.png")).expect("png");
+    let rgba: Vec<u8> = rgb
+        .chunks(3)
+        .flat_map(|p| [p[0], p[1], p[2], 255])
+        .collect();
+    let plain = common::dds(DxgiFormat::R8G8B8A8_UNorm_sRGB, (2, 2), false, rgba);
+    // One BC1 block: colour 0 red (RGB565 F800), colour 1 blue (001F); two bits a texel, a
+    // byte a row: rows 0 and 1 take colour 0, rows 2 and 3 colour 1.
+    let block = [0x00, 0xF8, 0x1F, 0x00, 0x00, 0x00, 0x55, 0x55];
+    let bc1 = common::dds(DxgiFormat::BC1_UNorm_sRGB, (4, 4), false, block.to_vec());
+    // Six faces, the first all red (every index 0).
+    let mut faces = vec![0x00, 0xF8, 0x1F, 0x00, 0, 0, 0, 0];
+    for _ in 0..5 {
+        faces.extend(block);
+    }
+    let cube = common::dds(DxgiFormat::BC1_UNorm, (4, 4), true, faces);
+    let cut = bc1[..bc1.len() - 4].to_vec();
+    for (name, bytes) in [
+        ("plain.dds", plain),
+        ("brick.DDS", bc1),
+        ("sky.dds", cube),
+        ("cut.dds", cut),
+    ] {
+        std::fs::write(dir.path().join(name), bytes).expect("write");
+    }
+    let mut mtl = String::new();
+    let mut obj = String::from("mtllib m.mtl\nvt 0 0\nvt 1 0\nvt 0 1\n");
+    let maps = ["plain.png", "plain.dds", "brick.DDS", "sky.dds", "cut.dds"];
+    for (i, map) in maps.iter().enumerate() {
+        mtl += &format!("newmtl m{i}\nKd 1 1 1\nmap_Kd {map}\n");
+        let x = 2 * i;
+        obj += &format!(
+            "usemtl m{i}\nv {x} 0 0\nv {} 0 0\nv {x} 1 0\nf {}/1 {}/2 {}/3\n",
+            x + 1,
+            3 * i + 1,
+            3 * i + 2,
+            3 * i + 3
+        );
+    }
+    std::fs::write(dir.path().join("m.mtl"), mtl).expect("write");
+    std::fs::write(dir.path().join("m.obj"), obj).expect("write");
+    let scene = load_scene_file(&dir.path().join("m.obj")).unwrap_or_else(|e| panic!("{e}"));
+    let texture = |i: usize| {
+        let id = material(&scene, &format!("m/m{i}"))
+            .diffuse_map
+            .unwrap_or_else(|| panic!("m{i} has its texture: {:?}", scene.warnings));
+        scene.textures[id.0 as usize].clone()
+    };
+    let (png, plain) = (texture(0), texture(1));
+    assert_eq!((plain.width, plain.height), (2, 2));
+    assert_eq!(plain.texels, png.texels, "uncompressed DDS against the PNG");
+    let brick = texture(2);
+    assert_eq!((brick.width, brick.height), (4, 4));
+    for (i, texel) in brick.texels.iter().enumerate() {
+        let want = if i < 8 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 0.0, 1.0]
+        };
+        assert_eq!(*texel, want, "BC1 texel {i}");
+    }
+    let sky = texture(3);
+    assert_eq!((sky.width, sky.height), (4, 4));
+    assert!(
+        sky.texels.iter().all(|&c| c == [1.0, 0.0, 0.0]),
+        "the cube map's first face"
+    );
+    assert!(material(&scene, "m/m4").diffuse_map.is_none());
+    assert!(
+        scene
+            .warnings
+            .iter()
+            .any(|w| w.contains("cannot use the texture `cut.dds`") && w.contains("(cannot")),
+        "{:?}",
+        scene.warnings
     );
 }

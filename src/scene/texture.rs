@@ -48,9 +48,9 @@ fn looks_like_tga(bytes: &[u8]) -> bool {
 }
 
 /// What [`decode_texture`] says of a file in none of the formats it reads.
-pub const NOT_AN_IMAGE: &str = "it is not a PNG, JPEG, TGA, BMP or TIFF image";
+pub const NOT_AN_IMAGE: &str = "it is not a PNG, JPEG, TGA, BMP, TIFF or DDS image";
 
-/// Decodes PNG, JPEG, TGA, BMP or TIFF `bytes` into a linear texture named `name`, or says why
+/// Decodes PNG, JPEG, TGA, BMP, TIFF or DDS `bytes` into a linear texture named `name`, or says why
 /// not in a phrase ([`NOT_AN_IMAGE`], "its 40000x40000 texels would need ..."). The format is
 /// read from the bytes, and for TGA (which has no signature) from a `.tga` ending of `name`,
 /// or from a header that can only be a TGA's (a TGA renamed `.png` by an exporter).
@@ -59,6 +59,9 @@ pub const NOT_AN_IMAGE: &str = "it is not a PNG, JPEG, TGA, BMP or TIFF image";
 /// refused too: the decoder would fill the missing part with grey and say nothing.
 pub fn decode_texture(name: &str, bytes: &[u8], limit: &MemoryLimit) -> Result<Texture, String> {
     use image::ImageFormat;
+    if bytes.starts_with(b"DDS ") {
+        return decode_dds(name, bytes, limit);
+    }
     let mut reader = image::ImageReader::new(Cursor::new(bytes))
         .with_guessed_format()
         .map_err(|e| format!("cannot read it ({})", one_line(&e)))?;
@@ -100,18 +103,54 @@ pub fn decode_texture(name: &str, bytes: &[u8], limit: &MemoryLimit) -> Result<T
         .map_err(|e| format!("cannot decode it ({})", one_line(&e)))?;
     let decoded = image::DynamicImage::from_decoder(decoder)
         .map_err(|e| format!("cannot decode it ({})", one_line(&e)))?;
-    let rgb = decoded.to_rgb8();
+    Ok(linear(name, &decoded.to_rgb8()))
+}
+
+/// A DDS texture (game assets: BC1–BC7 blocks, or uncompressed): its largest mipmap, and of a
+/// cube map or an array its first image. As for [`decode_texture`], one that would not fit in
+/// `limit` is refused from its header. Its texels are taken as sRGB, as an exporter writes a
+/// colour texture whatever format flag it sets.
+fn decode_dds(name: &str, bytes: &[u8], limit: &MemoryLimit) -> Result<Texture, String> {
+    let dds = image_dds::ddsfile::Dds::read(Cursor::new(bytes))
+        .map_err(|e| format!("cannot read it as DDS ({})", one_line(&e)))?;
+    let (width, height, depth) = (dds.get_width(), dds.get_height(), dds.get_depth());
+    if width == 0 || height == 0 {
+        return Err(format!("it has no texels ({width}x{height})"));
+    }
+    if depth > 1 {
+        return Err(format!(
+            "it is a volume texture ({width}x{height}x{depth}), not an image"
+        ));
+    }
+    // The decoded RGBA image, its RGB copy and the linear texels.
+    let texels = u64::from(width) * u64::from(height);
+    let peak = Texture::bytes(width, height).saturating_add(texels.saturating_mul(4 + 3));
+    limit
+        .check(format!("its {width}x{height} texels"), peak)
+        .map_err(|e| e.to_string())?;
+    let rgba = image_dds::SurfaceRgba8::decode_layers_mipmaps_dds(&dds, 0..1, 0..1)
+        .map_err(|e| format!("cannot decode it ({})", one_line(&e)))?
+        .into_image()
+        .map_err(|e| format!("cannot decode it ({})", one_line(&e)))?;
+    Ok(linear(
+        name,
+        &image::DynamicImage::ImageRgba8(rgba).to_rgb8(),
+    ))
+}
+
+/// The texture named `name` of an 8-bit sRGB image.
+fn linear(name: &str, rgb: &image::RgbImage) -> Texture {
     let lut: Vec<f32> = (0..=255u8).map(srgb_to_linear).collect();
     let texels = rgb
         .pixels()
         .map(|p| p.0.map(|c| lut[usize::from(c)]))
         .collect();
-    Ok(Texture {
+    Texture {
         name: name.to_string(),
-        width,
-        height,
+        width: rgb.width(),
+        height: rgb.height(),
         texels,
-    })
+    }
 }
 
 /// A decoder's error as words on one line (some end theirs with a line break): a warning is

@@ -182,3 +182,31 @@ pub fn floor() -> [Vec3; 4] {
         Vec3::new(-10.0, -1.0, -20.0),
     ]
 }
+
+/// A DDS file of `format` and `width`×`height` (a cube map of six faces when `cube`), holding
+/// `data`.
+pub fn dds(
+    format: image_dds::ddsfile::DxgiFormat,
+    (width, height): (u32, u32),
+    cube: bool,
+    data: Vec<u8>,
+) -> Vec<u8> {
+    use image_dds::ddsfile::{AlphaMode, D3D10ResourceDimension, Dds, NewDxgiParams};
+    let mut dds = Dds::new_dxgi(NewDxgiParams {
+        height,
+        width,
+        depth: None,
+        format,
+        mipmap_levels: None,
+        array_layers: None,
+        caps2: None,
+        is_cubemap: cube,
+        resource_dimension: D3D10ResourceDimension::Texture2D,
+        alpha_mode: AlphaMode::Straight,
+    })
+    .expect("a DDS header");
+    dds.data = data;
+    let mut out = Vec::new();
+    dds.write(&mut out).expect("writes");
+    out
+}
