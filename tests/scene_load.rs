@@ -969,3 +969,60 @@ fn dds_textures_load_uncompressed_bc1_and_a_cube_maps_first_face() {
         scene.warnings
     );
 }
+
+#[test]
+fn several_material_libraries_on_one_mtllib_line_are_all_read() {
+    // The format allows `mtllib a.mtl b.mtl`; a name with a space (`my model.mtl`, as Blender
+    // writes it) is still one file when there is one.
+    let dir = tempfile::tempdir().expect("temp dir");
+    std::fs::write(dir.path().join("a.mtl"), "newmtl red\nKd 1 0 0\n").expect("write");
+    std::fs::write(dir.path().join("b.mtl"), "newmtl green\nKd 0 1 0\n").expect("write");
+    std::fs::write(dir.path().join("my model.mtl"), "newmtl blue\nKd 0 0 1\n").expect("write");
+    let faces = "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\nusemtl green\nf 1 3 2\n";
+    std::fs::write(
+        dir.path().join("two.obj"),
+        format!("mtllib a.mtl b.mtl\n{faces}"),
+    )
+    .expect("write");
+    let scene = load_scene_file(&dir.path().join("two.obj")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        material(&scene, "two/red").diffuse,
+        Vec3::X,
+        "{:?}",
+        scene.warnings
+    );
+    assert_eq!(
+        material(&scene, "two/green").diffuse,
+        Vec3::Y,
+        "{:?}",
+        scene.warnings
+    );
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    // One of the two missing: the other's materials are used, the missing one is named.
+    std::fs::write(
+        dir.path().join("half.obj"),
+        format!("mtllib a.mtl gone.mtl\n{faces}"),
+    )
+    .expect("write");
+    let half = load_scene_file(&dir.path().join("half.obj")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(material(&half, "half/red").diffuse, Vec3::X);
+    assert!(
+        half.warnings
+            .iter()
+            .any(|w| w.contains("cannot read the material library `gone.mtl`")),
+        "{:?}",
+        half.warnings
+    );
+    std::fs::write(
+        dir.path().join("spaced.obj"),
+        "mtllib my model.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl blue\nf 1 2 3\n",
+    )
+    .expect("write");
+    let spaced = load_scene_file(&dir.path().join("spaced.obj")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        material(&spaced, "spaced/blue").diffuse,
+        Vec3::Z,
+        "{:?}",
+        spaced.warnings
+    );
+}

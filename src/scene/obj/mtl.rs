@@ -34,37 +34,72 @@ impl<'r> Libraries<'r> {
         }
     }
 
-    /// The library `path` (as the OBJ names it) read, for tobj.
+    /// The library `path` (as the OBJ names it) read, for tobj; `mtllib a.mtl b.mtl` (several
+    /// libraries on one line, as the format allows) when no one file has that whole name.
     pub(super) fn load(&self, path: &Path) -> tobj::MTLLoadResult {
-        let req = self.req;
-        if req.material_override.is_some() {
+        if self.req.material_override.is_some() {
             return Ok(Default::default());
         }
         let written = path.to_string_lossy();
-        let name = short_path(&written);
-        // As written, else as a texture named by another machine's path is looked for.
-        let mut first_reason = None;
-        let mut found = None;
-        for (i, candidate) in candidates(&written).into_iter().enumerate() {
-            match (req.resolve)(&sibling(req.key, &candidate)) {
-                Ok(text) => {
-                    found = Some((i, candidate, text));
-                    break;
+        let parts: Vec<&str> = written.split_whitespace().collect();
+        let whole = self.find(&written);
+        let libraries = match whole {
+            Err(_) if parts.len() > 1 && parts.iter().any(|p| self.find(p).is_ok()) => {
+                parts.iter().map(|&p| (p, self.find(p))).collect()
+            }
+            whole => vec![(written.as_ref(), whole)],
+        };
+        let mut merged: Option<tobj::MTLLoadResult> = None;
+        for (written, found) in libraries {
+            let result = self.read(written, found);
+            merged = Some(match (merged, result) {
+                (Some(Ok((mut materials, mut names))), Ok((more, more_names))) => {
+                    let offset = materials.len();
+                    materials.extend(more);
+                    names.extend(more_names.into_iter().map(|(k, i)| (k, i + offset)));
+                    Ok((materials, names))
                 }
+                (Some(Ok(ok)), Err(_)) => Ok(ok),
+                (_, result) => result,
+            });
+        }
+        merged.unwrap_or_else(|| Ok(Default::default()))
+    }
+
+    /// The library `written` (as the OBJ names it): its text and, when it was found by
+    /// [`candidates`] rather than as written, the name it was found as; or why it cannot be
+    /// read (the reason for the name as written).
+    fn find(&self, written: &str) -> Result<(Option<String>, String), String> {
+        let req = self.req;
+        let mut first_reason = None;
+        for (i, candidate) in candidates(written).into_iter().enumerate() {
+            match (req.resolve)(&sibling(req.key, &candidate)) {
+                Ok(text) => return Ok(((i > 0).then_some(candidate), text)),
                 Err(reason) => {
                     first_reason.get_or_insert(reason);
                 }
             }
         }
-        let Some((i, candidate, text)) = found else {
+        Err(first_reason.unwrap_or_default())
+    }
+
+    /// The library `written`, found (or not) by [`Libraries::find`], parsed for tobj, with a
+    /// warning when it cannot be and a note when it was found elsewhere.
+    fn read(
+        &self,
+        written: &str,
+        found: Result<(Option<String>, String), String>,
+    ) -> tobj::MTLLoadResult {
+        let req = self.req;
+        let name = short_path(written);
+        let (elsewhere, text) = found.map_err(|reason| {
             self.warnings.borrow_mut().push(format!(
-                "{}: cannot read the material library `{name}` ({}); its faces use the default material.",
-                req.label,
-                first_reason.unwrap_or_default()
+                "{}: cannot read the material library `{name}` ({reason}); its faces use the default material.",
+                req.label
             ));
-            return Err(tobj::LoadError::OpenFileFailed);
-        };
-        if i > 0 {
+            tobj::LoadError::OpenFileFailed
+        })?;
+        if let Some(candidate) = elsewhere {
             self.warnings.borrow_mut().push(format!(
                 "{}: the material library `{name}` is not where the OBJ says but next to it, as `{}`.",
                 req.label,
