@@ -352,26 +352,33 @@ fn png_bytes(w: u32, h: u32, rgb: &[u8]) -> Vec<u8> {
     out
 }
 
-#[test]
-fn map_kd_multiplies_kd_and_the_tree_shows_uv_and_texel() {
+/// A folder with TRI under material `t` of `t.mtl` (not written) and a scene of it seen by
+/// CAMERA: the folder and the scene file.
+fn textured_tri() -> (tempfile::TempDir, std::path::PathBuf) {
     let dir = tempfile::tempdir().expect("temp dir");
     std::fs::write(
         dir.path().join("tri.obj"),
         format!("mtllib t.mtl\nusemtl t\n{TRI}"),
     )
     .expect("obj");
-    std::fs::write(
-        dir.path().join("t.mtl"),
-        "newmtl t\nKd 0.5 0.5 0.5\nmap_Kd red.png\n",
-    )
-    .expect("mtl");
-    std::fs::write(dir.path().join("red.png"), png_bytes(1, 1, &[255, 0, 0])).expect("png");
     let scene_file = dir.path().join("s.toml");
     std::fs::write(
         &scene_file,
         format!("{CAMERA}[[mesh]]\nfile = \"tri.obj\"\n"),
     )
     .expect("toml");
+    (dir, scene_file)
+}
+
+#[test]
+fn map_kd_multiplies_kd_and_the_tree_shows_uv_and_texel() {
+    let (dir, scene_file) = textured_tri();
+    std::fs::write(
+        dir.path().join("t.mtl"),
+        "newmtl t\nKd 0.5 0.5 0.5\nmap_Kd red.png\n",
+    )
+    .expect("mtl");
+    std::fs::write(dir.path().join("red.png"), png_bytes(1, 1, &[255, 0, 0])).expect("png");
     let scene = load_scene_file(&scene_file).unwrap_or_else(|e| panic!("{e}"));
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
     assert_eq!(scene.textures.len(), 1);
@@ -409,6 +416,47 @@ fn map_kd_multiplies_kd_and_the_tree_shows_uv_and_texel() {
             "{what}: {w}"
         );
         assert!(scene.textures.is_empty());
+    }
+}
+
+#[test]
+fn map_kd_scale_and_offset_move_the_texture_on_the_texture_coordinates() {
+    // The centre pixel meets TRI at (0, 0): barycentric (¼, ¼, ½), so uv = (0.25, 0.5). The
+    // texture is two texels, red | blue, whose centres lie at u = 0.25 and 0.75; `-s` and `-o`
+    // move the lookup to u · s + o.
+    let (dir, scene_file) = textured_tri();
+    std::fs::write(
+        dir.path().join("rb.png"),
+        png_bytes(2, 1, &[255, 0, 0, 0, 0, 255]),
+    )
+    .expect("png");
+    for (options, want) in [
+        ("", Vec3::X),
+        ("-o 0.5 0 0 ", Vec3::Z),
+        ("-s 3 1 1 ", Vec3::Z),
+        ("-s 2 1 1 ", Vec3::new(0.5, 0.0, 0.5)),
+        ("-clamp on -s 2 1 1 -o 0.25 0 ", Vec3::Z),
+    ] {
+        std::fs::write(
+            dir.path().join("t.mtl"),
+            format!("newmtl t\nKd 1 1 1\nmap_Kd {options}rb.png\n"),
+        )
+        .expect("mtl");
+        let scene = load_scene_file(&scene_file).unwrap_or_else(|e| panic!("{options}: {e}"));
+        assert!(scene.warnings.is_empty(), "{options}: {:?}", scene.warnings);
+        let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());
+        let tree = pixel_tree(&tracer, 4, 4).expect("centre pixel");
+        let hit = tree.root.hit.as_ref().expect("hit");
+        let uv = glam::Vec2::from_array(hit.uv.expect("uv"));
+        assert!(
+            (uv - glam::Vec2::new(0.25, 0.5)).abs().max_element() < 1e-5,
+            "{options}: uv {uv}"
+        );
+        let texel = hit.texel.expect("texel");
+        assert!(
+            (texel - want).abs().max_element() < 1e-4,
+            "{options}: texel {texel}, want {want}"
+        );
     }
 }
 

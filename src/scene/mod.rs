@@ -130,6 +130,37 @@ pub struct Material {
     pub diffuse_map: Option<TextureId>,
     /// MTL `map_Ka`: a texture whose texel multiplies `ka`.
     pub ambient_map: Option<TextureId>,
+    /// Where `diffuse_map` lies on the texture coordinates (MTL `-s`, `-o`).
+    #[serde(default)]
+    pub diffuse_map_placement: MapPlacement,
+    /// Where `ambient_map` lies on the texture coordinates.
+    #[serde(default)]
+    pub ambient_map_placement: MapPlacement,
+}
+
+/// How a texture map lies on a mesh's texture coordinates: MTL's `-s u v` (scale, a floor tiled
+/// four times is `-s 4 4`) and `-o u v` (origin offset); a map is looked up at `uv · scale +
+/// offset`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MapPlacement {
+    pub scale: Vec2,
+    pub offset: Vec2,
+}
+
+impl Default for MapPlacement {
+    fn default() -> Self {
+        Self {
+            scale: Vec2::ONE,
+            offset: Vec2::ZERO,
+        }
+    }
+}
+
+impl MapPlacement {
+    /// The texture coordinate at which the map is sampled for the mesh's `uv`.
+    pub fn apply(self, uv: Vec2) -> Vec2 {
+        uv * self.scale + self.offset
+    }
 }
 
 impl Default for Material {
@@ -145,6 +176,8 @@ impl Default for Material {
             ior: 1.5,
             diffuse_map: None,
             ambient_map: None,
+            diffuse_map_placement: MapPlacement::default(),
+            ambient_map_placement: MapPlacement::default(),
         }
     }
 }

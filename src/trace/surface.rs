@@ -77,11 +77,12 @@ impl Tracer {
         let (mut texel_kd, mut texel_ka) = (None, None);
         if let Some(uv) = uv {
             let m = scene.material(material);
-            let texel = |map: Option<crate::scene::TextureId>| {
-                map.and_then(|id| scene.texture(id)).map(|t| t.sample(uv))
+            let texel = |map: Option<crate::scene::TextureId>, at: crate::scene::MapPlacement| {
+                map.and_then(|id| scene.texture(id))
+                    .map(|t| t.sample(at.apply(uv)))
             };
-            texel_kd = texel(m.diffuse_map);
-            texel_ka = texel(m.ambient_map);
+            texel_kd = texel(m.diffuse_map, m.diffuse_map_placement);
+            texel_ka = texel(m.ambient_map, m.ambient_map_placement);
         }
         // Field by field: a whole `SurfaceHit` assigned at once is formed on the stack and
         // copied (+0.2 % instructions on the 80k bench frame).

@@ -4,23 +4,61 @@
 
 use std::sync::Arc;
 
+use glam::Vec2;
+
 use super::paths::sibling;
 use super::read::quietly;
 use super::request::MeshRequest;
 use crate::scene::budget::{MemoryLimit, memory_limit};
 use crate::scene::diag::{short, short_path};
 use crate::scene::texture::decode_texture;
-use crate::scene::{Scene, Texture, TextureId};
+use crate::scene::{MapPlacement, Scene, Texture, TextureId};
 
-/// The file a `map_Kd` value names: the value, or its last word when it starts with options
-/// (`-s 2 2 1 wood.png`).
-fn texture_file(value: &str) -> &str {
-    let value = value.trim();
-    if value.starts_with('-') {
-        value.split_whitespace().last().unwrap_or(value)
-    } else {
-        value
+/// The file a `map_Kd` value names and where the map lies (`-s`, `-o`): the value after its
+/// options (`-s 2 2 1 wood.png`, `-o 0.5 0 -bm 1 my wood.png`), each option taking as many
+/// words after it as it may have (up to three numbers for `-s`, `-o`, `-t`; two for `-mm`;
+/// one for the others), so a file name with spaces stays whole. An option this does not know
+/// takes the numbers that follow it; `-t` (turbulence) and the others change nothing here.
+pub(super) fn texture_statement(value: &str) -> (&str, MapPlacement) {
+    let mut rest = value.trim();
+    let mut place = MapPlacement::default();
+    while let Some(option) = rest
+        .strip_prefix('-')
+        .and_then(|r| r.split_whitespace().next())
+    {
+        rest = rest[1 + option.len()..].trim_start();
+        let most = match option {
+            "s" | "o" | "t" => 3,
+            "mm" => 2,
+            "blendu" | "blendv" | "boost" | "texres" | "clamp" | "bm" | "imfchan" | "type"
+            | "cc" => 1,
+            _ => 3,
+        };
+        let mut numbers = Vec::new();
+        for _ in 0..most {
+            let Some(word) = rest.split_whitespace().next() else {
+                break;
+            };
+            let number = word.parse::<f32>().ok().filter(|n| n.is_finite());
+            let switch = matches!(word, "on" | "off") || matches!(option, "imfchan" | "type");
+            if number.is_none() && !switch {
+                break;
+            }
+            // Nothing after it: it is the file (`-bm 1 2.png` names `2.png`).
+            if rest[word.len()..].trim().is_empty() {
+                break;
+            }
+            numbers.extend(number);
+            rest = rest[word.len()..].trim_start();
+        }
+        let at = |i: usize, default: f32| numbers.get(i).copied().unwrap_or(default);
+        match option {
+            "s" if !numbers.is_empty() => place.scale = Vec2::new(at(0, 1.0), at(1, 1.0)),
+            "o" if !numbers.is_empty() => place.offset = Vec2::new(at(0, 0.0), at(1, 0.0)),
+            _ => {}
+        }
     }
+    (rest.trim(), place)
 }
 
 /// Where to look for a file `file` as a model names it (a texture in an MTL, a material
@@ -60,7 +98,7 @@ pub(super) fn load_texture(
     warnings: &mut Vec<String>,
     elsewhere: &mut Vec<(String, String)>,
 ) -> Option<TextureId> {
-    let file = texture_file(value);
+    let file = texture_statement(value).0;
     let tails = candidates(file);
     let paths: Vec<String> = tails.iter().map(|c| sibling(req.key, c)).collect();
     let place = mtl_texts
@@ -139,6 +177,49 @@ pub(super) fn load_texture(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn map_options_give_the_file_and_the_placement() {
+        let plain = MapPlacement::default();
+        let s = |u, v| MapPlacement {
+            scale: Vec2::new(u, v),
+            offset: Vec2::ZERO,
+        };
+        assert_eq!(texture_statement("wood.png"), ("wood.png", plain));
+        assert_eq!(texture_statement("  my wood.png "), ("my wood.png", plain));
+        assert_eq!(
+            texture_statement("-s 4 2 1 floor.png"),
+            ("floor.png", s(4.0, 2.0))
+        );
+        assert_eq!(
+            texture_statement("-s 3 floor.png"),
+            ("floor.png", s(3.0, 1.0))
+        );
+        assert_eq!(
+            texture_statement("-o 0.5 0.25 -s 2 2 my floor tiles.png"),
+            (
+                "my floor tiles.png",
+                MapPlacement {
+                    scale: Vec2::splat(2.0),
+                    offset: Vec2::new(0.5, 0.25),
+                }
+            )
+        );
+        // Options that change nothing here, with their words; a number that is the file.
+        assert_eq!(
+            texture_statement("-clamp on -bm 0.3 -imfchan l -type sphere -mm 0 1 bump.png"),
+            ("bump.png", plain)
+        );
+        assert_eq!(texture_statement("-bm 1 2.png"), ("2.png", plain));
+        assert_eq!(texture_statement("-blendu off 7"), ("7", plain));
+        // An option this does not know takes its numbers.
+        assert_eq!(texture_statement("-halo 1 2 wood.png"), ("wood.png", plain));
+        // A scale that is no finite number is not one.
+        assert_eq!(
+            texture_statement("-s nan wood.png"),
+            ("nan wood.png", plain)
+        );
+    }
 
     #[test]
     fn another_machines_paths_are_tried_as_tails_with_slashes() {

@@ -8,7 +8,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use super::maps::{candidates, load_texture};
+use super::maps::{candidates, load_texture, texture_statement};
 use super::parse::Facts;
 use super::paths::sibling;
 use super::request::MeshRequest;
@@ -239,9 +239,20 @@ pub(super) fn mtl_material(
     };
     let diffuse = texture("map_Kd", &m.diffuse_texture);
     let ambient = texture("map_Ka", &m.ambient_texture);
+    let placement = |file: &Option<String>| {
+        file.as_deref()
+            .map(|f| texture_statement(f).1)
+            .unwrap_or_default()
+    };
     let material = &mut scene.materials[id.0 as usize];
-    material.diffuse_map = material.diffuse_map.or(diffuse);
-    material.ambient_map = material.ambient_map.or(ambient);
+    if material.diffuse_map.is_none() && diffuse.is_some() {
+        material.diffuse_map = diffuse;
+        material.diffuse_map_placement = placement(&m.diffuse_texture);
+    }
+    if material.ambient_map.is_none() && ambient.is_some() {
+        material.ambient_map = ambient;
+        material.ambient_map_placement = placement(&m.ambient_texture);
+    }
     id
 }
 
@@ -300,6 +311,8 @@ fn material_from_mtl(
         ior,
         diffuse_map: None,
         ambient_map: None,
+        diffuse_map_placement: Default::default(),
+        ambient_map_placement: Default::default(),
     }
 }
 

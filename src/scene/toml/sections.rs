@@ -85,6 +85,8 @@ pub(super) fn parse_material(s: &Section, name: String) -> Result<Material, Scen
         ior: s.f32("ior", d.ior)?,
         diffuse_map: None,
         ambient_map: None,
+        diffuse_map_placement: Default::default(),
+        ambient_map_placement: Default::default(),
     };
     rules::check_material(&material).map_err(|v| s.verdict(&v))?;
     Ok(material)
