@@ -1026,3 +1026,51 @@ fn several_material_libraries_on_one_mtllib_line_are_all_read() {
         spaced.warnings
     );
 }
+
+#[test]
+fn windows_byte_order_marks_and_continued_lines_read_as_meant() {
+    // Notepad and some exporters start a file with a UTF-8 byte-order mark; the OBJ format
+    // lets a long face go on on the next line after a `\`. Both lost a vertex or the file.
+    let dir = tempfile::tempdir().expect("temp dir");
+    std::fs::write(
+        dir.path().join("m.mtl"),
+        "\u{FEFF}newmtl red\r\nKd 1 0 0\r\n",
+    )
+    .expect("write");
+    std::fs::write(
+        dir.path().join("m.obj"),
+        "\u{FEFF}v 0 0 0\r\nv 1 0 0\r\nv 1 1 0\r\nv 0 1 0\r\nmtllib m.mtl\r\nusemtl red\r\nf 1 2 \\\r\n 3 4\r\n",
+    )
+    .expect("write");
+    let scene = load_scene_file(&dir.path().join("m.obj")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.triangles.len(), 2, "the quad over two lines");
+    assert_eq!(
+        material(&scene, "m/red").diffuse,
+        Vec3::X,
+        "{:?}",
+        scene.warnings
+    );
+    assert!(
+        scene.warnings.iter().all(|w| !w.contains("usemtl")),
+        "{:?}",
+        scene.warnings
+    );
+    // A scene file with a mark.
+    std::fs::write(
+        dir.path().join("s.toml"),
+        "\u{FEFF}[render]\nwidth = 32\n[[mesh]]\nfile = \"m.obj\"\n",
+    )
+    .expect("write");
+    let scene = load_scene_file(&dir.path().join("s.toml")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.render.width, 32);
+    // After a continued face, an error still names its own line (8).
+    std::fs::write(
+        dir.path().join("bad.obj"),
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 \\\n 3 4\nv 1 2 3\nv 1 x 2\n",
+    )
+    .expect("write");
+    let err = load_scene_file(&dir.path().join("bad.obj"))
+        .expect_err("refused")
+        .to_string();
+    assert!(err.contains("bad.obj:8:"), "{err}");
+}

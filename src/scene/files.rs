@@ -187,11 +187,18 @@ fn read_text_watched(
     if let Some(reason) = super::lfs::pointer_reason(&bytes) {
         return Err(reason);
     }
+    // A UTF-8 byte-order mark (Windows tools write one) is no part of the first line.
+    if bytes.starts_with(BOM) {
+        bytes.drain(..BOM.len());
+    }
     // Valid UTF-8 is taken as it is, without the copy `from_utf8_lossy` would make.
     Ok(Some(String::from_utf8(bytes).unwrap_or_else(|e| {
         String::from_utf8_lossy(e.as_bytes()).into_owned()
     })))
 }
+
+/// The UTF-8 byte-order mark.
+const BOM: &[u8] = b"\xEF\xBB\xBF";
 
 /// The OS's reason without the platform-specific "(os error N)" tail, for stable messages.
 fn os_reason(e: &std::io::Error) -> String {

@@ -3,6 +3,7 @@
 //! material found, and the degenerate faces dropped; last the mesh's normals, texture
 //! coordinates and warnings.
 
+use std::borrow::Cow;
 use std::sync::Arc;
 
 use glam::{Mat3, Vec2, Vec3};
@@ -14,7 +15,7 @@ use super::faces::{Faces, Given, PLACED, dropped, keep_placed};
 use super::memory::check_memory;
 use super::mtl::{Libraries, mtl_material, warn_unknown_usemtl};
 use super::parse::Facts;
-use super::read::{ObjProblem, read_models, scan};
+use super::read::{ObjProblem, join_continued_lines, read_models, scan};
 use super::request::MeshRequest;
 use crate::scene::diag::short_path;
 use crate::scene::{MaterialId, MeshAttributes, MeshPart, NormalsMode, Scene};
@@ -25,6 +26,15 @@ const UNNAMED: &str = "unnamed_object";
 /// Adds the OBJ's triangles (placed, degenerate ones dropped) and the MTL materials they use
 /// to `scene`; returns how many triangles were added.
 pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, ObjProblem> {
+    let joined = join_continued_lines(req.text);
+    let with_joined;
+    let req = match &joined {
+        Cow::Owned(text) => {
+            with_joined = MeshRequest { text, ..*req };
+            &with_joined
+        }
+        Cow::Borrowed(_) => req,
+    };
     let (scanned, fast_corners, facts) = scan(req.text)?;
     // A file without `vn` whose faces are in smoothing groups (`s 1`) shades as its exporter
     // meant: smooth, with normals computed as for `normals = "smooth"` within each group.

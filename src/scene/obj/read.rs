@@ -28,6 +28,46 @@ impl ObjProblem {
     }
 }
 
+/// OBJ text with its continued lines joined: a statement whose line ends in `\` goes on on the
+/// next line (the format allows it, for long faces; tobj does not read it). The `\` and the
+/// line break become a space, and the break is put back after the joined statement, so every
+/// later line keeps its number in messages. Only statements of numbers and names continue
+/// (`v`, `vt`, `vn`, `vp`, `f`, `fo`, `l`, `p`, `g`): a comment or a file name (`mtllib
+/// C:\models\`) that ends in `\` does not swallow the next line.
+pub(super) fn join_continued_lines(text: &str) -> Cow<'_, str> {
+    const CONTINUE: [&str; 9] = ["v", "vt", "vn", "vp", "f", "fo", "l", "p", "g"];
+    let ends_continued = |line: &str| line.trim_end_matches(['\n', '\r']).ends_with('\\');
+    let starts_continuable = |line: &str| {
+        line.split_whitespace()
+            .next()
+            .is_some_and(|word| CONTINUE.contains(&word))
+    };
+    if !text.as_bytes().contains(&b'\\')
+        || !text
+            .split_inclusive('\n')
+            .any(|l| l.ends_with('\n') && ends_continued(l) && starts_continuable(l))
+    {
+        return Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len());
+    let mut owed = 0;
+    for line in text.split_inclusive('\n') {
+        let continuing = owed > 0 || starts_continuable(line);
+        if continuing && line.ends_with('\n') && ends_continued(line) {
+            let body = line.trim_end_matches(['\n', '\r']);
+            out.push_str(&body[..body.len() - 1]);
+            out.push(' ');
+            owed += 1;
+        } else {
+            out.push_str(line);
+            out.extend(std::iter::repeat_n('\n', owed));
+            owed = 0;
+        }
+    }
+    out.extend(std::iter::repeat_n('\n', owed));
+    Cow::Owned(out)
+}
+
 /// One pass of the parallel reader over `text`: the pass (`None` when it leaves the text to
 /// tobj), which faces give `vn`/`vt` at every corner as it saw them, and the [`Facts`] the budget
 /// and the warnings need (counted line by line for a text left to tobj).
@@ -248,6 +288,39 @@ fn error_line(text: &str) -> Option<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn continued_lines_are_joined_and_later_lines_keep_their_numbers() {
+        let join = |t| join_continued_lines(t).into_owned();
+        // Nothing continued: the text itself, not a copy.
+        for t in ["v 0 0 0\nf 1 2 3\n", "mtllib C:\\models\\m.mtl\n"] {
+            assert!(matches!(join_continued_lines(t), Cow::Borrowed(_)), "{t:?}");
+        }
+        assert_eq!(
+            join("v 0 0 0\nf 1 2 \\\n 3 4\nf 1 2 3\n"),
+            "v 0 0 0\nf 1 2   3 4\n\nf 1 2 3\n"
+        );
+        // CRLF, a statement over three lines, and one that ends the file.
+        assert_eq!(
+            join("f 1 \\\r\n2 \\\r\n3\r\nv 0 0 0\r\n"),
+            "f 1  2  3\r\n\n\nv 0 0 0\r\n"
+        );
+        assert_eq!(join("v 1 2 \\\n3"), "v 1 2  3\n");
+        assert_eq!(join("v 0 0 0\nf 1 2 \\\n"), "v 0 0 0\nf 1 2  \n");
+        // A comment or a file name ending in `\` does not take the next line.
+        let kept = "# a note \\\nv 0 0 0\nmtllib C:\\models\\\nv 1 0 0\nf 1 2 \\\n3\n";
+        assert_eq!(
+            join(kept),
+            "# a note \\\nv 0 0 0\nmtllib C:\\models\\\nv 1 0 0\nf 1 2  3\n\n"
+        );
+        for t in [
+            "v 0 0 0\nf 1 2 \\\n 3 4\nf 1 2 3\n",
+            "f 1 \\\r\n2 \\\r\n3\r\nv 0 0 0\r\n",
+            kept,
+        ] {
+            assert_eq!(join(t).lines().count(), t.lines().count(), "{t:?}");
+        }
+    }
 
     #[test]
     fn error_lines_are_found() {
