@@ -423,3 +423,50 @@ fn faces_with_mixed_corners_are_flagged_alike_on_either_path() {
     assert!(fast.warnings[1].contains("texture coordinates (`vt`) at some corners only"));
     assert!(fast.warnings[2].contains("degenerate triangles"));
 }
+
+#[test]
+fn a_concave_face_is_cut_inside_its_outline_with_its_attributes() {
+    // An L-shaped n-gon (area 3) as Blender writes a floor plan, from a corner whose fan
+    // covers the notch [1, 2]², with a normal of its own at every corner (x, y, 4); and a
+    // convex hexagon, whose fan stays.
+    let text = "v 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nv 0 0 0\nv 2 0 0\n\
+        vn 2 1 4\nvn 1 1 4\nvn 1 2 4\nvn 0 2 4\nvn 0 0 4\nvn 2 0 4\n\
+        f 1//1 2//2 3//3 4//4 5//5 6//6\n\
+        v 5 0 0\nv 6 0 0\nv 7 1 0\nv 6 2 0\nv 5 2 0\nv 4 1 0\nf 7 8 9 10 11 12\n";
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("plan.obj");
+    std::fs::write(&path, text).expect("write");
+    let scene = raytree::scene::load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.triangles.len(), 8);
+    let mut l_area = 0.0;
+    for (i, t) in scene.triangles.iter().enumerate().take(4) {
+        let [a, b, c] = t.vertices;
+        let n = (b - a).cross(c - a);
+        assert!(n.z > 0.0, "triangle {i} keeps the face's winding: {n}");
+        l_area += 0.5 * n.z;
+        let centre = (a + b + c) / 3.0;
+        assert!(
+            !(centre.x > 1.0 && centre.y > 1.0),
+            "triangle {i} ({a}, {b}, {c}) lies in the notch"
+        );
+        // Each corner kept its own normal.
+        let (attrs, local) = scene.attributes_of(i).expect("attributes");
+        let normals = attrs.normals_of(local).expect("normals");
+        for (p, n) in t.vertices.iter().zip(normals) {
+            let want = glam::Vec3::new(p.x, p.y, 4.0).normalize();
+            assert!((n - want).length() < 1e-6, "{p} has the normal {n}");
+        }
+    }
+    assert!((l_area - 3.0).abs() < 1e-5, "the L's area {l_area}");
+    let hex_area: f32 = scene.triangles[4..]
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.vertices;
+            0.5 * (b - a).cross(c - a).z
+        })
+        .sum();
+    assert!(
+        (hex_area - 4.0).abs() < 1e-5,
+        "the hexagon's area {hex_area}"
+    );
+}

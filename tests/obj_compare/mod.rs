@@ -110,7 +110,7 @@ pub fn without_polylines(text: &str) -> String {
 }
 
 /// What the loader's single pass must count, counted line by line here: `v`, `vt`, `vn`,
-/// triangles of `f` (one for a face of fewer than three corners), `l` lines, the names of
+/// triangles of `f` (one for a face of fewer than three corners) and its n-gons, `l` lines, the names of
 /// `usemtl` followed by a space or tab, and whether an `s` line names a group (not `off`, not
 /// a number equal to 0).
 pub fn facts_by_lines(text: &str) -> raytree::scene::obj::parse::Facts {
@@ -129,7 +129,11 @@ pub fn facts_by_lines(text: &str) -> raytree::scene::obj::parse::Facts {
                     f.smoothing |= !off;
                 }
             }
-            Some("f") => f.triangles += (words.count() as u64).saturating_sub(2).max(1),
+            Some("f") => {
+                let corners = words.count() as u64;
+                f.triangles += corners.saturating_sub(2).max(1);
+                f.ngons += u64::from(corners >= 5);
+            }
             _ => {}
         }
         if let Some(rest) = line.trim_start().strip_prefix("usemtl")

@@ -51,8 +51,11 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     };
     check_memory(scene, req.text.len(), &facts, req.normals)?;
     let libraries = Libraries::new(req);
-    let (models, mtl_materials, fast) =
+    let (mut models, mtl_materials, fast) =
         read_models(req.text, scanned, |path| libraries.load(path))?;
+    if facts.ngons > 0 {
+        super::polygons::cut_concave_faces(&mut models, req.text);
+    }
     let face_corners = face_corners(req.text, &models, fast, fast_corners)?;
     let (mut warnings, mtl_texts) = libraries.finish();
     warn_about_reading(req, &facts, &mtl_materials, &mut warnings);

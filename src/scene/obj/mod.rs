@@ -23,6 +23,7 @@ mod mesh;
 mod mtl;
 pub mod parse;
 mod paths;
+mod polygons;
 mod read;
 mod request;
 

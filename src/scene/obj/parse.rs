@@ -66,6 +66,8 @@ struct Chunk {
     face_triangles: u64,
     /// `l` lines skipped ([`Polylines::Skip`]).
     polylines: u64,
+    /// `f` lines of five corners or more.
+    ngons: u64,
     /// `usemtl` names as the loader's warning names them (see [`Facts::usemtl`]).
     usemtl: Vec<String>,
     /// For the triangles of the `f` lines, in runs of equal flags (most files have one run):
@@ -102,6 +104,8 @@ pub struct Facts {
     pub triangles: u64,
     /// `l` statements skipped ([`Polylines::Skip`]; 0 with [`Polylines::AsFaces`]).
     pub polylines: u64,
+    /// `f` statements of five corners or more (n-gons, which may be concave).
+    pub ngons: u64,
     /// The names of `usemtl` lines that start (after leading whitespace) with `usemtl` and a
     /// space or tab, trimmed, without empty ones.
     pub usemtl: BTreeSet<String>,
@@ -230,6 +234,7 @@ pub fn scan(text: &str, polylines: Polylines) -> Option<Scanned> {
         base.1[2] += chunk.normals.len() / 3;
         facts.triangles += chunk.face_triangles;
         facts.polylines += chunk.polylines;
+        facts.ngons += chunk.ngons;
         facts.usemtl.extend(std::mem::take(&mut chunk.usemtl));
         facts.smoothing |= chunk.smoothing;
     }
@@ -492,6 +497,7 @@ fn parse_line<'a>(
             let (corners, given) = face(words, &mut chunk.corners)?;
             let triangles = (chunk.corners.len() - before) / 3;
             chunk.face_triangles += triangles as u64;
+            chunk.ngons += u64::from(corners >= 5);
             // The same facts as [`super::corners`] finds by reading the line again.
             let all = |list: usize| given[list] == corners;
             let flags = (u8::from(all(0)) * ALL_UVS) | (u8::from(all(1)) * ALL_NORMALS);

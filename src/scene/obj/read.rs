@@ -246,6 +246,7 @@ pub(super) fn slow_facts(text: &str) -> Facts {
             Some("vn") => facts.normals += 1,
             Some("vt") => facts.texcoords += 1,
             Some("l") => facts.polylines += 1,
+            Some("f") => facts.ngons += u64::from(words.count() >= 5),
             _ => {}
         }
         if let Some(rest) = line.trim_start().strip_prefix("usemtl")
