@@ -7,8 +7,9 @@
 
 use glam::{DVec2, DVec3};
 
-/// Faces of more corners than this keep their fan: ear clipping is quadratic in the corners.
-const MAX_CORNERS: usize = 1024;
+/// Faces of more corners than this keep their fan: ear clipping costs up to the cube of the
+/// corners (their square for a face with few reflex corners, as floor plans and letters are).
+const MAX_CORNERS: usize = 256;
 
 /// The corners of each `f` statement in file order (the order of the readers' triangles).
 fn face_corners(text: &str) -> Vec<usize> {
@@ -131,19 +132,34 @@ fn ear_clip(points: &[DVec3]) -> Option<Vec<[usize; 3]>> {
         side(a, b) > 0.0 && side(b, c) > 0.0 && side(c, a) > 0.0
     };
     let mut ring: Vec<usize> = (0..n).collect();
+    // Only a reflex corner can lie inside an ear, and corners only turn convex as ears go: the
+    // test of an ear looks at the reflex corners left (none in most of a floor plan's fan).
+    let mut reflex: Vec<usize> = (0..n)
+        .filter(|&i| turn((i + n - 1) % n, i, (i + 1) % n) <= 0.0)
+        .collect();
     let mut out = Vec::with_capacity(n - 2);
+    // The search for the next ear starts where the last was cut, where one usually is.
+    let mut start = 0;
     while ring.len() > 3 {
         let m = ring.len();
-        let ear = (0..m).find(|&i| {
+        let ear = (0..m).map(|k| (start + k) % m).find(|&i| {
             let (a, b, c) = (ring[(i + m - 1) % m], ring[i], ring[(i + 1) % m]);
             turn(a, b, c) > 0.0
-                && ring
+                && reflex
                     .iter()
                     .filter(|&&k| k != a && k != b && k != c)
                     .all(|&k| !inside(flat[k], a, b, c))
         })?;
-        out.push([ring[(ear + m - 1) % m], ring[ear], ring[(ear + 1) % m]]);
+        let (a, b, c) = (ring[(ear + m - 1) % m], ring[ear], ring[(ear + 1) % m]);
+        out.push([a, b, c]);
         ring.remove(ear);
+        // The ear's neighbours have new neighbours of their own.
+        let m = ring.len();
+        let (ia, ic) = ((ear + m - 1) % m, ear % m);
+        let convex = |i: usize| turn(ring[(i + m - 1) % m], ring[i], ring[(i + 1) % m]) > 0.0;
+        let (a_convex, c_convex) = (convex(ia), convex(ic));
+        reflex.retain(|&k| k != b && !(k == a && a_convex) && !(k == c && c_convex));
+        start = ia;
     }
     out.push([ring[0], ring[1], ring[2]]);
     Some(out)
@@ -199,6 +215,46 @@ mod tests {
             ear_clip(&plane(&[(0., 0.), (1., 0.), (2., 0.), (3., 0.)])),
             None
         );
+    }
+
+    #[test]
+    fn a_star_of_many_points_is_cut_into_its_area() {
+        // 128 points (256 corners, every other one reflex), and a comb of 40 teeth.
+        let star: Vec<(f64, f64)> = (0..256)
+            .map(|i| {
+                let a = std::f64::consts::TAU * f64::from(i) / 256.0;
+                let r = if i % 2 == 0 { 1.0 } else { 0.6 };
+                (r * a.cos(), r * a.sin())
+            })
+            .collect();
+        let mut comb = vec![(0.0, 0.0), (40.0, 0.0)];
+        for t in (0..40).rev() {
+            let x = f64::from(t);
+            comb.extend([(x + 1.0, 3.0), (x + 0.5, 3.0), (x + 0.5, 1.0), (x, 1.0)]);
+        }
+        comb.pop();
+        comb.push((0.0, 3.0));
+        for (what, outline) in [("star", star), ("comb", comb)] {
+            let points = plane(&outline);
+            let n = points.len();
+            let shoelace: f64 = (0..n)
+                .map(|i| {
+                    let (p, q) = (points[i], points[(i + 1) % n]);
+                    0.5 * (p.x * q.y - q.x * p.y)
+                })
+                .sum();
+            let cut = ear_clip(&points).unwrap_or_else(|| panic!("{what} is concave"));
+            assert_eq!(cut.len(), n - 2, "{what}");
+            assert!(
+                cut.iter().all(|&t| area2(&points, t) > 0.0),
+                "{what}: winding"
+            );
+            let area: f64 = cut.iter().map(|&t| 0.5 * area2(&points, t)).sum();
+            assert!(
+                (area - shoelace).abs() < 1e-9 * shoelace,
+                "{what}: {area} against {shoelace}"
+            );
+        }
     }
 
     #[test]
