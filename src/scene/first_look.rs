@@ -328,9 +328,10 @@ impl Probe {
     }
 }
 
-/// The first view of a model whose bounds are `lo..hi`, `up` being its up axis: inside it when
-/// it is a room (walls and a ceiling around a point near its middle), else from the front and
-/// a little above (higher for a room without a ceiling), as close as the whole model allows.
+/// The first view of a model whose bounds are `lo..hi`, `up` being its up axis: when it is a
+/// room (walls and a ceiling around a point near its middle), inside it, in the opening of a
+/// wall with a door or a hole, or in front of a side that is open; else from the front and a
+/// little above (higher for a room without a ceiling), as close as the whole model allows.
 fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32) -> FirstView {
     let center = 0.5 * (lo + hi);
     let half = 0.5 * (hi - lo);
