@@ -59,6 +59,12 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     let face_corners = face_corners(req.text, &models, fast, fast_corners)?;
     let (mut warnings, mtl_texts) = libraries.finish();
     warn_about_reading(req, &facts, &mtl_materials, &mut warnings);
+    if models.iter().any(|m| !m.mesh.vertex_color.is_empty()) {
+        warnings.push(format!(
+            "{}: the vertices have colours (`v x y z r g b`, as scans and MeshLab write), which raytree does not show: the faces take their materials' colours.",
+            req.label
+        ));
+    }
     // A file with `vn` on some faces only: those of the others in a smoothing group get
     // normals computed within it.
     let lacking = |f: u8| f & corners::ALL_NORMALS == 0;
