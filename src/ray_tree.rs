@@ -37,7 +37,8 @@ pub struct HitRecord {
     /// Texture coordinates, where a texture applies.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub uv: Option<[f32; 2]>,
-    /// The `map_Kd` texel at `uv` (linear RGB), which multiplies the material's diffuse.
+    /// What multiplies the material's diffuse at the hit (linear RGB): the `map_Kd` texel at
+    /// `uv`, times the vertex colour interpolated there when the mesh has colours.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub texel: Option<Vec3>,
 }

@@ -461,6 +461,44 @@ fn map_kd_scale_and_offset_move_the_texture_on_the_texture_coordinates() {
 }
 
 #[test]
+fn vertex_colours_multiply_kd_interpolated_at_the_hit() {
+    // The centre pixel meets the triangle at barycentric (¼, ¼, ½) (as TRI): red, green and
+    // blue corners (sRGB 1, linear 1) give (0.25, 0.25, 0.5); a grey of sRGB 0.5 at every
+    // corner gives its linear 0.2140.
+    for (colours, want) in [
+        (["1 0 0", "0 1 0", "0 0 1"], Vec3::new(0.25, 0.25, 0.5)),
+        (["0.5 0.5 0.5"; 3], Vec3::splat(0.214_041)),
+    ] {
+        let obj = format!(
+            "v -1 -1 0 {}\nv 1 -1 0 {}\nv 0 1 0 {}\nf 1 2 3\n",
+            colours[0], colours[1], colours[2]
+        );
+        let dir = tempfile::tempdir().expect("temp dir");
+        std::fs::write(dir.path().join("c.obj"), obj).expect("obj");
+        let scene_file = dir.path().join("s.toml");
+        std::fs::write(&scene_file, format!("{CAMERA}[[mesh]]\nfile = \"c.obj\"\n")).expect("toml");
+        let scene = load_scene_file(&scene_file).unwrap_or_else(|e| panic!("{e}"));
+        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());
+        let tree = pixel_tree(&tracer, 4, 4).expect("centre pixel");
+        let hit = tree.root.hit.as_ref().expect("hit");
+        let texel = hit.texel.expect("the colour multiplies kd");
+        assert!(
+            (texel - want).abs().max_element() < 1e-4,
+            "{colours:?}: {texel}, want {want}"
+        );
+        // kd (0.7 by default) × the colour: no other hue.
+        let local = tree.root.local.expect("shaded");
+        let ratio = local.diffuse / want;
+        assert!(
+            (ratio - Vec3::splat(ratio.x)).abs().max_element() < 1e-3,
+            "{colours:?}: diffuse {} not in the colour's proportions",
+            local.diffuse
+        );
+    }
+}
+
+#[test]
 fn built_in_textures_are_read_from_the_binary() {
     let scene = load_scene_str_with_files(
         raytree::scene::builtin::scene_text("smooth").expect("smooth"),

@@ -1074,29 +1074,3 @@ fn windows_byte_order_marks_and_continued_lines_read_as_meant() {
         .to_string();
     assert!(err.contains("bad.obj:8:"), "{err}");
 }
-
-#[test]
-fn vertex_colours_are_named_as_not_shown() {
-    let dir = tempfile::tempdir().expect("temp dir");
-    let path = dir.path().join("scan.obj");
-    std::fs::write(
-        &path,
-        "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nf 1 2 3\n",
-    )
-    .expect("write");
-    let scene = load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(scene.triangles.len(), 1);
-    let said: Vec<&String> = (scene.warnings.iter())
-        .filter(|w| w.contains("the vertices have colours"))
-        .collect();
-    assert_eq!(said.len(), 1, "{:?}", scene.warnings);
-    assert!(said[0].contains("scan.obj: "), "{}", said[0]);
-    // Without colours, no such word.
-    std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").expect("write");
-    let plain = load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
-    assert!(
-        plain.warnings.iter().all(|w| !w.contains("colours")),
-        "{:?}",
-        plain.warnings
-    );
-}

@@ -1238,7 +1238,15 @@ fn detail_rows(node: &Node, phong: bool) -> Vec<Row> {
             push(r, "UV", format!("({u:.4}, {v:.4})"));
         }
         if let Some(t) = hit.texel {
-            push(r, "texel (× kd)", fmt3(t));
+            push(
+                r,
+                if hit.uv.is_some() {
+                    "texel (× kd)"
+                } else {
+                    "vertex colour (× kd)"
+                },
+                fmt3(t),
+            );
         }
     }
     if node.direction_corrected {

@@ -287,35 +287,44 @@ pub struct MeshAttributes {
     pub uvs: Vec<Vec2>,
     /// As `normal_indices`, for `uvs`.
     pub uv_indices: Vec<[u32; 3]>,
+    /// Vertex colours (`v x y z r g b`), linear RGB; they multiply `kd` as a texel does.
+    pub colors: Vec<Vec3>,
+    /// As `normal_indices`, for `colors`.
+    pub color_indices: Vec<[u32; 3]>,
+}
+
+/// The values of triangle `local`'s three corners, by its entry in `indices`; `None` when it
+/// has none (no entry, [`NO_INDEX`], or an index past `values`).
+#[inline]
+fn corner_values<T: Copy>(indices: &[[u32; 3]], values: &[T], local: usize) -> Option<[T; 3]> {
+    let idx = indices.get(local)?;
+    if idx[0] == NO_INDEX {
+        return None;
+    }
+    Some([
+        *values.get(idx[0] as usize)?,
+        *values.get(idx[1] as usize)?,
+        *values.get(idx[2] as usize)?,
+    ])
 }
 
 impl MeshAttributes {
     /// The vertex normals of triangle `local` (counted from `first_triangle`), if it has them.
     #[inline]
     pub fn normals_of(&self, local: usize) -> Option<[Vec3; 3]> {
-        let idx = self.normal_indices.get(local)?;
-        if idx[0] == NO_INDEX {
-            return None;
-        }
-        Some([
-            *self.normals.get(idx[0] as usize)?,
-            *self.normals.get(idx[1] as usize)?,
-            *self.normals.get(idx[2] as usize)?,
-        ])
+        corner_values(&self.normal_indices, &self.normals, local)
     }
 
     /// The texture coordinates of triangle `local`, if it has them.
     #[inline]
     pub fn uvs_of(&self, local: usize) -> Option<[Vec2; 3]> {
-        let idx = self.uv_indices.get(local)?;
-        if idx[0] == NO_INDEX {
-            return None;
-        }
-        Some([
-            *self.uvs.get(idx[0] as usize)?,
-            *self.uvs.get(idx[1] as usize)?,
-            *self.uvs.get(idx[2] as usize)?,
-        ])
+        corner_values(&self.uv_indices, &self.uvs, local)
+    }
+
+    /// The vertex colours of triangle `local`, if it has them.
+    #[inline]
+    pub fn colors_of(&self, local: usize) -> Option<[Vec3; 3]> {
+        corner_values(&self.color_indices, &self.colors, local)
     }
 
     /// Bytes the arrays take (for the memory budget).
@@ -323,7 +332,9 @@ impl MeshAttributes {
         (self.normals.len() * 12
             + self.normal_indices.len() * 12
             + self.uvs.len() * 8
-            + self.uv_indices.len() * 12) as u64
+            + self.uv_indices.len() * 12
+            + self.colors.len() * 12
+            + self.color_indices.len() * 12) as u64
     }
 }
 

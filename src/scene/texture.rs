@@ -16,7 +16,11 @@ pub const MAX_TEXTURE_FILE_BYTES: u64 = 256 << 20;
 
 /// The sRGB transfer function inverted: the linear value of an 8-bit sRGB code.
 fn srgb_to_linear(code: u8) -> f32 {
-    let c = f32::from(code) / 255.0;
+    srgb_unit_to_linear(f32::from(code) / 255.0)
+}
+
+/// The linear value of an sRGB-encoded one in [0, 1].
+pub(crate) fn srgb_unit_to_linear(c: f32) -> f32 {
     if c <= 0.04045 {
         c / 12.92
     } else {

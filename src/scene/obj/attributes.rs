@@ -15,6 +15,7 @@ use crate::scene::{MeshAttributes, NO_INDEX, NormalsMode, Scene};
 pub(super) struct Corners {
     pub normals: Vec<[u32; 3]>,
     pub uvs: Vec<[u32; 3]>,
+    pub colors: Vec<[u32; 3]>,
     /// Faces whose `vn` indices are out of range or name a zero or non-finite normal.
     pub bad_normals: usize,
     /// Faces whose `vt` indices are out of range or name non-finite coordinates.
@@ -25,15 +26,18 @@ pub(super) struct Corners {
 }
 
 impl Corners {
-    /// Adds a model's indices (`normal_ids`, `uv_ids`: each empty, or one per kept triangle)
-    /// after the `added` triangles the mesh kept before it.
+    /// Adds a model's normal, texture-coordinate and colour indices (each empty, or one per
+    /// kept triangle) after the `added` triangles the mesh kept before it.
     pub(super) fn append(
         &mut self,
         added: usize,
-        normal_ids: Vec<[u32; 3]>,
-        uv_ids: Vec<[u32; 3]>,
+        [normal_ids, uv_ids, color_ids]: [Vec<[u32; 3]>; 3],
     ) {
-        for (list, ids) in [(&mut self.normals, normal_ids), (&mut self.uvs, uv_ids)] {
+        for (list, ids) in [
+            (&mut self.normals, normal_ids),
+            (&mut self.uvs, uv_ids),
+            (&mut self.colors, color_ids),
+        ] {
             if ids.is_empty() {
                 continue;
             }
@@ -64,7 +68,7 @@ pub(super) fn finish_attributes(
     attrs.triangle_count = count as u32;
     let grouped = groups.is_some() && req.normals == NormalsMode::File;
     warn_about_corners(req.label, &corners, textured, grouped, warnings);
-    for list in [&mut corners.normals, &mut corners.uvs] {
+    for list in [&mut corners.normals, &mut corners.uvs, &mut corners.colors] {
         if !list.is_empty() {
             list.resize(count, [NO_INDEX; 3]);
         }
@@ -98,9 +102,18 @@ pub(super) fn finish_attributes(
     } else {
         attrs.uvs.clear();
     }
+    if corners.colors.iter().any(|c| c[0] != NO_INDEX) {
+        attrs.color_indices = corners.colors;
+    } else {
+        attrs.colors.clear();
+    }
     attrs.normals.shrink_to_fit();
     attrs.uvs.shrink_to_fit();
-    if count > 0 && (!attrs.normal_indices.is_empty() || !attrs.uv_indices.is_empty()) {
+    attrs.colors.shrink_to_fit();
+    let carries = !attrs.normal_indices.is_empty()
+        || !attrs.uv_indices.is_empty()
+        || !attrs.color_indices.is_empty();
+    if count > 0 && carries {
         scene.attributes.push(Arc::new(attrs));
     }
 }

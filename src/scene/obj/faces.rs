@@ -19,6 +19,8 @@ pub(super) struct Faces<'a> {
     pub mirrors: bool,
     pub normals: Option<(&'a [Vec3], u32)>,
     pub uvs: Option<(&'a [Vec2], u32)>,
+    /// The index of the model's first vertex colour in the mesh's, when it has colours.
+    pub colors: Option<u32>,
 }
 
 /// The material of a placed triangle until its model's material is known.
@@ -104,6 +106,19 @@ impl Faces<'_> {
         self.all_corner_ids(count, given, ALL_NORMALS, list, &usable)
     }
 
+    /// The vertex-colour indices of the model's `count` faces (a colour per position, so the
+    /// positions' own indices), or none when the model has no colours.
+    pub(super) fn color_ids(&self, count: usize) -> Vec<[u32; 3]> {
+        let Some(base) = self.colors else {
+            return Vec::new();
+        };
+        let idx = &self.mesh.indices;
+        (0..count)
+            .into_par_iter()
+            .map(|k| [idx[3 * k], idx[3 * k + 1], idx[3 * k + 2]].map(|i| base + i))
+            .collect()
+    }
+
     /// As [`Faces::normal_ids`], for the texture coordinates (`vt`).
     pub(super) fn uv_ids(&self, count: usize, given: &Given) -> Vec<[u32; 3]> {
         let Some((uvs, base)) = self.uvs else {
@@ -172,15 +187,14 @@ pub(super) fn dropped(placed: &[Triangle]) -> (usize, usize) {
 pub(super) fn keep_placed(
     triangles: &mut Vec<Triangle>,
     start: usize,
-    ids: [&mut Vec<[u32; 3]>; 2],
+    mut ids: [&mut Vec<[u32; 3]>; 3],
 ) {
     let count = triangles.len() - start;
-    let [normal_ids, uv_ids] = ids;
     let mut w = 0;
     for k in 0..count {
         if triangles[start + k].material == PLACED {
             triangles[start + w] = triangles[start + k];
-            for ids in [&mut *normal_ids, &mut *uv_ids] {
+            for ids in ids.iter_mut() {
                 if !ids.is_empty() {
                     ids[w] = ids[k];
                 }
@@ -189,8 +203,9 @@ pub(super) fn keep_placed(
         }
     }
     triangles.truncate(start + w);
-    normal_ids.truncate(w);
-    uv_ids.truncate(w);
+    for ids in ids {
+        ids.truncate(w);
+    }
 }
 
 #[cfg(test)]

@@ -59,12 +59,6 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     let face_corners = face_corners(req.text, &models, fast, fast_corners)?;
     let (mut warnings, mtl_texts) = libraries.finish();
     warn_about_reading(req, &facts, &mtl_materials, &mut warnings);
-    if models.iter().any(|m| !m.mesh.vertex_color.is_empty()) {
-        warnings.push(format!(
-            "{}: the vertices have colours (`v x y z r g b`, as scans and MeshLab write), which raytree does not show: the faces take their materials' colours.",
-            req.label
-        ));
-    }
     // A file with `vn` on some faces only: those of the others in a smoothing group get
     // normals computed within it.
     let lacking = |f: u8| f & corners::ALL_NORMALS == 0;
@@ -274,7 +268,7 @@ impl<'a> MeshBuild<'a> {
     /// Adds one model's faces: placed, with their normal and texture-coordinate indices and
     /// their material, the degenerate and too distant ones dropped.
     fn add_model(&mut self, scene: &mut Scene, mesh: &tobj::Mesh, mtl_texts: &[(String, String)]) {
-        let (normal_base, uv_base) = self.read_attributes(mesh);
+        let (normal_base, uv_base, color_base) = self.read_attributes(mesh);
         let faces = Faces {
             mesh,
             linear: self.linear,
@@ -282,6 +276,7 @@ impl<'a> MeshBuild<'a> {
             mirrors: self.mirrors,
             normals: normal_base.map(|base| (&self.attrs.normals[..], base)),
             uvs: uv_base.map(|base| (&self.attrs.uvs[..], base)),
+            colors: color_base,
         };
         let count = mesh.indices.len() / 3;
         let given = Given {
@@ -292,6 +287,7 @@ impl<'a> MeshBuild<'a> {
         faces.place(Arc::make_mut(&mut scene.triangles), count, self.req.object);
         let mut normal_ids = faces.normal_ids(count, &given);
         let mut uv_ids = faces.uv_ids(count, &given);
+        let mut color_ids = faces.color_ids(count);
         self.corners.bad_normals += given.unusable(&normal_ids, corners::ALL_NORMALS);
         self.corners.bad_uvs += given.unusable(&uv_ids, corners::ALL_UVS);
         self.triangle_read += count;
@@ -313,21 +309,26 @@ impl<'a> MeshBuild<'a> {
         if kept < count {
             // Rare: keep the placed ones, in order, with their corner indices.
             let triangles = Arc::make_mut(&mut scene.triangles);
-            keep_placed(triangles, start, [&mut normal_ids, &mut uv_ids]);
+            keep_placed(
+                triangles,
+                start,
+                [&mut normal_ids, &mut uv_ids, &mut color_ids],
+            );
         }
         if let Some(material) = material {
             Arc::make_mut(&mut scene.triangles)[start..]
                 .par_iter_mut()
                 .for_each(|t| t.material = material);
         }
-        self.corners.append(self.added, normal_ids, uv_ids);
+        self.corners
+            .append(self.added, [normal_ids, uv_ids, color_ids]);
         self.added += kept;
     }
 
     /// Adds the model's normals (placed) and texture coordinates to the mesh's, when its faces
     /// give them; returns the index of the model's first of each. Per-face normal and texture
     /// indices exist only when every face gives them.
-    fn read_attributes(&mut self, mesh: &tobj::Mesh) -> (Option<u32>, Option<u32>) {
+    fn read_attributes(&mut self, mesh: &tobj::Mesh) -> (Option<u32>, Option<u32>, Option<u32>) {
         let attrs = &mut self.attrs;
         let normal_base = attrs.normals.len() as u32;
         let has_normals = self.file_normals
@@ -351,9 +352,28 @@ impl<'a> MeshBuild<'a> {
                     .map(|t| Vec2::new(t[0], t[1])),
             );
         }
+        // Vertex colours, one per position, written as the display shows them (sRGB, 0 to 1):
+        // made linear as a texture's texels are.
+        let color_base = attrs.colors.len() as u32;
+        let has_colors =
+            !mesh.vertex_color.is_empty() && mesh.vertex_color.len() == mesh.positions.len();
+        if has_colors {
+            attrs
+                .colors
+                .par_extend(mesh.vertex_color.par_chunks_exact(3).map(|c| {
+                    Vec3::new(c[0], c[1], c[2]).map(|x| {
+                        if x.is_finite() {
+                            crate::scene::texture::srgb_unit_to_linear(x.clamp(0.0, 1.0))
+                        } else {
+                            1.0
+                        }
+                    })
+                }));
+        }
         (
             has_normals.then_some(normal_base),
             has_uvs.then_some(uv_base),
+            has_colors.then_some(color_base),
         )
     }
 
