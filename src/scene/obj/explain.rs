@@ -87,6 +87,9 @@ pub(super) fn explain(error: &LoadError, text: &str, line: Option<usize>) -> Str
         LoadError::FaceVertexOutOfBounds => index(&[0]).unwrap_or_else(corners),
         LoadError::FaceTexCoordOutOfBounds => index(&[1]).unwrap_or_else(corners),
         LoadError::FaceNormalOutOfBounds => index(&[2]).unwrap_or_else(corners),
+        LoadError::FaceColorOutOfBounds => format!(
+            "{quoted} uses vertices without a colour, while other `v` lines give one (`v x y z r g b`): every vertex needs a colour, or none"
+        ),
         _ => format!("{quoted}: {error}"),
     }
 }
@@ -130,6 +133,15 @@ mod tests {
         assert_eq!(
             at_last_line(LoadError::TexcoordParseError, "vt 0.5"),
             "`vt 0.5` has 1 number; a texture coordinate needs two (u v, then an optional w)"
+        );
+    }
+
+    #[test]
+    fn a_face_of_uncoloured_vertices_among_coloured_ones_says_so() {
+        let text = "v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3";
+        assert_eq!(
+            at_last_line(LoadError::FaceColorOutOfBounds, text),
+            "`f 1 2 3` uses vertices without a colour, while other `v` lines give one (`v x y z r g b`): every vertex needs a colour, or none"
         );
     }
 
