@@ -666,3 +666,58 @@ fn many_blender_materials_make_one_short_warning() {
         );
     }
 }
+
+/// A twelve-pointed star of `2 * 12` corners as one face, in the plane `axis` = 0.5 (the
+/// other two coordinates from `plane`), wound as written or reversed.
+fn flat_star(axis: usize, reversed: bool) -> String {
+    let mut obj = String::new();
+    let n = 24;
+    for i in 0..n {
+        let a = i as f32 / n as f32 * std::f32::consts::TAU;
+        let r = if i % 2 == 0 { 1.0 } else { 0.5 };
+        let (u, v) = (r * a.cos(), r * a.sin());
+        let p = match axis {
+            0 => Vec3::new(0.5, u + 2.0, v),
+            _ => Vec3::new(u, 0.5, v),
+        };
+        obj.push_str(&format!("v {} {} {}\n", p.x, p.y, p.z));
+    }
+    let mut corners: Vec<String> = (1..=n).map(|i| i.to_string()).collect();
+    if reversed {
+        corners.reverse();
+    }
+    obj.push_str(&format!("f {}\n", corners.join(" ")));
+    obj
+}
+
+/// How much of the image shows the model (pixels brighter than the black background).
+fn covered(scene: &Scene) -> f32 {
+    let image = pixels(scene);
+    image.iter().filter(|c| c.max_element() > 0.02).count() as f32 / image.len() as f32
+}
+
+#[test]
+fn a_flat_model_is_seen_square_to_its_plane_not_edge_on() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    // Upright in x = 0.5 (a LightWave polygon as assimp's test files have it): from the +z
+    // front it was edge-on and the image black. Looked at from the side its faces face.
+    for (reversed, toward) in [(false, -1.0), (true, 1.0)] {
+        let scene = load(dir.path(), "upright.obj", &flat_star(0, reversed));
+        let f = forward(&scene);
+        assert!(
+            f.x * toward > 0.9,
+            "reversed {reversed}: looks along {f}, not square to the plane facing the faces"
+        );
+        let c = covered(&scene);
+        assert!(
+            c > 0.15,
+            "reversed {reversed}: the star covers {c} of the image"
+        );
+    }
+    // Lying in y = 0.5 (a floor plan): from above at 45°, not at a grazing 17°.
+    let scene = load(dir.path(), "lying.obj", &flat_star(1, false));
+    let f = forward(&scene);
+    assert!(f.y < -0.6, "looks along {f}");
+    let c = covered(&scene);
+    assert!(c > 0.15, "the star covers {c} of the image");
+}

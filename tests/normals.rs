@@ -423,7 +423,8 @@ fn map_kd_multiplies_kd_and_the_tree_shows_uv_and_texel() {
 fn map_kd_scale_and_offset_move_the_texture_on_the_texture_coordinates() {
     // The centre pixel meets TRI at (0, 0): barycentric (¼, ¼, ½), so uv = (0.25, 0.5). The
     // texture is two texels, red | blue, whose centres lie at u = 0.25 and 0.75; `-s` and `-o`
-    // move the lookup to u · s + o.
+    // move the lookup to u · s + o. `-clamp on` keeps the lookup on the image: past an edge
+    // it takes that edge's texels (u = 1: blue, where a repeated map blends blue and red).
     let (dir, scene_file) = textured_tri();
     std::fs::write(
         dir.path().join("rb.png"),
@@ -436,6 +437,12 @@ fn map_kd_scale_and_offset_move_the_texture_on_the_texture_coordinates() {
         ("-s 3 1 1 ", Vec3::Z),
         ("-s 2 1 1 ", Vec3::new(0.5, 0.0, 0.5)),
         ("-clamp on -s 2 1 1 -o 0.25 0 ", Vec3::Z),
+        ("-o 0.75 0 ", Vec3::new(0.5, 0.0, 0.5)),
+        ("-clamp on -o 0.75 0 ", Vec3::Z),
+        ("-o 1 0 ", Vec3::X),
+        ("-clamp on -o 1 0 ", Vec3::Z),
+        ("-clamp on -o -1 0 ", Vec3::X),
+        ("-colorspace sRGB -clamp off -o 1 0 ", Vec3::X),
     ] {
         std::fs::write(
             dir.path().join("t.mtl"),

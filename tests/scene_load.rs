@@ -1074,3 +1074,100 @@ fn windows_byte_order_marks_and_continued_lines_read_as_meant() {
         .to_string();
     assert!(err.contains("bad.obj:8:"), "{err}");
 }
+
+#[test]
+fn files_other_tools_write_read_as_meant() {
+    // UTF-16 text (Notepad's "Unicode"), big- and little-endian, for the OBJ and its MTL.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let utf16 = |text: &str, big: bool| -> Vec<u8> {
+        let mut out = if big {
+            vec![0xFE, 0xFF]
+        } else {
+            vec![0xFF, 0xFE]
+        };
+        for unit in text.encode_utf16() {
+            out.extend(if big {
+                unit.to_be_bytes()
+            } else {
+                unit.to_le_bytes()
+            });
+        }
+        out
+    };
+    std::fs::write(
+        dir.path().join("u.mtl"),
+        utf16("newmtl red\r\nKd 1 0 0\r\n", false),
+    )
+    .expect("write");
+    std::fs::write(
+        dir.path().join("u.obj"),
+        utf16(
+            "mtllib u.mtl\r\nv 0 0 0\r\nv 1 0 0\r\nv 1 1 0\r\nusemtl red\r\nf 1 2 3\r\n",
+            true,
+        ),
+    )
+    .expect("write");
+    let scene = load_scene_file(&dir.path().join("u.obj")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.triangles.len(), 1);
+    assert_eq!(
+        material(&scene, "u/red").diffuse,
+        Vec3::X,
+        "{:?}",
+        scene.warnings
+    );
+
+    // A material without a name (`newmtl` and `usemtl` alone), which tobj refuses.
+    std::fs::write(dir.path().join("n.mtl"), "newmtl \nKd 0 0 1\n").expect("write");
+    std::fs::write(
+        dir.path().join("n.obj"),
+        "mtllib n.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl \nf 1 2 3\n",
+    )
+    .expect("write");
+    let scene = load_scene_file(&dir.path().join("n.obj")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        material(&scene, "n/(no name)").diffuse,
+        Vec3::Z,
+        "{:?}",
+        scene.warnings
+    );
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+
+    // Old Windows spellings of what is not a number: the face on such vertices is dropped as
+    // any non-finite one, the rest shows.
+    std::fs::write(
+        dir.path().join("nan.obj"),
+        "v 1.#IND -1.#IND 1.#IND\nv 1.#INF -1.#INF 1.#INF\nv 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\nf 3 4 5\n",
+    )
+    .expect("write");
+    let scene = load_scene_file(&dir.path().join("nan.obj")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.triangles.len(), 1);
+    assert!(
+        scene
+            .warnings
+            .iter()
+            .any(|w| w.contains("dropped 1 degenerate triangle")),
+        "{:?}",
+        scene.warnings
+    );
+
+    // `mtllib` names with spaces written `\ `, beside a missing library.
+    std::fs::write(dir.path().join("my mats.mtl"), "newmtl green\nKd 0 1 0\n").expect("write");
+    std::fs::write(
+        dir.path().join("e.obj"),
+        "mtllib gone.mtl my\\ mats.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl green\nf 1 2 3\n",
+    )
+    .expect("write");
+    let scene = load_scene_file(&dir.path().join("e.obj")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        material(&scene, "e/green").diffuse,
+        Vec3::Y,
+        "{:?}",
+        scene.warnings
+    );
+    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    assert!(
+        scene.warnings[0].contains("`gone.mtl`"),
+        "{:?}",
+        scene.warnings
+    );
+}

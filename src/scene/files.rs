@@ -191,6 +191,10 @@ fn read_text_watched(
     if bytes.starts_with(BOM) {
         bytes.drain(..BOM.len());
     }
+    // UTF-16 text (Windows tools save "Unicode" so), known by its byte-order mark.
+    if let Some(text) = utf16_text(&bytes) {
+        return Ok(Some(text));
+    }
     // Valid UTF-8 is taken as it is, without the copy `from_utf8_lossy` would make.
     Ok(Some(String::from_utf8(bytes).unwrap_or_else(|e| {
         String::from_utf8_lossy(e.as_bytes()).into_owned()
@@ -199,6 +203,29 @@ fn read_text_watched(
 
 /// The UTF-8 byte-order mark.
 const BOM: &[u8] = b"\xEF\xBB\xBF";
+
+/// The text of UTF-16 `bytes` that start with a byte-order mark (big- or little-endian), any
+/// unpaired surrogate replaced; `None` for other bytes.
+fn utf16_text(bytes: &[u8]) -> Option<String> {
+    let big = match bytes {
+        [0xFE, 0xFF, ..] => true,
+        [0xFF, 0xFE, ..] => false,
+        _ => return None,
+    };
+    let units = bytes[2..].chunks(2).map(|pair| {
+        let pair = [pair[0], pair.get(1).copied().unwrap_or(0)];
+        if big {
+            u16::from_be_bytes(pair)
+        } else {
+            u16::from_le_bytes(pair)
+        }
+    });
+    Some(
+        char::decode_utf16(units)
+            .map(|c| c.unwrap_or(char::REPLACEMENT_CHARACTER))
+            .collect(),
+    )
+}
 
 /// The OS's reason without the platform-specific "(os error N)" tail, for stable messages.
 fn os_reason(e: &std::io::Error) -> String {

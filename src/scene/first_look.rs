@@ -354,8 +354,9 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
     }
     let probes = probe_points(triangles, &curve, &points, &dirs, (lo, hi));
     if !probes.iter().any(|p| p.in_room()) {
+        let (front, elevation) = flat_front(triangles, half, up, side, front);
         return FirstView {
-            camera: frame_outside(triangles, center, up, front, 0.3, aspect),
+            camera: frame_outside(triangles, center, up, front, elevation, aspect),
             room: None,
         };
     }
@@ -532,6 +533,47 @@ fn opening(
 /// The camera in front of the model (from `front`, raised by `elevation`: 0.3 is about 17°), aimed
 /// at the bounds' centre, as close as keeps every vertex inside the image with a 5 % margin on each
 /// side.
+/// A model this flat (its thinnest extent at most this fraction of its largest) is looked at
+/// square to its plane ([`flat_front`]).
+const FLAT: f32 = 0.01;
+
+/// The side a model seen from outside is looked at from, and how high (the camera's rise over
+/// its run): its `front`, a little from above (0.3), unless it is flat. A flat model standing
+/// upright (a sign, a wall, a cut-out polygon) is looked at square to its plane, from the side
+/// its faces face (by their winding, summed by area; `front`'s side of that axis when they
+/// cancel), where seen from `front` it would be edge-on; a flat model lying down (a floor plan,
+/// a terrain patch) is looked at from higher up (1.0, 45°).
+fn flat_front(
+    triangles: &[Triangle],
+    half: Vec3,
+    up: Vec3,
+    side: Vec3,
+    front: Vec3,
+) -> (Vec3, f32) {
+    use rayon::prelude::*;
+    let extent = |axis: Vec3| (half * axis).length();
+    let largest = half.max_element();
+    let flat = |axis: Vec3| extent(axis) <= FLAT * largest;
+    if largest <= 0.0 || !largest.is_finite() {
+        return (front, 0.3);
+    }
+    if flat(up) && !flat(side) && !flat(front) {
+        return (front, 1.0);
+    }
+    if flat(side) && !flat(front) {
+        let facing: f32 = triangles
+            .par_iter()
+            .map(|t| {
+                let [a, b, c] = t.vertices;
+                0.5 * (b - a).cross(c - a).dot(side)
+            })
+            .sum();
+        let toward = if facing < 0.0 { -side } else { side };
+        return (toward, 0.3);
+    }
+    (front, 0.3)
+}
+
 fn frame_outside(
     triangles: &[Triangle],
     center: Vec3,

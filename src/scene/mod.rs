@@ -140,11 +140,13 @@ pub struct Material {
 
 /// How a texture map lies on a mesh's texture coordinates: MTL's `-s u v` (scale, a floor tiled
 /// four times is `-s 4 4`) and `-o u v` (origin offset); a map is looked up at `uv · scale +
-/// offset`.
+/// offset`. With `-clamp on` it is not repeated: outside `0..1` it takes its edge's texels.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MapPlacement {
     pub scale: Vec2,
     pub offset: Vec2,
+    #[serde(default)]
+    pub clamp: bool,
 }
 
 impl Default for MapPlacement {
@@ -152,6 +154,7 @@ impl Default for MapPlacement {
         Self {
             scale: Vec2::ONE,
             offset: Vec2::ZERO,
+            clamp: false,
         }
     }
 }
@@ -203,8 +206,8 @@ pub struct Triangle {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct TextureId(pub u32);
 
-/// An image texture, decoded once from sRGB to linear RGB, looked up with wrapping (repeat) and
-/// bilinear filtering.
+/// An image texture, decoded once from sRGB to linear RGB, looked up with wrapping (repeat) or
+/// clamped to its edges, and bilinear filtering.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Texture {
     /// The path as the MTL gave it, for messages and the tree.
@@ -224,16 +227,33 @@ impl Texture {
     /// The bilinear texel at texture coordinate `uv` (OBJ convention: `v` = 0 at the bottom
     /// row), wrapping in both directions.
     pub fn sample(&self, uv: Vec2) -> Vec3 {
+        self.sample_placed(uv, false)
+    }
+
+    /// [`Texture::sample`], or with `clamp` the texels of the image's edges outside `0..1` (and
+    /// no blend across an edge with the opposite one).
+    pub fn sample_placed(&self, uv: Vec2, clamp: bool) -> Vec3 {
         let (w, h) = (self.width as usize, self.height as usize);
         if w == 0 || h == 0 || self.texels.len() < w * h || !uv.is_finite() {
             return Vec3::ONE;
         }
+        let (u, v) = if clamp {
+            (uv.x.clamp(0.0, 1.0), uv.y.clamp(0.0, 1.0))
+        } else {
+            (uv.x.rem_euclid(1.0), uv.y.rem_euclid(1.0))
+        };
         // Texel centres at half-integers; `v` flipped so row 0 is the top of the image.
-        let x = uv.x.rem_euclid(1.0) * w as f32 - 0.5;
-        let y = (1.0 - uv.y.rem_euclid(1.0)) * h as f32 - 0.5;
+        let x = u * w as f32 - 0.5;
+        let y = (1.0 - v) * h as f32 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
-        let wrap = |i: f32, n: usize| (i as i64).rem_euclid(n as i64) as usize;
+        let wrap = |i: f32, n: usize| {
+            if clamp {
+                (i as i64).clamp(0, n as i64 - 1) as usize
+            } else {
+                (i as i64).rem_euclid(n as i64) as usize
+            }
+        };
         let (xa, xb) = (wrap(x0, w), wrap(x0 + 1.0, w));
         let (ya, yb) = (wrap(y0, h), wrap(y0 + 1.0, h));
         let at = |x: usize, y: usize| Vec3::from_array(self.texels[y * w + x]);

@@ -81,7 +81,7 @@ impl Tracer {
             let m = scene.material(material);
             let texel = |map: Option<crate::scene::TextureId>, at: crate::scene::MapPlacement| {
                 map.and_then(|id| scene.texture(id))
-                    .map(|t| t.sample(at.apply(uv)))
+                    .map(|t| t.sample_placed(at.apply(uv), at.clamp))
             };
             texel_kd = texel(m.diffuse_map, m.diffuse_map_placement);
             texel_ka = texel(m.ambient_map, m.ambient_map_placement);

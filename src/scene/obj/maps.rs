@@ -14,11 +14,12 @@ use crate::scene::diag::{short, short_path};
 use crate::scene::texture::decode_texture;
 use crate::scene::{MapPlacement, Scene, Texture, TextureId};
 
-/// The file a `map_Kd` value names and where the map lies (`-s`, `-o`): the value after its
-/// options (`-s 2 2 1 wood.png`, `-o 0.5 0 -bm 1 my wood.png`), each option taking as many
-/// words after it as it may have (up to three numbers for `-s`, `-o`, `-t`; two for `-mm`;
-/// one for the others), so a file name with spaces stays whole. An option this does not know
-/// takes the numbers that follow it; `-t` (turbulence) and the others change nothing here.
+/// The file a `map_Kd` value names and where the map lies (`-s`, `-o`, `-clamp`): the value
+/// after its options (`-s 2 2 1 wood.png`, `-o 0.5 0 -bm 1 my wood.png`), each option taking
+/// as many words after it as it may have (up to three numbers for `-s`, `-o`, `-t`; two for
+/// `-mm`; one number, `on`/`off` or a name for the others, as `-colorspace sRGB`), so a file
+/// name with spaces stays whole. An option this does not know takes the numbers that follow
+/// it; `-t` (turbulence) and the others change nothing here.
 pub(super) fn texture_statement(value: &str) -> (&str, MapPlacement) {
     let mut rest = value.trim();
     let mut place = MapPlacement::default();
@@ -31,7 +32,7 @@ pub(super) fn texture_statement(value: &str) -> (&str, MapPlacement) {
             "s" | "o" | "t" => 3,
             "mm" => 2,
             "blendu" | "blendv" | "boost" | "texres" | "clamp" | "bm" | "imfchan" | "type"
-            | "cc" => 1,
+            | "cc" | "colorspace" => 1,
             _ => 3,
         };
         let mut numbers = Vec::new();
@@ -40,9 +41,13 @@ pub(super) fn texture_statement(value: &str) -> (&str, MapPlacement) {
                 break;
             };
             let number = word.parse::<f32>().ok().filter(|n| n.is_finite());
-            let switch = matches!(word, "on" | "off") || matches!(option, "imfchan" | "type");
+            let switch =
+                matches!(word, "on" | "off") || matches!(option, "imfchan" | "type" | "colorspace");
             if number.is_none() && !switch {
                 break;
+            }
+            if option == "clamp" {
+                place.clamp = word == "on";
             }
             // Nothing after it: it is the file (`-bm 1 2.png` names `2.png`).
             if rest[word.len()..].trim().is_empty() {
@@ -183,7 +188,7 @@ mod tests {
         let plain = MapPlacement::default();
         let s = |u, v| MapPlacement {
             scale: Vec2::new(u, v),
-            offset: Vec2::ZERO,
+            ..plain
         };
         assert_eq!(texture_statement("wood.png"), ("wood.png", plain));
         assert_eq!(texture_statement("  my wood.png "), ("my wood.png", plain));
@@ -202,13 +207,37 @@ mod tests {
                 MapPlacement {
                     scale: Vec2::splat(2.0),
                     offset: Vec2::new(0.5, 0.25),
+                    clamp: false,
                 }
             )
         );
         // Options that change nothing here, with their words; a number that is the file.
         assert_eq!(
-            texture_statement("-clamp on -bm 0.3 -imfchan l -type sphere -mm 0 1 bump.png"),
+            texture_statement("-bm 0.3 -imfchan l -type sphere -mm 0 1 bump.png"),
             ("bump.png", plain)
+        );
+        // A colour space is a name (tinyobjloader's and Blender's `-colorspace sRGB`).
+        assert_eq!(
+            texture_statement("-colorspace sRGB -o 0.1 diffuse.jpg"),
+            (
+                "diffuse.jpg",
+                MapPlacement {
+                    offset: Vec2::new(0.1, 0.0),
+                    ..plain
+                }
+            )
+        );
+        let clamped = MapPlacement {
+            clamp: true,
+            ..plain
+        };
+        assert_eq!(
+            texture_statement("-clamp on decal.png"),
+            ("decal.png", clamped)
+        );
+        assert_eq!(
+            texture_statement("-clamp off decal.png"),
+            ("decal.png", plain)
         );
         assert_eq!(texture_statement("-bm 1 2.png"), ("2.png", plain));
         assert_eq!(texture_statement("-blendu off 7"), ("7", plain));

@@ -15,7 +15,7 @@ use super::faces::{Faces, Given, PLACED, dropped, keep_placed};
 use super::memory::check_memory;
 use super::mtl::{Libraries, mtl_material, warn_unknown_usemtl};
 use super::parse::Facts;
-use super::read::{ObjProblem, join_continued_lines, read_models, scan};
+use super::read::{ObjProblem, prepare_text, read_models, scan};
 use super::request::MeshRequest;
 use crate::scene::diag::short_path;
 use crate::scene::{MaterialId, MeshAttributes, MeshPart, NormalsMode, Scene};
@@ -26,7 +26,7 @@ const UNNAMED: &str = "unnamed_object";
 /// Adds the OBJ's triangles (placed, degenerate ones dropped) and the MTL materials they use
 /// to `scene`; returns how many triangles were added.
 pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, ObjProblem> {
-    let joined = join_continued_lines(req.text);
+    let joined = prepare_text(req.text);
     let with_joined;
     let req = match &joined {
         Cow::Owned(text) => {

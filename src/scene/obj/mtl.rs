@@ -35,17 +35,18 @@ impl<'r> Libraries<'r> {
     }
 
     /// The library `path` (as the OBJ names it) read, for tobj; `mtllib a.mtl b.mtl` (several
-    /// libraries on one line, as the format allows) when no one file has that whole name.
+    /// libraries on one line, as the format allows, a space within a name written `\ `) when
+    /// no one file has that whole name.
     pub(super) fn load(&self, path: &Path) -> tobj::MTLLoadResult {
         if self.req.material_override.is_some() {
             return Ok(Default::default());
         }
         let written = path.to_string_lossy();
-        let parts: Vec<&str> = written.split_whitespace().collect();
+        let parts = library_names(&written);
         let whole = self.find(&written);
         let libraries = match whole {
-            Err(_) if parts.len() > 1 && parts.iter().any(|p| self.find(p).is_ok()) => {
-                parts.iter().map(|&p| (p, self.find(p))).collect()
+            Err(_) if parts != [written.as_ref()] && parts.iter().any(|p| self.find(p).is_ok()) => {
+                parts.iter().map(|p| (p.as_str(), self.find(p))).collect()
             }
             whole => vec![(written.as_ref(), whole)],
         };
@@ -129,55 +130,84 @@ impl<'r> Libraries<'r> {
     }
 }
 
+/// The names of an `mtllib` line's value: split at white space, except where a `\` escapes it
+/// (`my\ materials.mtl` is one name, with a space, as tinyobjloader and Blender's importer read
+/// it); any other `\` stays (`C:\models\a.mtl`).
+fn library_names(value: &str) -> Vec<String> {
+    let mut names = Vec::new();
+    let mut name = String::new();
+    let mut chars = value.chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '\\' if chars.peek().is_some_and(|n| n.is_whitespace()) => {
+                name.extend(chars.next());
+            }
+            c if c.is_whitespace() => {
+                if !name.is_empty() {
+                    names.push(std::mem::take(&mut name));
+                }
+            }
+            c => name.push(c),
+        }
+    }
+    if !name.is_empty() {
+        names.push(name);
+    }
+    names
+}
+
 /// MTL text as `tobj` can take it, or the line and the reason it cannot. The MTL format lets
 /// `Ka`, `Kd`, `Ks` and `Ke` give one number for all three channels (`Kd 0.8`); tobj 4.0.5
 /// panics on that (and on zero or two numbers), so one number is spelled out three times here
-/// and zero or two are refused with their line.
+/// and zero or two are refused with their line. A material without a name (`newmtl` alone,
+/// as some exporters write for an unnamed material) is named [`UNNAMED_MATERIAL`], as the
+/// OBJ's `usemtl` alone is, where tobj refuses the file.
 fn mtl_for_tobj(text: &str) -> Result<Cow<'_, str>, (usize, String)> {
     let mut fixed: Option<String> = None;
     for (i, line) in text.lines().enumerate() {
-        let mut words = line.split_whitespace();
-        let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() else {
-            if let Some(out) = fixed.as_mut() {
-                out.push_str(line);
-                out.push('\n');
+        let replaced = mtl_line_for_tobj(line).map_err(|reason| (i + 1, reason))?;
+        if replaced.is_some() && fixed.is_none() {
+            let mut head = String::with_capacity(text.len() + 64);
+            for earlier in text.lines().take(i) {
+                head.push_str(earlier);
+                head.push('\n');
             }
-            continue;
-        };
-        let values: Vec<&str> = words.collect();
-        let parses = values.iter().all(|v| v.parse::<f32>().is_ok());
-        match values.len() {
-            1 | 2 if !parses => {} // tobj reports the bad number as an error
-            0 | 2 => {
-                return Err((
-                    i + 1,
-                    format!(
-                        "`{key}` needs one number or three (r g b), got {}",
-                        values.len()
-                    ),
-                ));
-            }
-            1 => {
-                let out = fixed.get_or_insert_with(|| {
-                    let mut head = String::with_capacity(text.len() + 64);
-                    for earlier in text.lines().take(i) {
-                        head.push_str(earlier);
-                        head.push('\n');
-                    }
-                    head
-                });
-                let v = values[0];
-                out.push_str(&format!("{key} {v} {v} {v}\n"));
-                continue;
-            }
-            _ => {}
+            fixed = Some(head);
         }
         if let Some(out) = fixed.as_mut() {
-            out.push_str(line);
+            out.push_str(replaced.as_deref().unwrap_or(line));
             out.push('\n');
         }
     }
     Ok(fixed.map_or(Cow::Borrowed(text), Cow::Owned))
+}
+
+/// The name given to a material the files leave without one (`newmtl` or `usemtl` alone).
+pub(super) const UNNAMED_MATERIAL: &str = "(no name)";
+
+/// What [`mtl_for_tobj`] puts for one MTL line: `None` to keep it.
+fn mtl_line_for_tobj(line: &str) -> Result<Option<String>, String> {
+    let mut words = line.split_whitespace();
+    match words.next() {
+        Some("newmtl") if words.next().is_none() => Ok(Some(format!("newmtl {UNNAMED_MATERIAL}"))),
+        Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) => {
+            let values: Vec<&str> = words.collect();
+            let parses = values.iter().all(|v| v.parse::<f32>().is_ok());
+            match values.len() {
+                1 | 2 if !parses => Ok(None), // tobj reports the bad number as an error
+                0 | 2 => Err(format!(
+                    "`{key}` needs one number or three (r g b), got {}",
+                    values.len()
+                )),
+                1 => {
+                    let v = values[0];
+                    Ok(Some(format!("{key} {v} {v} {v}")))
+                }
+                _ => Ok(None),
+            }
+        }
+        _ => Ok(None),
+    }
 }
 
 /// `usemtl` names ([`Facts::usemtl`]) that no loaded library defines: tobj silently gives

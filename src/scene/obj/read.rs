@@ -9,6 +9,7 @@ use std::path::Path;
 use std::sync::Once;
 
 use super::corners::FaceCorners;
+use super::mtl::UNNAMED_MATERIAL;
 use super::parse::{self, Facts, Polylines, Scanned};
 
 /// Why an OBJ could not be read: the `tobj` reason and, when found, the line.
@@ -26,6 +27,100 @@ impl ObjProblem {
             None => format!(": {}", self.reason),
         }
     }
+}
+
+/// OBJ text as the readers take it: continued lines joined ([`join_continued_lines`]), a
+/// `usemtl` without a name given one ([`name_unnamed_usemtl`]) and old Windows spellings of
+/// non-finite numbers read as such ([`spell_non_finite`]); the text itself when none applies.
+pub(super) fn prepare_text(text: &str) -> Cow<'_, str> {
+    let mut text = join_continued_lines(text);
+    for step in [name_unnamed_usemtl, spell_non_finite] {
+        if let Some(changed) = step(&text) {
+            text = Cow::Owned(changed);
+        }
+    }
+    text
+}
+
+/// `text` with each line rewritten by `line` (given a line without its line break; `None`
+/// keeps it), line breaks and so line numbers kept.
+fn rewrite_lines(text: &str, line: impl Fn(&str) -> Option<String>) -> String {
+    let mut out = String::with_capacity(text.len() + 64);
+    for whole in text.split_inclusive('\n') {
+        let body = whole.trim_end_matches(['\n', '\r']);
+        match line(body) {
+            Some(new) => {
+                out.push_str(&new);
+                out.push_str(&whole[body.len()..]);
+            }
+            None => out.push_str(whole),
+        }
+    }
+    out
+}
+
+/// A `usemtl` without a name (some exporters write one for an unnamed material, with
+/// `newmtl` alone in the MTL) names [`UNNAMED_MATERIAL`], as the MTL's `newmtl` alone does;
+/// tobj refuses the file. `None` when the text has none.
+fn name_unnamed_usemtl(text: &str) -> Option<String> {
+    let alone = |line: &str| {
+        let mut words = line.split_whitespace();
+        words.next() == Some("usemtl") && words.next().is_none()
+    };
+    let any = text.match_indices("usemtl").any(|(i, _)| {
+        let start = text[..i].rfind('\n').map_or(0, |n| n + 1);
+        let end = text[i..].find('\n').map_or(text.len(), |n| i + n);
+        alone(&text[start..end])
+    });
+    any.then(|| {
+        rewrite_lines(text, |line| {
+            alone(line).then(|| format!("usemtl {UNNAMED_MATERIAL}"))
+        })
+    })
+}
+
+/// Numbers in `v`, `vn`, `vt` and `vp` lines as old Microsoft C libraries print what is not
+/// finite (`1.#IND`, `-1.#QNAN0`, `1.#INF00`) spelled `NaN` or `inf`, so the file reads and
+/// the triangles on such vertices are dropped as any non-finite ones are, where the readers
+/// stop at the first one. `None` when the text has none.
+fn spell_non_finite(text: &str) -> Option<String> {
+    if !text.contains(".#") {
+        return None;
+    }
+    let spelled = |word: &str| -> Option<&'static str> {
+        let (number, tail) = word.split_once(".#")?;
+        let negative = number.starts_with('-');
+        let digits = number.trim_start_matches(['-', '+']);
+        if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+            return None;
+        }
+        let kind = tail.trim_end_matches(|c: char| c.is_ascii_digit());
+        match (kind.to_ascii_uppercase().as_str(), negative) {
+            ("INF", false) => Some("inf"),
+            ("INF", true) => Some("-inf"),
+            ("IND" | "QNAN" | "SNAN" | "NAN", _) => Some("NaN"),
+            _ => None,
+        }
+    };
+    let line = |line: &str| {
+        let mut words = line.split_whitespace();
+        if !matches!(words.next(), Some("v" | "vn" | "vt" | "vp")) || !line.contains(".#") {
+            return None;
+        }
+        let words: Vec<&str> = line.split_whitespace().collect();
+        words.iter().any(|w| spelled(w).is_some()).then(|| {
+            words
+                .iter()
+                .map(|w| spelled(w).unwrap_or(w))
+                .collect::<Vec<_>>()
+                .join(" ")
+        })
+    };
+    let any = text
+        .lines()
+        .filter(|l| l.contains(".#"))
+        .any(|l| line(l).is_some());
+    any.then(|| rewrite_lines(text, line))
 }
 
 /// OBJ text with its continued lines joined: a statement whose line ends in `\` goes on on the
@@ -289,6 +384,23 @@ fn error_line(text: &str) -> Option<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn unnamed_materials_and_old_windows_non_finite_numbers_are_spelled_for_the_readers() {
+        let same = "v 1 2 3\nusemtl a\n# usemtl\nf 1 1 1\n";
+        assert!(matches!(prepare_text(same), Cow::Borrowed(_)));
+        assert_eq!(
+            prepare_text("v 0 0 0\r\nusemtl \r\n  usemtl\nf 1 1 1"),
+            "v 0 0 0\r\nusemtl (no name)\r\nusemtl (no name)\nf 1 1 1"
+        );
+        assert_eq!(
+            prepare_text("v 1.#IND -1.#IND00 1.#INF\nvn -1.#INF00 1.#QNAN0 0\n# 1.#IND\nv 1 2 3\n"),
+            "v NaN NaN inf\nvn -inf NaN 0\n# 1.#IND\nv 1 2 3\n"
+        );
+        // Not such a number: left for the reader's error.
+        let odd = "v 1.#IX 0 0\nv a.#IND 0 0\n";
+        assert!(matches!(prepare_text(odd), Cow::Borrowed(_)));
+    }
 
     #[test]
     fn continued_lines_are_joined_and_later_lines_keep_their_numbers() {
