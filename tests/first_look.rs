@@ -546,18 +546,23 @@ fn ns_0_shows_no_highlight_through_a_scene_file_too() {
     assert_eq!(m("chrome").specular, Vec3::ZERO, "no highlight");
     assert_eq!(m("chrome").reflectivity, Vec3::splat(0.9), "still a mirror");
     assert_eq!(m("shiny").specular, Vec3::ONE, "`Ns 50`: kept");
-    assert_warned(&scene, "bottle.toml", &["`material_0` has `Ns 0`"]);
-    assert_warned(&scene, "bottle.toml", &["`chrome` has `Ns 0`"]);
+    // One sentence for both.
+    assert_warned(
+        &scene,
+        "bottle.toml",
+        &["materials `material_0` and `chrome` have `Ns 0`"],
+    );
     assert_not_warned(&scene, "bottle.toml", "`shiny`");
 }
 
 /// A Blender export whose material is black in every colour (`Kd 0`, `Ka 0`, a bump map only)
-/// was invisible on the dark background: it is shown grey, with a note; a black material
-/// that is a mirror is left alone.
+/// was invisible on the dark background: it is shown grey, with a note, and so is one a little
+/// see-through (Blender 2.7's `d 0.75`); a black material that is a mirror, or glass (more
+/// transparent than opaque), is left alone.
 #[test]
 fn a_black_material_of_a_bare_obj_is_shown_grey() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let mtl = "newmtl body\nKa 0 0 0\nKd 0 0 0\nKs 0.5 0.5 0.5\nNs 100\nmap_Bump bump.png\nillum 2\n\nnewmtl chrome\nKa 0 0 0\nKd 0 0 0\nKs 0.9 0.9 0.9\nillum 3\n";
+    let mtl = "newmtl body\nKa 0 0 0\nKd 0 0 0\nKs 0.5 0.5 0.5\nNs 100\nmap_Bump bump.png\nillum 2\n\nnewmtl chrome\nKa 0 0 0\nKd 0 0 0\nKs 0.9 0.9 0.9\nillum 3\n\nnewmtl visor\nKa 0 0 0\nKd 0 0 0\nKs 0 0 0\nd 0.75\n\nnewmtl pane\nKa 0 0 0\nKd 0 0 0\nKs 0 0 0\nd 0.1\n";
     std::fs::write(dir.path().join("statue.mtl"), mtl).expect("write");
     let mut text = String::from("mtllib statue.mtl\nusemtl body\n");
     let mut base = 0;
@@ -570,8 +575,16 @@ fn a_black_material_of_a_bare_obj_is_shown_grey() {
         &[],
     );
     text.push_str("usemtl chrome\nv 3 0 0\nv 4 0 0\nv 3 1 0\nf -3 -2 -1\n");
+    text.push_str("usemtl visor\nv -3 0 0\nv -4 0 0\nv -3 1 0\nf -3 -1 -2\n");
+    text.push_str("usemtl pane\nv -3 1 0\nv -4 1 0\nv -3 2 0\nf -3 -1 -2\n");
     let scene = load(dir.path(), "statue.obj", &text);
     let m = |n: &str| material(&scene, n);
+    assert_ne!(
+        m("/visor").diffuse,
+        Vec3::ZERO,
+        "a little see-through: grey"
+    );
+    assert_eq!(m("/pane").diffuse, Vec3::ZERO, "glass stays as it is");
     assert_ne!(m("/body").diffuse, Vec3::ZERO, "shown grey");
     assert_eq!(m("/body").diffuse, m("/body").ambient);
     assert_eq!(
@@ -579,8 +592,13 @@ fn a_black_material_of_a_bare_obj_is_shown_grey() {
         Vec3::ZERO,
         "a black mirror stays black"
     );
-    assert_warned(&scene, "statue.obj", &["material `body` is black"]);
+    assert_warned(
+        &scene,
+        "statue.obj",
+        &["materials `body` and `visor` are black"],
+    );
     assert_not_warned(&scene, "statue.obj", "`chrome`");
+    assert_not_warned(&scene, "statue.obj", "`pane`");
     assert_readable(&scene, "statue.obj", 0.03..0.6, 0.02);
 }
 

@@ -129,9 +129,72 @@ pub(crate) fn list_some(items: &[String]) -> String {
     list_and(&named)
 }
 
+/// `warnings` with those that say the same of several materials ("FILE: material `a` has `Ns
+/// 0`, which…", the same for `b`) said once, naming them ("FILE: materials `a` and `b` have
+/// `Ns 0`, which…"; five named and the rest counted), where the first of them stood. A model
+/// of many materials exported alike otherwise repeats one sentence for each.
+pub(crate) fn fold_material_warnings(warnings: Vec<String>) -> Vec<String> {
+    // "LABEL: material `NAME` has|is REST" as (LABEL, NAME, has|is, REST).
+    fn parts(w: &str) -> Option<(&str, &str, &str, &str)> {
+        let (label, after) = w.split_once(": material `")?;
+        let (name, rest) = after.split_once("` ")?;
+        let (verb, rest) = rest.split_once(' ')?;
+        matches!(verb, "has" | "is").then_some((label, name, verb, rest))
+    }
+    let mut out: Vec<String> = Vec::with_capacity(warnings.len());
+    /// Warnings alike: (label, verb, rest), the slot in `out` of the first, the names.
+    type Group = ((String, String, String), usize, Vec<String>);
+    let mut groups: Vec<Group> = Vec::new();
+    for w in warnings {
+        let Some((label, name, verb, rest)) = parts(&w) else {
+            out.push(w);
+            continue;
+        };
+        let key = (label.to_string(), verb.to_string(), rest.to_string());
+        match groups.iter_mut().find(|g| g.0 == key) {
+            Some(group) => group.2.push(format!("`{name}`")),
+            None => {
+                groups.push((key, out.len(), vec![format!("`{name}`")]));
+                out.push(w);
+            }
+        }
+    }
+    for ((label, verb, rest), slot, names) in groups {
+        if names.len() > 1 {
+            let plural = if verb == "has" { "have" } else { "are" };
+            out[slot] = format!("{label}: materials {} {plural} {rest}", list_some(&names));
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn warnings_that_say_the_same_of_several_materials_are_said_once() {
+        let w = |s: &str| s.to_string();
+        let folded = fold_material_warnings(vec![
+            w("a.obj: material `Base` has `Ns 0`, which would add all of `Ks`."),
+            w("a.obj: first note."),
+            w("a.obj: material `Site` has `Ns 0`, which would add all of `Ks`."),
+            w("a.obj: material `Trim` has an invalid `Ni` 0; using 1.5."),
+            w("b.obj: material `Base` has `Ns 0`, which would add all of `Ks`."),
+            w("a.obj: material `Door` has `Ns 0`, which would add all of `Ks`."),
+            w("a.obj: material `Glass` is black."),
+        ]);
+        assert_eq!(
+            folded,
+            [
+                "a.obj: materials `Base`, `Site` and `Door` have `Ns 0`, which would add all of `Ks`.",
+                "a.obj: first note.",
+                "a.obj: material `Trim` has an invalid `Ni` 0; using 1.5.",
+                "b.obj: material `Base` has `Ns 0`, which would add all of `Ks`.",
+                "a.obj: material `Glass` is black.",
+            ]
+        );
+    }
 
     #[test]
     fn long_lists_name_five_and_count_the_rest() {

@@ -101,6 +101,7 @@ pub fn load_scene_file_watched(
         load_scene_str_with_files(&text, &file, &resolve, &resolve_bytes)?
     };
     scene.source = Some(path.to_path_buf());
+    scene.warnings = super::diag::fold_material_warnings(std::mem::take(&mut scene.warnings));
     Ok(Some(scene))
 }
 

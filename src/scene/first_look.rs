@@ -87,7 +87,9 @@ pub(crate) fn load_obj_scene(
     }
     // A material black in every colour it shows (`Kd 0` and `Ka 0` without a texture, neither
     // mirror nor glass; Blender writes that for a model whose look was a node graph or a bump
-    // map only) leaves the model invisible on the dark background: shown in the default grey.
+    // map only, with `d 0.75` when it was a little see-through) leaves the model invisible on
+    // the dark background: shown in the default grey, its transparency kept. A material more
+    // transparent than opaque is glass, and its look is what it lets through.
     let mut black = Vec::new();
     let grey = super::Material::default();
     for m in &mut scene.materials {
@@ -96,7 +98,7 @@ pub(crate) fn load_obj_scene(
             && m.diffuse_map.is_none()
             && m.ambient_map.is_none()
             && m.reflectivity == Vec3::ZERO
-            && m.transparency == Vec3::ZERO;
+            && m.transparency.max_element() < 0.5;
         if shows_nothing && m.name.starts_with(&prefix) {
             m.diffuse = grey.diffuse;
             m.ambient = grey.diffuse;

@@ -11,6 +11,7 @@ use glam::Vec3;
 use super::maps::{candidates, load_texture, texture_statement};
 use super::parse::Facts;
 use super::paths::sibling;
+use super::read::UNNAMED_MATERIAL;
 use super::request::MeshRequest;
 use crate::scene::diag::{list_some, short, short_path};
 use crate::scene::{Material, MaterialId, Scene};
@@ -181,9 +182,6 @@ fn mtl_for_tobj(text: &str) -> Result<Cow<'_, str>, (usize, String)> {
     }
     Ok(fixed.map_or(Cow::Borrowed(text), Cow::Owned))
 }
-
-/// The name given to a material the files leave without one (`newmtl` or `usemtl` alone).
-pub(super) const UNNAMED_MATERIAL: &str = "(no name)";
 
 /// What [`mtl_for_tobj`] puts for one MTL line: `None` to keep it.
 fn mtl_line_for_tobj(line: &str) -> Result<Option<String>, String> {
@@ -411,7 +409,7 @@ impl Values<'_> {
         let tr = self.scalar(tr, "Tr", in_unit, 0.0)?;
         if tr == 1.0 && !glass {
             self.warnings.push(format!(
-                "{}: material `{}` has `Tr 1` (fully transparent) but is not glass; taken as opaque, as MeshLab means it.",
+                "{}: material `{}` has `Tr 1` (fully transparent) without being glass; taken as opaque, as MeshLab means it.",
                 self.label,
                 short(&m.name)
             ));

@@ -9,7 +9,6 @@ use std::path::Path;
 use std::sync::Once;
 
 use super::corners::FaceCorners;
-use super::mtl::UNNAMED_MATERIAL;
 use super::parse::{self, Facts, Polylines, Scanned};
 
 /// Why an OBJ could not be read: the `tobj` reason and, when found, the line.
@@ -28,6 +27,9 @@ impl ObjProblem {
         }
     }
 }
+
+/// The name given to a material the files leave without one (`newmtl` or `usemtl` alone).
+pub(super) const UNNAMED_MATERIAL: &str = "(no name)";
 
 /// OBJ text as the readers take it: continued lines joined ([`join_continued_lines`]), a
 /// `usemtl` without a name given one ([`name_unnamed_usemtl`]) and old Windows spellings of
