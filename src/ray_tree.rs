@@ -428,15 +428,32 @@ fn write_node(out: &mut String, node: &Node, indent: usize) {
     if let Some(hit) = &node.hit {
         let _ = writeln!(
             out,
-            "{pad}  hit {} ({}) at t = {:.5}, P = {}, N = {}{}{}",
+            "{pad}  hit {} ({}) at t = {:.5}, P = {}, N = {}{}{}{}{}{}",
             hit.object,
             hit.material,
             hit.t,
             fmt_v(hit.point),
             fmt_v(hit.normal),
+            hit.geometric_normal
+                .map(|n| format!(" (geometric {})", fmt_v(n)))
+                .unwrap_or_default(),
             if hit.front_face { "" } else { ", inside" },
             hit.barycentric
                 .map(|b| format!(", barycentric ({:.4}, {:.4}, {:.4})", b[0], b[1], b[2]))
+                .unwrap_or_default(),
+            hit.uv
+                .map(|t| format!(", uv ({:.4}, {:.4})", t[0], t[1]))
+                .unwrap_or_default(),
+            hit.texel
+                .map(|t| format!(
+                    ", {} {}",
+                    if hit.uv.is_some() {
+                        "texel (× kd)"
+                    } else {
+                        "vertex colour (× kd)"
+                    },
+                    fmt_v(t)
+                ))
                 .unwrap_or_default(),
         );
     }

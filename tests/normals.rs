@@ -6,7 +6,7 @@
 use std::sync::Arc;
 
 use glam::Vec3;
-use raytree::ray_tree::pixel_tree;
+use raytree::ray_tree::{pixel_tree, tree_text};
 use raytree::scene::{
     NormalsMode, ObjectSource, Scene, load_scene_file, load_scene_str_with,
     load_scene_str_with_files, scene_to_toml,
@@ -464,6 +464,13 @@ fn map_kd_scale_and_offset_move_the_texture_on_the_texture_coordinates() {
             (texel - want).abs().max_element() < 1e-4,
             "{options}: texel {texel}, want {want}"
         );
+        // `raytree tree` prints the uv and the texel.
+        let text = tree_text(&tree);
+        let line = format!(
+            ", uv (0.2500, 0.5000), texel (× kd) ({:.4}, {:.4}, {:.4})",
+            texel.x, texel.y, texel.z
+        );
+        assert!(text.contains(&line), "{options}: {line} in {text}");
     }
 }
 
@@ -494,6 +501,13 @@ fn vertex_colours_multiply_kd_interpolated_at_the_hit() {
             (texel - want).abs().max_element() < 1e-4,
             "{colours:?}: {texel}, want {want}"
         );
+        // `raytree tree` prints it too.
+        let text = tree_text(&tree);
+        let line = format!(
+            ", vertex colour (× kd) ({:.4}, {:.4}, {:.4})",
+            texel.x, texel.y, texel.z
+        );
+        assert!(text.contains(&line), "{line} in {text}");
         // kd (0.7 by default) × the colour: no other hue.
         let local = tree.root.local.expect("shaded");
         let ratio = local.diffuse / want;
