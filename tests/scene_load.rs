@@ -1166,7 +1166,8 @@ fn files_other_tools_write_read_as_meant() {
     );
     assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
     assert!(
-        scene.warnings[0].contains("`gone.mtl`"),
+        scene.warnings[0].contains("`gone.mtl`")
+            && scene.warnings[0].contains("the other libraries on its `mtllib` line are read"),
         "{:?}",
         scene.warnings
     );

@@ -51,9 +51,10 @@ impl<'r> Libraries<'r> {
             }
             whole => vec![(written.as_ref(), whole)],
         };
+        let several = libraries.len() > 1;
         let mut merged: Option<tobj::MTLLoadResult> = None;
         for (written, found) in libraries {
-            let result = self.read(written, found);
+            let result = self.read(written, found, several);
             merged = Some(match (merged, result) {
                 (Some(Ok((mut materials, mut names))), Ok((more, more_names))) => {
                     let offset = materials.len();
@@ -86,17 +87,24 @@ impl<'r> Libraries<'r> {
     }
 
     /// The library `written`, found (or not) by [`Libraries::find`], parsed for tobj, with a
-    /// warning when it cannot be and a note when it was found elsewhere.
+    /// warning when it cannot be and a note when it was found elsewhere; `several` when it is
+    /// one of several libraries on its `mtllib` line.
     fn read(
         &self,
         written: &str,
         found: Result<(Option<String>, String), String>,
+        several: bool,
     ) -> tobj::MTLLoadResult {
         let req = self.req;
         let name = short_path(written);
+        let outcome = if several {
+            "the faces of its materials use the default material; the other libraries on its `mtllib` line are read"
+        } else {
+            "its faces use the default material"
+        };
         let (elsewhere, text) = found.map_err(|reason| {
             self.warnings.borrow_mut().push(format!(
-                "{}: cannot read the material library `{name}` ({reason}); its faces use the default material.",
+                "{}: cannot read the material library `{name}` ({reason}); {outcome}.",
                 req.label
             ));
             tobj::LoadError::OpenFileFailed
@@ -111,14 +119,14 @@ impl<'r> Libraries<'r> {
         self.texts.borrow_mut().push((name.clone(), text.clone()));
         let text = mtl_for_tobj(&text).map_err(|(line, reason)| {
             self.warnings.borrow_mut().push(format!(
-                "{}: cannot read the material library `{name}` (line {line}: {reason}); its faces use the default material.",
+                "{}: cannot read the material library `{name}` (line {line}: {reason}); {outcome}.",
                 req.label
             ));
             tobj::LoadError::MaterialParseError
         })?;
         tobj::load_mtl_buf(&mut text.as_bytes()).inspect_err(|e| {
             self.warnings.borrow_mut().push(format!(
-                "{}: cannot read the material library `{name}` ({e}); its faces use the default material.",
+                "{}: cannot read the material library `{name}` ({e}); {outcome}.",
                 req.label
             ));
         })
