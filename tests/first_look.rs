@@ -739,3 +739,51 @@ fn a_flat_model_is_seen_square_to_its_plane_not_edge_on() {
     let c = covered(&scene);
     assert!(c > 0.15, "the star covers {c} of the image");
 }
+
+#[test]
+fn a_bare_obj_rendered_at_another_size_is_framed_for_that_size() {
+    // `raytree render counter.obj --width 320 --height 100`: framed for the 640×480 it loaded
+    // with, the model filled under half the width; framed again for 320×100 it fills it, and
+    // nothing is cut off.
+    let mut text = String::new();
+    let mut base = 0;
+    cuboid(
+        &mut text,
+        &mut base,
+        Vec3::new(-5.0, 0.0, -1.0),
+        Vec3::new(5.0, 1.0, 1.0),
+        false,
+        &[],
+    );
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut scene = load(dir.path(), "counter.obj", &text);
+    let (w, h) = (320usize, 100usize);
+    scene.render.width = w as u32;
+    scene.render.height = h as u32;
+    let span = |scene: &Scene| {
+        let tracer = Tracer::new(Arc::new(scene.clone()), TraceSettings::default());
+        let image = render(&tracer, 1, 0, &|_, _| {}).expect("renders").0.pixels;
+        let lit = |x: usize, y: usize| image[y * w + x].max_element() > 0.0;
+        let columns: Vec<usize> = (0..w).filter(|&x| (0..h).any(|y| lit(x, y))).collect();
+        let rows: Vec<usize> = (0..h).filter(|&y| (0..w).any(|x| lit(x, y))).collect();
+        let cut = columns[0] == 0
+            || columns[columns.len() - 1] == w - 1
+            || rows[0] == 0
+            || rows[rows.len() - 1] == h - 1;
+        ((columns.len()) as f32 / w as f32, cut)
+    };
+    let (before, _) = span(&scene);
+    let forward_before = forward(&scene);
+    raytree::scene::first_look::refit_bare_obj(&mut scene);
+    let (after, cut) = span(&scene);
+    eprintln!("span {before} -> {after}");
+    assert!(
+        after > 0.75,
+        "spans {after} of the width (before: {before})"
+    );
+    assert!(!cut, "cut off");
+    assert!(
+        forward(&scene).distance(forward_before) < 1e-5,
+        "the same direction"
+    );
+}

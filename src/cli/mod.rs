@@ -140,11 +140,15 @@ pub fn load_scene(arg: &str) -> Result<Scene> {
 }
 
 pub fn apply_overrides(scene: &mut Scene, o: &SceneOverrides) -> TraceSettings {
+    let size = (scene.render.width, scene.render.height);
     if let Some(w) = o.width {
         scene.render.width = w;
     }
     if let Some(h) = o.height {
         scene.render.height = h;
+    }
+    if (scene.render.width, scene.render.height) != size {
+        scene::first_look::refit_bare_obj(scene);
     }
     if let Some(d) = o.max_depth {
         scene.render.max_depth = d;

@@ -190,6 +190,52 @@ pub(crate) fn load_obj_scene(
     Ok(scene)
 }
 
+/// A bare OBJ's first look framed again for the image's aspect, after its size changed from
+/// the one it was framed for (`raytree render x.obj --width 640 --height 300`): a camera that
+/// looks at the model from outside keeps its direction and moves to the distance that fits the
+/// new aspect, and the key light, which stood in proportion to that distance, moves with it.
+/// A camera inside the model (a room), or a scene that is no bare OBJ, is left alone.
+pub fn refit_bare_obj(scene: &mut Scene) {
+    let bare = scene
+        .source
+        .as_ref()
+        .and_then(|p| p.extension())
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    let Some((lo, hi)) = scene.bounds() else {
+        return;
+    };
+    let center = 0.5 * (lo + hi);
+    let camera = scene.camera.clone();
+    let outside = !(camera.position.cmpge(lo).all() && camera.position.cmple(hi).all());
+    if !bare || !outside || camera.look_at.distance(center) > 1e-4 * (hi - lo).length() {
+        return;
+    }
+    let back = camera.position - center;
+    let distance = back.length();
+    if !(distance > 0.0 && distance.is_finite()) {
+        return;
+    }
+    let aspect = scene.render.width.max(1) as f32 / scene.render.height.max(1) as f32;
+    let framed = frame_outside(
+        &scene.triangles,
+        center,
+        camera.up,
+        back / distance,
+        0.0,
+        aspect,
+    );
+    let scale = framed.position.distance(center) / distance;
+    if check_camera(&framed).is_err() || !scale.is_finite() {
+        return;
+    }
+    scene.camera.position = framed.position;
+    for light in &mut scene.lights {
+        if light.name == "key" && !light.follow_camera {
+            light.position = center + (light.position - center) * scale;
+        }
+    }
+}
+
 /// The ambient light of a bare OBJ.
 pub const BARE_OBJ_AMBIENT: f32 = 0.1;
 
