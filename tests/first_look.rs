@@ -602,10 +602,8 @@ fn a_black_material_of_a_bare_obj_is_shown_grey() {
     assert_readable(&scene, "statue.obj", 0.03..0.6, 0.02);
 }
 
-#[test]
-fn a_wide_model_fills_the_frame_and_nothing_is_cut_off() {
-    // A long low model (a kitchen counter, a car): framing its bounding sphere left it a
-    // third of the image wide.
+/// A long low box (a kitchen counter), 10 × 1 × 2, as a bare OBJ.
+fn counter(dir: &Path) -> Scene {
     let mut text = String::new();
     let mut base = 0;
     cuboid(
@@ -616,8 +614,15 @@ fn a_wide_model_fills_the_frame_and_nothing_is_cut_off() {
         false,
         &[],
     );
+    load(dir, "counter.obj", &text)
+}
+
+#[test]
+fn a_wide_model_fills_the_frame_and_nothing_is_cut_off() {
+    // A long low model (a kitchen counter, a car): framing its bounding sphere left it a
+    // third of the image wide.
     let dir = tempfile::tempdir().expect("temp dir");
-    let scene = load(dir.path(), "counter.obj", &text);
+    let scene = counter(dir.path());
     let image = pixels(&scene);
     let (w, h) = (160usize, 120usize);
     let lit = |x: usize, y: usize| image[y * w + x].max_element() > 0.0;
@@ -745,18 +750,8 @@ fn a_bare_obj_rendered_at_another_size_is_framed_for_that_size() {
     // `raytree render counter.obj --width 320 --height 100`: framed for the 640×480 it loaded
     // with, the model filled under half the width; framed again for 320×100 it fills it, and
     // nothing is cut off.
-    let mut text = String::new();
-    let mut base = 0;
-    cuboid(
-        &mut text,
-        &mut base,
-        Vec3::new(-5.0, 0.0, -1.0),
-        Vec3::new(5.0, 1.0, 1.0),
-        false,
-        &[],
-    );
     let dir = tempfile::tempdir().expect("temp dir");
-    let mut scene = load(dir.path(), "counter.obj", &text);
+    let mut scene = counter(dir.path());
     let (w, h) = (320usize, 100usize);
     scene.render.width = w as u32;
     scene.render.height = h as u32;
