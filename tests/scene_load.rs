@@ -1077,8 +1077,21 @@ fn windows_byte_order_marks_and_continued_lines_read_as_meant() {
 
 #[test]
 fn files_other_tools_write_read_as_meant() {
-    // UTF-16 text (Notepad's "Unicode"), big- and little-endian, for the OBJ and its MTL.
     let dir = tempfile::tempdir().expect("temp dir");
+    // Writes `files` (name, bytes) and loads the last, an OBJ.
+    let load = |files: &[(&str, Vec<u8>)]| -> Scene {
+        for (name, bytes) in files {
+            std::fs::write(dir.path().join(name), bytes).expect("write");
+        }
+        let obj = dir.path().join(files[files.len() - 1].0);
+        load_scene_file(&obj).unwrap_or_else(|e| panic!("{e}"))
+    };
+    let text = |t: &str| t.as_bytes().to_vec();
+    let diffuse = |scene: &Scene, name: &str, want: Vec3| {
+        assert_eq!(material(scene, name).diffuse, want, "{:?}", scene.warnings);
+    };
+
+    // UTF-16 text (Notepad's "Unicode"), big- and little-endian, for the OBJ and its MTL.
     let utf16 = |text: &str, big: bool| -> Vec<u8> {
         let mut out = if big {
             vec![0xFE, 0xFF]
@@ -1094,52 +1107,38 @@ fn files_other_tools_write_read_as_meant() {
         }
         out
     };
-    std::fs::write(
-        dir.path().join("u.mtl"),
-        utf16("newmtl red\r\nKd 1 0 0\r\n", false),
-    )
-    .expect("write");
-    std::fs::write(
-        dir.path().join("u.obj"),
-        utf16(
-            "mtllib u.mtl\r\nv 0 0 0\r\nv 1 0 0\r\nv 1 1 0\r\nusemtl red\r\nf 1 2 3\r\n",
-            true,
+    let scene = load(&[
+        ("u.mtl", utf16("newmtl red\r\nKd 1 0 0\r\n", false)),
+        (
+            "u.obj",
+            utf16(
+                "mtllib u.mtl\r\nv 0 0 0\r\nv 1 0 0\r\nv 1 1 0\r\nusemtl red\r\nf 1 2 3\r\n",
+                true,
+            ),
         ),
-    )
-    .expect("write");
-    let scene = load_scene_file(&dir.path().join("u.obj")).unwrap_or_else(|e| panic!("{e}"));
+    ]);
     assert_eq!(scene.triangles.len(), 1);
-    assert_eq!(
-        material(&scene, "u/red").diffuse,
-        Vec3::X,
-        "{:?}",
-        scene.warnings
-    );
+    diffuse(&scene, "u/red", Vec3::X);
 
     // A material without a name (`newmtl` and `usemtl` alone), which tobj refuses.
-    std::fs::write(dir.path().join("n.mtl"), "newmtl \nKd 0 0 1\n").expect("write");
-    std::fs::write(
-        dir.path().join("n.obj"),
-        "mtllib n.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl \nf 1 2 3\n",
-    )
-    .expect("write");
-    let scene = load_scene_file(&dir.path().join("n.obj")).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(
-        material(&scene, "n/(no name)").diffuse,
-        Vec3::Z,
-        "{:?}",
-        scene.warnings
-    );
+    let scene = load(&[
+        ("n.mtl", text("newmtl \nKd 0 0 1\n")),
+        (
+            "n.obj",
+            text("mtllib n.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl \nf 1 2 3\n"),
+        ),
+    ]);
+    diffuse(&scene, "n/(no name)", Vec3::Z);
     assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
 
     // Old Windows spellings of what is not a number: the face on such vertices is dropped as
     // any non-finite one, the rest shows.
-    std::fs::write(
-        dir.path().join("nan.obj"),
-        "v 1.#IND -1.#IND 1.#IND\nv 1.#INF -1.#INF 1.#INF\nv 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\nf 3 4 5\n",
-    )
-    .expect("write");
-    let scene = load_scene_file(&dir.path().join("nan.obj")).unwrap_or_else(|e| panic!("{e}"));
+    let scene = load(&[(
+        "nan.obj",
+        text(
+            "v 1.#IND -1.#IND 1.#IND\nv 1.#INF -1.#INF 1.#INF\nv 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\nf 3 4 5\n",
+        ),
+    )]);
     assert_eq!(scene.triangles.len(), 1);
     assert!(
         scene
@@ -1151,19 +1150,16 @@ fn files_other_tools_write_read_as_meant() {
     );
 
     // `mtllib` names with spaces written `\ `, beside a missing library.
-    std::fs::write(dir.path().join("my mats.mtl"), "newmtl green\nKd 0 1 0\n").expect("write");
-    std::fs::write(
-        dir.path().join("e.obj"),
-        "mtllib gone.mtl my\\ mats.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl green\nf 1 2 3\n",
-    )
-    .expect("write");
-    let scene = load_scene_file(&dir.path().join("e.obj")).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(
-        material(&scene, "e/green").diffuse,
-        Vec3::Y,
-        "{:?}",
-        scene.warnings
-    );
+    let scene = load(&[
+        ("my mats.mtl", text("newmtl green\nKd 0 1 0\n")),
+        (
+            "e.obj",
+            text(
+                "mtllib gone.mtl my\\ mats.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl green\nf 1 2 3\n",
+            ),
+        ),
+    ]);
+    diffuse(&scene, "e/green", Vec3::Y);
     assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
     assert!(
         scene.warnings[0].contains("`gone.mtl`")

@@ -588,8 +588,7 @@ const FLAT: f32 = 0.01;
 /// The side a model seen from outside is looked at from, and how high (the camera's rise over
 /// its run): its `front`, a little from above (0.3), unless it is flat. A flat model standing
 /// upright (a sign, a wall, a cut-out polygon) is looked at square to its plane, from the side
-/// its faces face (by their winding, summed by area; `front`'s side of that axis when they
-/// cancel), where seen from `front` it would be edge-on; a flat model lying down (a floor plan,
+/// its faces face (by their winding, summed by area; the positive side when they cancel), where seen from `front` it would be edge-on; a flat model lying down (a floor plan,
 /// a terrain patch) is looked at from higher up (1.0, 45°).
 fn flat_front(
     triangles: &[Triangle],

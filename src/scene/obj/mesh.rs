@@ -15,7 +15,7 @@ use super::faces::{Faces, Given, PLACED, dropped, keep_placed};
 use super::memory::check_memory;
 use super::mtl::{Libraries, mtl_material, warn_unknown_usemtl};
 use super::parse::Facts;
-use super::read::{ObjProblem, prepare_text, read_models, scan};
+use super::read::{ObjProblem, join_continued_lines, read_models, respell, scan};
 use super::request::MeshRequest;
 use crate::scene::diag::short_path;
 use crate::scene::{MaterialId, MeshAttributes, MeshPart, NormalsMode, Scene};
@@ -26,7 +26,7 @@ const UNNAMED: &str = "unnamed_object";
 /// Adds the OBJ's triangles (placed, degenerate ones dropped) and the MTL materials they use
 /// to `scene`; returns how many triangles were added.
 pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, ObjProblem> {
-    let joined = prepare_text(req.text);
+    let joined = join_continued_lines(req.text);
     let with_joined;
     let req = match &joined {
         Cow::Owned(text) => {
@@ -35,7 +35,19 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
         }
         Cow::Borrowed(_) => req,
     };
-    let (scanned, fast_corners, facts) = scan(req.text)?;
+    let (mut scanned, mut fast_corners, mut facts) = scan(req.text)?;
+    // What the parallel reader gave up on may be a spelling tobj refuses too (`usemtl` alone,
+    // `1.#IND`): spelled so that it reads, and read again.
+    let respelled = scanned.is_none().then(|| respell(req.text)).flatten();
+    let with_respelled;
+    let req = match &respelled {
+        Some(text) => {
+            (scanned, fast_corners, facts) = scan(text)?;
+            with_respelled = MeshRequest { text, ..*req };
+            &with_respelled
+        }
+        None => req,
+    };
     // A file without `vn` whose faces are in smoothing groups (`s 1`) shades as its exporter
     // meant: smooth, with normals computed as for `normals = "smooth"` within each group.
     let by_groups = req.normals == NormalsMode::File && facts.normals == 0 && facts.smoothing;

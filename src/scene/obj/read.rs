@@ -31,17 +31,14 @@ impl ObjProblem {
 /// The name given to a material the files leave without one (`newmtl` or `usemtl` alone).
 pub(super) const UNNAMED_MATERIAL: &str = "(no name)";
 
-/// OBJ text as the readers take it: continued lines joined ([`join_continued_lines`]), a
-/// `usemtl` without a name given one ([`name_unnamed_usemtl`]) and old Windows spellings of
-/// non-finite numbers read as such ([`spell_non_finite`]); the text itself when none applies.
-pub(super) fn prepare_text(text: &str) -> Cow<'_, str> {
-    let mut text = join_continued_lines(text);
-    for step in [name_unnamed_usemtl, spell_non_finite] {
-        if let Some(changed) = step(&text) {
-            text = Cow::Owned(changed);
-        }
-    }
-    text
+/// OBJ text the parallel reader gave up on, spelled so that it reads: a `usemtl` without a
+/// name given one ([`name_unnamed_usemtl`]) and old Windows spellings of non-finite numbers
+/// read as such ([`spell_non_finite`]); `None` when neither applies. Only a text that reader
+/// refused is searched (it refuses both), so a file that reads pays nothing.
+pub(super) fn respell(text: &str) -> Option<String> {
+    let named = name_unnamed_usemtl(text);
+    let spelled = spell_non_finite(named.as_deref().unwrap_or(text));
+    spelled.or(named)
 }
 
 /// `text` with each line rewritten by `line` (given a line without its line break; `None`
@@ -105,12 +102,12 @@ fn spell_non_finite(text: &str) -> Option<String> {
         }
     };
     let line = |line: &str| {
-        let mut words = line.split_whitespace();
-        if !matches!(words.next(), Some("v" | "vn" | "vt" | "vp")) || !line.contains(".#") {
+        if !line.contains(".#") {
             return None;
         }
         let words: Vec<&str> = line.split_whitespace().collect();
-        words.iter().any(|w| spelled(w).is_some()).then(|| {
+        let numbers = matches!(words.first(), Some(&("v" | "vn" | "vt" | "vp")));
+        (numbers && words.iter().any(|w| spelled(w).is_some())).then(|| {
             words
                 .iter()
                 .map(|w| spelled(w).unwrap_or(w))
@@ -118,11 +115,9 @@ fn spell_non_finite(text: &str) -> Option<String> {
                 .join(" ")
         })
     };
-    let any = text
-        .lines()
-        .filter(|l| l.contains(".#"))
-        .any(|l| line(l).is_some());
-    any.then(|| rewrite_lines(text, line))
+    text.lines()
+        .any(|l| line(l).is_some())
+        .then(|| rewrite_lines(text, line))
 }
 
 /// OBJ text with its continued lines joined: a statement whose line ends in `\` goes on on the
@@ -390,18 +385,23 @@ mod tests {
     #[test]
     fn unnamed_materials_and_old_windows_non_finite_numbers_are_spelled_for_the_readers() {
         let same = "v 1 2 3\nusemtl a\n# usemtl\nf 1 1 1\n";
-        assert!(matches!(prepare_text(same), Cow::Borrowed(_)));
+        assert_eq!(respell(same), None);
         assert_eq!(
-            prepare_text("v 0 0 0\r\nusemtl \r\n  usemtl\nf 1 1 1"),
-            "v 0 0 0\r\nusemtl (no name)\r\nusemtl (no name)\nf 1 1 1"
+            respell("v 0 0 0\r\nusemtl \r\n  usemtl\nf 1 1 1").as_deref(),
+            Some("v 0 0 0\r\nusemtl (no name)\r\nusemtl (no name)\nf 1 1 1")
         );
         assert_eq!(
-            prepare_text("v 1.#IND -1.#IND00 1.#INF\nvn -1.#INF00 1.#QNAN0 0\n# 1.#IND\nv 1 2 3\n"),
-            "v NaN NaN inf\nvn -inf NaN 0\n# 1.#IND\nv 1 2 3\n"
+            respell("v 1.#IND -1.#IND00 1.#INF\nvn -1.#INF00 1.#QNAN0 0\n# 1.#IND\nv 1 2 3\n")
+                .as_deref(),
+            Some("v NaN NaN inf\nvn -inf NaN 0\n# 1.#IND\nv 1 2 3\n")
+        );
+        assert_eq!(
+            respell("usemtl\nv 1.#IND 0 0\n").as_deref(),
+            Some("usemtl (no name)\nv NaN 0 0\n"),
+            "both at once"
         );
         // Not such a number: left for the reader's error.
-        let odd = "v 1.#IX 0 0\nv a.#IND 0 0\n";
-        assert!(matches!(prepare_text(odd), Cow::Borrowed(_)));
+        assert_eq!(respell("v 1.#IX 0 0\nv a.#IND 0 0\n"), None);
     }
 
     #[test]
