@@ -782,3 +782,114 @@ fn a_bare_obj_rendered_at_another_size_is_framed_for_that_size() {
         "the same direction"
     );
 }
+
+/// A closed UV sphere of radius 1 about `(0, 1, 0)` (`rings` × `segments` quads, split in two),
+/// counter-clockwise seen from outside, without normals.
+fn ball(rings: usize, segments: usize) -> String {
+    let mut out = String::new();
+    for i in 0..=rings {
+        let theta = std::f32::consts::PI * i as f32 / rings as f32;
+        for j in 0..segments {
+            let phi = std::f32::consts::TAU * j as f32 / segments as f32;
+            let (s, c) = theta.sin_cos();
+            out += &format!("v {} {} {}\n", s * phi.cos(), 1.0 + c, -s * phi.sin());
+        }
+    }
+    let at = |i: usize, j: usize| i * segments + j % segments + 1;
+    for i in 0..rings {
+        for j in 0..segments {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            if i > 0 {
+                out += &format!("f {a} {b} {d}\n");
+            }
+            if i + 1 < rings {
+                out += &format!("f {b} {c} {d}\n");
+            }
+        }
+    }
+    out
+}
+
+/// `text` (positions and triangles `f a b c` only) with a `vn` per face, the normal its
+/// winding gives, on each of its corners; with the corners listed the other way round when
+/// `wind_back`, so the faces are wound clockwise seen from the side their normals face.
+fn with_face_normals(text: &str, wind_back: bool) -> String {
+    let mut points = Vec::new();
+    let mut out = String::new();
+    let mut faces = String::new();
+    for line in text.lines() {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        match words.first() {
+            Some(&"v") => {
+                let p: Vec<f32> = words[1..4].iter().map(|w| w.parse().expect("x")).collect();
+                points.push(Vec3::new(p[0], p[1], p[2]));
+                out += line;
+                out += "\n";
+            }
+            Some(&"f") => {
+                let i: Vec<usize> = words[1..4].iter().map(|w| w.parse().expect("i")).collect();
+                let [a, b, c] = [i[0], i[1], i[2]].map(|i| points[i - 1]);
+                let n = (b - a).cross(c - a).normalize();
+                out += &format!("vn {} {} {}\n", n.x, n.y, n.z);
+                let k = out.matches("vn ").count();
+                let order = if wind_back {
+                    [i[0], i[2], i[1]]
+                } else {
+                    [i[0], i[1], i[2]]
+                };
+                faces += &format!("f {}//{k} {}//{k} {}//{k}\n", order[0], order[1], order[2]);
+            }
+            _ => {}
+        }
+    }
+    out + &faces
+}
+
+#[test]
+fn a_model_wound_against_its_normals_opens_as_the_normals_say() {
+    // Wound clockwise with outward normals (a file converted from left-handed axes by
+    // negating z): the same ball as wound right, seen from outside and lit, not a dark room.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let right = load(
+        dir.path(),
+        "ball.obj",
+        &with_face_normals(&ball(12, 24), false),
+    );
+    let back = load(
+        dir.path(),
+        "ball_cw.obj",
+        &with_face_normals(&ball(12, 24), true),
+    );
+    assert_not_warned(&right, "ball.obj", "wound clockwise");
+    assert_warned(
+        &back,
+        "ball_cw.obj",
+        &["its faces are wound clockwise", "`vn`"],
+    );
+    assert!(!inside(back.camera.position, &back), "outside the ball");
+    assert!(
+        back.camera.position.distance(right.camera.position) < 1e-4,
+        "the same first look: {:?} against {:?}",
+        back.camera,
+        right.camera
+    );
+    let (a, b) = (pixels(&right), pixels(&back));
+    let differ = a
+        .iter()
+        .zip(&b)
+        .filter(|(x, y)| (**x - **y).abs().max_element() > 1e-3);
+    assert!(
+        differ.count() * 1000 < a.len(),
+        "the two balls render alike"
+    );
+    assert_readable(&back, "ball_cw.obj", 0.03..0.6, 0.1);
+    // Wound outwards with inward normals (a furnace test's box, made to be seen from inside):
+    // a room, so the camera starts inside it and the walls are lit.
+    let mut room = String::new();
+    let hi = Vec3::new(3.0, 4.0, 4.0);
+    cuboid(&mut room, &mut 0, -hi.with_y(0.0), hi, true, &[]);
+    let furnace = load(dir.path(), "furnace.obj", &with_face_normals(&room, true));
+    assert_warned(&furnace, "furnace.obj", &["its faces are wound clockwise"]);
+    assert!(inside(furnace.camera.position, &furnace), "inside the box");
+    assert_readable(&furnace, "furnace.obj", 0.1..0.9, 0.1);
+}

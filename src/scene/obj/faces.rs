@@ -208,6 +208,48 @@ pub(super) fn keep_placed(
     }
 }
 
+/// Turns round the faces wound against their own vertex normals: a face whose three `vn` all
+/// lie on the other side of its plane from the normal its winding gives (a file wound
+/// clockwise, or converted between left- and right-handed axes by negating one coordinate of
+/// its points and normals) gets two corners swapped, with their normal, texture-coordinate and
+/// colour indices (`ids`: normals first, each empty or one per triangle), so that its front is
+/// the side its normals face. Faces without usable `vn` at every corner keep their winding.
+/// Returns how many were turned.
+pub(super) fn wind_as_normals(
+    triangles: &mut [Triangle],
+    normals: &[Vec3],
+    ids: [&mut Vec<[u32; 3]>; 3],
+) -> usize {
+    let [normal_ids, uv_ids, color_ids] = ids;
+    if normal_ids.len() != triangles.len() {
+        return 0;
+    }
+    let against = |t: &Triangle, n: &[u32; 3]| {
+        let v = &t.vertices;
+        let winding = (v[1] - v[0]).cross(v[2] - v[0]);
+        n[0] != NO_INDEX && n.iter().all(|&i| normals[i as usize].dot(winding) < 0.0)
+    };
+    let turned = triangles
+        .par_iter()
+        .zip(normal_ids.par_iter())
+        .filter(|(t, n)| against(t, n))
+        .count();
+    if turned == 0 {
+        return 0;
+    }
+    for k in 0..triangles.len() {
+        if against(&triangles[k], &normal_ids[k]) {
+            triangles[k].vertices.swap(1, 2);
+            for ids in [&mut *normal_ids, &mut *uv_ids, &mut *color_ids] {
+                if let Some(corners) = ids.get_mut(k) {
+                    corners.swap(1, 2);
+                }
+            }
+        }
+    }
+    turned
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -223,5 +265,35 @@ mod tests {
             Vec3::X * 3e38,
             Vec3::Y * 3e38
         ]));
+    }
+
+    #[test]
+    fn only_faces_whose_three_normals_all_face_the_other_way_are_turned() {
+        let t = Triangle {
+            vertices: [Vec3::ZERO, Vec3::X, Vec3::Y],
+            material: PLACED,
+            object: ObjectId(0),
+        };
+        // Normals 0, 1: +z (the winding's side); 2, 3: -z; 4: tilted, still -z's side.
+        let normals = [
+            Vec3::Z,
+            Vec3::Z,
+            -Vec3::Z,
+            -Vec3::Z,
+            Vec3::new(0.9, 0.0, -0.1),
+        ];
+        let mut triangles = vec![t; 4];
+        let mut normal_ids = vec![[0, 1, 0], [2, 3, 0], [2, 3, 4], [NO_INDEX; 3]];
+        let mut uv_ids = vec![[0, 1, 2], [3, 4, 5], [6, 7, 8], [9, 10, 11]];
+        let mut color_ids = Vec::new();
+        let ids = [&mut normal_ids, &mut uv_ids, &mut color_ids];
+        assert_eq!(wind_as_normals(&mut triangles, &normals, ids), 1);
+        assert_eq!(triangles[2].vertices, [Vec3::ZERO, Vec3::Y, Vec3::X]);
+        assert_eq!((normal_ids[2], uv_ids[2]), ([2, 4, 3], [6, 8, 7]));
+        // A face with one normal on its winding's side, and one without normals, stay.
+        for k in [0, 1, 3] {
+            assert_eq!(triangles[k].vertices, t.vertices);
+        }
+        assert_eq!((normal_ids[1], uv_ids[1]), ([2, 3, 0], [3, 4, 5]));
     }
 }

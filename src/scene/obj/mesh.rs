@@ -11,7 +11,7 @@ use rayon::prelude::*;
 
 use super::attributes::{Corners, finish_attributes};
 use super::corners::{self, FaceCorners};
-use super::faces::{Faces, Given, PLACED, dropped, keep_placed};
+use super::faces::{Faces, Given, PLACED, dropped, keep_placed, wind_as_normals};
 use super::memory::check_memory;
 use super::mtl::{Libraries, mtl_material, warn_unknown_usemtl};
 use super::parse::Facts;
@@ -214,6 +214,8 @@ struct MeshBuild<'a> {
     /// Triangles dropped so far: of zero area or not finite, and beyond the scene-size limit.
     dropped: usize,
     too_far: usize,
+    /// Triangles kept so far that were wound against their vertex normals, and turned round.
+    turned: usize,
     attrs: MeshAttributes,
     corners: Corners,
     warnings: Vec<String>,
@@ -256,6 +258,7 @@ impl<'a> MeshBuild<'a> {
             added: 0,
             dropped: 0,
             too_far: 0,
+            turned: 0,
             attrs: MeshAttributes {
                 first_triangle: first_triangle as u32,
                 ..MeshAttributes::default()
@@ -327,6 +330,11 @@ impl<'a> MeshBuild<'a> {
                 [&mut normal_ids, &mut uv_ids, &mut color_ids],
             );
         }
+        self.turned += wind_as_normals(
+            &mut Arc::make_mut(&mut scene.triangles)[start..],
+            &self.attrs.normals,
+            [&mut normal_ids, &mut uv_ids, &mut color_ids],
+        );
         if let Some(material) = material {
             Arc::make_mut(&mut scene.triangles)[start..]
                 .par_iter_mut()
@@ -439,6 +447,19 @@ impl<'a> MeshBuild<'a> {
             let s = if dropped == 1 { "" } else { "s" };
             warnings.push(format!(
                 "{}: dropped {dropped} degenerate triangle{s} (zero area or non-finite vertices).",
+                req.label
+            ));
+        }
+        if self.turned > 0 {
+            let which = match self.turned {
+                n if n == added => "its faces are".to_string(),
+                1 => "1 of its faces is".to_string(),
+                n => format!("{n} of its {added} faces are"),
+            };
+            warnings.push(format!(
+                "{}: {which} wound clockwise seen from the side their vertex normals (`vn`) \
+                 face, as a file converted between left- and right-handed axes is: their front \
+                 is taken to be the side the normals face.",
                 req.label
             ));
         }
