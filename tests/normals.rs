@@ -546,7 +546,7 @@ fn built_in_textures_are_read_from_the_binary() {
 fn faces_without_normals_at_every_corner_are_flat() {
     let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\n\
 vn 0.3 0 1\nvn 0 0.3 1\n\
-f 1//1 2//2 3//1\nf 2 4 3\nf 2//1 5 4//2\nf 1//2 2//2 3//2 4//1\n";
+f 1//1 2//2 3//1\nf 2 4 3\nf 2//1 5 4//2\nf 1//2 2//2 4//1 3//2\n";
     let list: &'static [(&str, &str)] = Box::leak(Box::new([("m.obj", obj)]));
     let scene = load("[[mesh]]\nfile = \"m.obj\"\n", list);
     assert_eq!(scene.triangles.len(), 5);

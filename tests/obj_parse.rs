@@ -418,10 +418,13 @@ fn faces_with_mixed_corners_are_flagged_alike_on_either_path() {
     assert_eq!(fast.warnings, slow.warnings);
     // The faces that repeat a vertex are dropped after the flags are read: the flags of the
     // faces after them must still be theirs.
-    assert_eq!(fast.warnings.len(), 3, "{:?}", fast.warnings);
+    // The random normals lie against the winding of about a third of the faces, so those are
+    // turned round, alike on both paths.
+    assert_eq!(fast.warnings.len(), 4, "{:?}", fast.warnings);
     assert!(fast.warnings[0].contains("normals (`vn`) at some corners only"));
     assert!(fast.warnings[1].contains("texture coordinates (`vt`) at some corners only"));
     assert!(fast.warnings[2].contains("degenerate triangles"));
+    assert!(fast.warnings[3].contains("faces are wound clockwise"));
 }
 
 #[test]

@@ -453,8 +453,8 @@ impl<'a> MeshBuild<'a> {
         if self.turned > 0 {
             let which = match self.turned {
                 n if n == added => "its faces are".to_string(),
-                1 => "1 of its faces is".to_string(),
-                n => format!("{n} of its {added} faces are"),
+                1 => "1 face is".to_string(),
+                n => format!("{n} faces are"),
             };
             warnings.push(format!(
                 "{}: {which} wound clockwise seen from the side their vertex normals (`vn`) \
