@@ -229,25 +229,26 @@ pub(super) fn wind_as_normals(
         let winding = (v[1] - v[0]).cross(v[2] - v[0]);
         n[0] != NO_INDEX && n.iter().all(|&i| normals[i as usize].dot(winding) < 0.0)
     };
-    let turned = triangles
-        .par_iter()
-        .zip(normal_ids.par_iter())
-        .filter(|(t, n)| against(t, n))
-        .count();
-    if turned == 0 {
-        return 0;
-    }
-    for k in 0..triangles.len() {
-        if against(&triangles[k], &normal_ids[k]) {
-            triangles[k].vertices.swap(1, 2);
-            for ids in [&mut *normal_ids, &mut *uv_ids, &mut *color_ids] {
-                if let Some(corners) = ids.get_mut(k) {
-                    corners.swap(1, 2);
-                }
+    // One pass decides and turns the corners and their normals; the few turned faces' texture
+    // and colour indices follow.
+    let turned: Vec<usize> = (triangles.par_iter_mut().zip(normal_ids.par_iter_mut()))
+        .enumerate()
+        .filter_map(|(k, (t, n))| {
+            against(t, n).then(|| {
+                t.vertices.swap(1, 2);
+                n.swap(1, 2);
+                k
+            })
+        })
+        .collect();
+    for &k in &turned {
+        for ids in [&mut *uv_ids, &mut *color_ids] {
+            if let Some(corners) = ids.get_mut(k) {
+                corners.swap(1, 2);
             }
         }
     }
-    turned
+    turned.len()
 }
 
 #[cfg(test)]
