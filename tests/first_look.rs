@@ -745,6 +745,70 @@ fn a_flat_model_is_seen_square_to_its_plane_not_edge_on() {
     assert!(c > 0.15, "the star covers {c} of the image");
 }
 
+/// The star of [`flat_star`] in the plane through `center` square to `normal`, wound so that
+/// its faces face `normal`.
+fn slanted_star(center: Vec3, normal: Vec3) -> String {
+    let n = normal.normalize();
+    let u = n.any_orthonormal_vector();
+    let v = n.cross(u);
+    let mut obj = String::new();
+    for i in 0..24 {
+        let a = i as f32 / 24.0 * std::f32::consts::TAU;
+        let r = if i % 2 == 0 { 1.0 } else { 0.5 };
+        let p = center + u * (r * a.cos()) + v * (r * a.sin());
+        obj.push_str(&format!("v {} {} {}\n", p.x, p.y, p.z));
+    }
+    let corners: Vec<String> = (1..=24).map(|i| i.to_string()).collect();
+    obj.push_str(&format!("f {}\n", corners.join(" ")));
+    obj
+}
+
+#[test]
+fn a_flat_model_in_a_slanted_plane_is_seen_square_to_it() {
+    // Flat, but along no axis, so its bounds are not thin: seen from the +z front it was
+    // almost edge-on, a sliver across a black image.
+    let dir = tempfile::tempdir().expect("temp dir");
+    for normal in [
+        Vec3::new(-1.0, -0.25, -0.1),
+        Vec3::new(1.0, 0.3, 0.2),
+        Vec3::new(0.9, 0.1, -0.3),
+    ] {
+        let scene = load(
+            dir.path(),
+            "slanted.obj",
+            &slanted_star(Vec3::new(3.0, 1.0, -2.0), normal),
+        );
+        let f = forward(&scene);
+        let square = -f.dot(normal.normalize());
+        assert!(
+            square > 0.9,
+            "normal {normal}: looks along {f}, {square} of square to the faces' side"
+        );
+        let c = covered(&scene);
+        assert!(
+            c > 0.15,
+            "normal {normal}: the star covers {c} of the image"
+        );
+    }
+    // One long slanted triangle, as a reader's test file has it.
+    let triangle = "v 1.864151 -1.219172 -5.532511\nv 0.575869 -0.666304 5.896140\n\
+        v 0.940448 1.000000 -1.971128\nf 1 2 3\n";
+    let scene = load(dir.path(), "triangle.obj", triangle);
+    let c = covered(&scene);
+    assert!(
+        c > 0.07,
+        "the triangle covers {c} of the image (seen from +z: 0.02)"
+    );
+    // A flat model seen well from the front keeps the front view, whichever way it faces.
+    let scene = load(
+        dir.path(),
+        "front.obj",
+        &slanted_star(Vec3::ZERO, Vec3::new(0.3, 0.0, -1.0)),
+    );
+    let f = forward(&scene);
+    assert!(f.z < -0.9, "looks along {f}");
+}
+
 #[test]
 fn a_bare_obj_rendered_at_another_size_is_framed_for_that_size() {
     // `raytree render counter.obj --width 320 --height 100`: framed for the 640×480 it loaded

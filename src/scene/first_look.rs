@@ -402,7 +402,7 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
     }
     let probes = probe_points(triangles, &curve, &points, &dirs, (lo, hi));
     if !probes.iter().any(|p| p.in_room()) {
-        let (front, elevation) = flat_front(triangles, half, up, side, front);
+        let (front, elevation) = flat_front(triangles, half, up, front);
         return FirstView {
             camera: frame_outside(triangles, center, up, front, elevation, aspect),
             room: None,
@@ -578,49 +578,100 @@ fn opening(
     (open.len() as f32 / points.len() as f32, door)
 }
 
-/// The camera in front of the model (from `front`, raised by `elevation`: 0.3 is about 17°), aimed
-/// at the bounds' centre, as close as keeps every vertex inside the image with a 5 % margin on each
-/// side.
-/// A model this flat (its thinnest extent at most this fraction of its largest) is looked at
-/// square to its plane ([`flat_front`]).
+/// A model this flat (its vertices within twice this fraction of its bounds' largest half extent
+/// of a plane) is looked at as a flat thing ([`flat_front`]).
 const FLAT: f32 = 0.01;
 
+/// A flat model seen from its front at more than this angle from square (the cosine: 60°) is
+/// looked at square to its plane instead ([`flat_front`]).
+const GRAZING: f32 = 0.5;
+
 /// The side a model seen from outside is looked at from, and how high (the camera's rise over
-/// its run): its `front`, a little from above (0.3), unless it is flat. A flat model standing
-/// upright (a sign, a wall, a cut-out polygon) is looked at square to its plane, from the side
-/// its faces face (by their winding, summed by area; the positive side when they cancel), where seen from `front` it would be edge-on; a flat model lying down (a floor plan,
-/// a terrain patch) is looked at from higher up (1.0, 45°).
-fn flat_front(
-    triangles: &[Triangle],
-    half: Vec3,
-    up: Vec3,
-    side: Vec3,
-    front: Vec3,
-) -> (Vec3, f32) {
-    use rayon::prelude::*;
-    let extent = |axis: Vec3| (half * axis).length();
+/// its run): its `front`, a little from above (0.3), unless it is flat, in whatever plane. A
+/// flat model lying within 45° of level (a floor plan, a terrain patch) is looked at from
+/// higher up (1.0, 45°). A flat model that view or the plain front view would see at a grazing
+/// angle (a sign or a cut-out polygon standing sideways, a single slanted triangle) is looked
+/// at square to its plane, from the side its faces face (by their winding, summed by area; the
+/// positive side when they cancel), raised as the front view is.
+fn flat_front(triangles: &[Triangle], half: Vec3, up: Vec3, front: Vec3) -> (Vec3, f32) {
     let largest = half.max_element();
-    let flat = |axis: Vec3| extent(axis) <= FLAT * largest;
     if largest <= 0.0 || !largest.is_finite() {
         return (front, 0.3);
     }
-    if flat(up) && !flat(side) && !flat(front) {
-        return (front, 1.0);
+    let Some((normal, facing)) = plane(triangles, 2.0 * FLAT * largest) else {
+        return (front, 0.3);
+    };
+    let elevation = if normal.dot(up).abs() >= std::f32::consts::FRAC_1_SQRT_2 {
+        1.0
+    } else {
+        0.3
+    };
+    if (front + elevation * up).normalize().dot(normal).abs() >= GRAZING {
+        return (front, elevation);
     }
-    if flat(side) && !flat(front) {
-        let facing: f32 = triangles
-            .par_iter()
-            .map(|t| {
-                let [a, b, c] = t.vertices;
-                0.5 * (b - a).cross(c - a).dot(side)
-            })
-            .sum();
-        let toward = if facing < 0.0 { -side } else { side };
-        return (toward, 0.3);
+    let toward = if facing < 0.0 { -normal } else { normal };
+    let rise = (up - up.dot(toward) * toward).normalize_or_zero();
+    let back = (toward + 0.3 * rise).normalize();
+    let level = back - back.dot(up) * up;
+    if level.length() < 1e-3 {
+        return (front, elevation);
     }
-    (front, 0.3)
+    (level.normalize(), back.dot(up) / level.length())
 }
 
+/// The plane a model lies in, when it lies in one: its unit normal and the model's faces'
+/// area along it (twice, signed by their winding), if every vertex lies within `thickness` of
+/// every other along that normal. The normal is the faces' normals summed by area, each turned
+/// to the side of the largest face's, so faces wound either way do not cancel.
+fn plane(triangles: &[Triangle], thickness: f32) -> Option<(Vec3, f32)> {
+    use rayon::prelude::*;
+    let area = |t: &Triangle| {
+        let [a, b, c] = t.vertices;
+        (b - a).cross(c - a)
+    };
+    let largest = triangles.par_iter().map(area).reduce(
+        || Vec3::ZERO,
+        |x, y| {
+            if y.length_squared() > x.length_squared() {
+                y
+            } else {
+                x
+            }
+        },
+    );
+    let normal = triangles
+        .par_iter()
+        .map(|t| {
+            let n = area(t);
+            if n.dot(largest) < 0.0 { -n } else { n }
+        })
+        .reduce(|| Vec3::ZERO, |x, y| x + y)
+        .normalize_or_zero();
+    if normal == Vec3::ZERO || !normal.is_finite() {
+        return None;
+    }
+    let (low, high) = triangles
+        .par_iter()
+        .flat_map_iter(|t| t.vertices.map(|v| v.dot(normal)))
+        .fold(
+            || (f32::INFINITY, f32::NEG_INFINITY),
+            |(lo, hi), d| (lo.min(d), hi.max(d)),
+        )
+        .reduce(
+            || (f32::INFINITY, f32::NEG_INFINITY),
+            |a, b| (a.0.min(b.0), a.1.max(b.1)),
+        );
+    let spread = high - low;
+    if !spread.is_finite() || spread > thickness {
+        return None;
+    }
+    let facing = triangles.par_iter().map(|t| area(t).dot(normal)).sum();
+    Some((normal, facing))
+}
+
+/// The camera in front of the model (from `front`, raised by `elevation`: 0.3 is about 17°), aimed
+/// at the bounds' centre, as close as keeps every vertex inside the image with a 5 % margin on each
+/// side.
 fn frame_outside(
     triangles: &[Triangle],
     center: Vec3,
