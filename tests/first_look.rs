@@ -957,3 +957,71 @@ fn a_model_wound_against_its_normals_opens_as_the_normals_say() {
     assert!(inside(furnace.camera.position, &furnace), "inside the box");
     assert_readable(&furnace, "furnace.obj", 0.1..0.9, 0.1);
 }
+
+/// A pipe of `segments` sides with walls of radius `inner` and `outer`, `length` long along
+/// `axis` (0 x, 1 y, 2 z) from the origin: a closed solid, wound outwards.
+fn pipe(axis: usize, inner: f32, outer: f32, length: f32, segments: usize) -> String {
+    let place = |r: f32, a: f32, t: f32| {
+        let (u, v) = (r * a.cos(), r * a.sin());
+        let p = match axis {
+            0 => Vec3::new(t, u, v),
+            1 => Vec3::new(v, t, u),
+            _ => Vec3::new(u, v, t),
+        };
+        format!("v {} {} {}\n", p.x, p.y, p.z)
+    };
+    let mut obj = String::new();
+    // Per segment, four vertices per end: outer and inner at t = 0, then at t = length.
+    for k in 0..segments {
+        let a = k as f32 / segments as f32 * std::f32::consts::TAU;
+        for t in [0.0, length] {
+            obj.push_str(&place(outer, a, t));
+            obj.push_str(&place(inner, a, t));
+        }
+    }
+    let at = |k: usize, i: usize| 4 * (k % segments) + i + 1;
+    for k in 0..segments {
+        let (o0, i0, o1, i1) = (at(k, 0), at(k, 1), at(k, 2), at(k, 3));
+        let (p0, j0, p1, j1) = (at(k + 1, 0), at(k + 1, 1), at(k + 1, 2), at(k + 1, 3));
+        obj.push_str(&format!("f {o0} {p0} {p1} {o1}\n")); // outer wall
+        obj.push_str(&format!("f {i0} {i1} {j1} {j0}\n")); // inner wall
+        obj.push_str(&format!("f {o0} {i0} {j0} {p0}\n")); // the ring at t = 0
+        obj.push_str(&format!("f {o1} {p1} {j1} {i1}\n")); // the ring at t = length
+    }
+    obj
+}
+
+#[test]
+fn a_pipe_is_seen_from_outside_not_from_inside_its_hole() {
+    // Its hole's walls face the middle as a room's walls do; from inside, the first look showed
+    // one grey wall filling the image.
+    let dir = tempfile::tempdir().expect("temp dir");
+    for axis in 0..3 {
+        let name = format!("pipe{axis}.obj");
+        let scene = load(dir.path(), &name, &pipe(axis, 0.68, 0.83, 12.0, 32));
+        assert!(
+            !inside(scene.camera.position, &scene),
+            "{name}: the camera stands inside, at {}",
+            scene.camera.position
+        );
+        assert!(
+            !scene.warnings.iter().any(|w| w.contains("a room")),
+            "{name}: {:?}",
+            scene.warnings
+        );
+        let c = covered(&scene);
+        assert!(
+            c > 0.05 && c < 0.9,
+            "{name}: the pipe covers {c} of the image"
+        );
+    }
+    // A short, wide ring (a washer, a bushing) is seen from outside as before; a room open at
+    // both ends, 10 long and 3 high, is still a room (a tube would be under 2.5 across).
+    let scene = load(dir.path(), "ring.obj", &pipe(0, 0.5, 1.0, 0.5, 32));
+    assert!(!inside(scene.camera.position, &scene), "ring: inside");
+    let mut hall = String::new();
+    let (lo, hi) = (Vec3::new(-2.0, 0.0, -5.0), Vec3::new(2.0, 3.0, 5.0));
+    cuboid(&mut hall, &mut 0, lo, hi, true, &[4, 5]);
+    let scene = load(dir.path(), "hall.obj", &hall);
+    assert_warned(&scene, "hall.obj", &["(a room)"]);
+}

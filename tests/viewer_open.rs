@@ -406,3 +406,41 @@ fn stopping_cancels_the_open() {
         "it stopped before its build"
     );
 }
+
+/// A file named on the command line is opened before the window's first frame, when the
+/// render pane's size is not known yet. When it came in after the pane's size was taken, it
+/// was rendered at the scene's 640×480 and shown scaled into the pane, letterboxed, until the
+/// window was resized. Once in, it is rendered at the pane's size, as a scene opened later is.
+#[test]
+fn a_file_opened_before_the_first_frame_is_rendered_at_the_panes_size() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let obj = write_obj(dir.path(), "first.obj", 2_000);
+    let path = obj.clone();
+    let gate = Gate::new(Some(OpenStage::Parse));
+    let hook_gate = gate.clone();
+    let mut h = window_with(small_default(), [1280.0, 800.0], move |app| {
+        app.set_view(4, true);
+        hook_gate.install(app);
+        app.command(Command::OpenFile(path));
+        // Begun now, before any frame, as the window's own start does it.
+        app.apply();
+        assert!(app.files.opening().is_some(), "the open began");
+    });
+    // The pane's size is taken (by the scene shown meanwhile) while the file is still read.
+    steps_until(&mut h, "the render did not take the pane's size", |a| {
+        let pane = a.render.pane_seen(&a.workspace.prefs);
+        pane.is_some() && pane == Some(a.render_size())
+    });
+    assert!(h.state().files.opening().is_some(), "the open was held");
+    gate.hold_at(None);
+    steps_until(&mut h, "the open did not finish", |a| {
+        a.files.opening().is_none() && a.scene().source.as_deref() == Some(obj.as_path())
+    });
+    let pane = h.state().render.pane_seen(&h.state().workspace.prefs);
+    let (w, hh) = h.state().render_size();
+    assert_eq!(
+        pane,
+        Some((w, hh)),
+        "rendered at {w}x{hh}, not at the 1280×800 window's pane"
+    );
+}

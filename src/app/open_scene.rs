@@ -91,6 +91,16 @@ impl ViewerApp {
         self.files.watch(&self.working.scene, &mut self.messages);
         self.render.pending_build = None;
         self.start_generation(tracer, Reach::RenderAndSceneView);
+        // The open was fitted to the pane as it was when it began: none yet for a file named
+        // on the command line (opened before the window's first frame), or another one if the
+        // window was resized while the file loaded. At the pane's size as it is now.
+        let pane = self.render.pane(&self.workspace.prefs);
+        if pane.is_some()
+            && opening::fit_render(self.render.scene_size, pane, self.render.max_side).render
+                != self.render.size()
+        {
+            self.restart(false, Reach::RenderAndSceneView);
+        }
     }
 
     /// Makes `s` the working copy, named `label`: nothing of the old scene stays picked, the

@@ -401,7 +401,7 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
         }
     }
     let probes = probe_points(triangles, &curve, &points, &dirs, (lo, hi));
-    if !probes.iter().any(|p| p.in_room()) {
+    if !probes.iter().any(|p| p.in_room()) || through_tube(triangles, &curve, center, (lo, hi)) {
         let (front, elevation) = flat_front(triangles, half, up, front);
         return FirstView {
             camera: frame_outside(triangles, center, up, front, elevation, aspect),
@@ -526,6 +526,35 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
             entry: Entry::Inside,
         }),
     }
+}
+
+/// A hole through the model's middle whose width, both ways across, is under this fraction of
+/// the model's length along it makes it a tube ([`through_tube`]).
+const TUBE: f32 = 0.25;
+
+/// A hollow tube (a pipe, a bushing, a shaft open at both ends): from the bounds' `center`, the
+/// rays both ways along one axis meet nothing, and across that axis, both ways, the hole is
+/// under [`TUBE`] of the model's length along it. Its hole's walls face the middle as a
+/// room's walls do, but from inside it one would see only the wall in front: it is seen from
+/// outside.
+fn through_tube(triangles: &[Triangle], order: &[u32], center: Vec3, bounds: (Vec3, Vec3)) -> bool {
+    let axes = [Vec3::X, Vec3::Y, Vec3::Z];
+    let rays: Vec<(Vec3, Vec3)> = axes
+        .iter()
+        .flat_map(|&a| [(center, a), (center, -a)])
+        .collect();
+    let met = nearest(triangles, order, &rays);
+    let both = |i: usize| (met[2 * i].0, met[2 * i + 1].0);
+    let size = bounds.1 - bounds.0;
+    (0..3).any(|i| {
+        let (ahead, behind) = both(i);
+        ahead.is_infinite()
+            && behind.is_infinite()
+            && (0..3).filter(|&j| j != i).all(|j| {
+                let (ahead, behind) = both(j);
+                ahead + behind < TUBE * size[i]
+            })
+    })
 }
 
 /// How open the bounds' face towards `wall` (a horizontal axis, signed) is: the fraction of a
