@@ -482,6 +482,8 @@ fn vertex_colours_multiply_kd_interpolated_at_the_hit() {
     for (colours, want) in [
         (["1 0 0", "0 1 0", "0 0 1"], Vec3::new(0.25, 0.25, 0.5)),
         (["0.5 0.5 0.5"; 3], Vec3::splat(0.214_041)),
+        // Two corners without a colour among coloured ones (a file tobj refuses): white.
+        (["1 0 0", "", ""], Vec3::new(1.0, 0.75, 0.75)),
     ] {
         let obj = format!(
             "v -1 -1 0 {}\nv 1 -1 0 {}\nv 0 1 0 {}\nf 1 2 3\n",
@@ -492,7 +494,16 @@ fn vertex_colours_multiply_kd_interpolated_at_the_hit() {
         let scene_file = dir.path().join("s.toml");
         std::fs::write(&scene_file, format!("{CAMERA}[[mesh]]\nfile = \"c.obj\"\n")).expect("toml");
         let scene = load_scene_file(&scene_file).unwrap_or_else(|e| panic!("{e}"));
-        assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        if colours.contains(&"") {
+            assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+            assert!(
+                scene.warnings[0].contains("2 vertices give no colour (`v x y z`) where the others give one (`v x y z r g b`): taken as white"),
+                "{:?}",
+                scene.warnings
+            );
+        } else {
+            assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+        }
         let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());
         let tree = pixel_tree(&tracer, 4, 4).expect("centre pixel");
         let hit = tree.root.hit.as_ref().expect("hit");

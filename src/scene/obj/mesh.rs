@@ -39,9 +39,10 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     // What the parallel reader gave up on may be a spelling tobj refuses too (`usemtl` alone,
     // `1.#IND`): spelled so that it reads, and read again.
     let respelled = scanned.is_none().then(|| respell(req.text)).flatten();
+    let made_white = respelled.as_ref().map_or(0, |(_, white)| *white);
     let with_respelled;
     let req = match &respelled {
-        Some(text) => {
+        Some((text, _)) => {
             (scanned, fast_corners, facts) = scan(text)?;
             with_respelled = MeshRequest { text, ..*req };
             &with_respelled
@@ -71,6 +72,16 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     let face_corners = face_corners(req.text, &models, fast, fast_corners)?;
     let (mut warnings, mtl_texts) = libraries.finish();
     warn_about_reading(req, &facts, &mtl_materials, &mut warnings);
+    if made_white > 0 {
+        let (which, give) = match made_white {
+            1 => ("1 vertex".to_string(), "gives"),
+            n => (format!("{n} vertices"), "give"),
+        };
+        warnings.push(format!(
+            "{}: {which} {give} no colour (`v x y z`) where the others give one (`v x y z r g b`): taken as white, so their faces show their material's colour.",
+            req.label
+        ));
+    }
     // A file with `vn` on some faces only: those of the others in a smoothing group get
     // normals computed within it.
     let lacking = |f: u8| f & corners::ALL_NORMALS == 0;

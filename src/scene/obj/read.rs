@@ -32,13 +32,40 @@ impl ObjProblem {
 pub(super) const UNNAMED_MATERIAL: &str = "(no name)";
 
 /// OBJ text the parallel reader gave up on, spelled so that it reads: a `usemtl` without a
-/// name given one ([`name_unnamed_usemtl`]) and old Windows spellings of non-finite numbers
-/// read as such ([`spell_non_finite`]); `None` when neither applies. Only a text that reader
-/// refused is searched (it refuses both), so a file that reads pays nothing.
-pub(super) fn respell(text: &str) -> Option<String> {
+/// name given one ([`name_unnamed_usemtl`]), old Windows spellings of non-finite numbers
+/// read as such ([`spell_non_finite`]) and vertices without a colour among coloured ones
+/// made white ([`colour_uncoloured`]); `None` when none applies, else the text and how many
+/// vertices were made white. Only a text that reader refused is searched (it refuses all
+/// three), so a file that reads pays nothing.
+pub(super) fn respell(text: &str) -> Option<(String, usize)> {
     let named = name_unnamed_usemtl(text);
-    let spelled = spell_non_finite(named.as_deref().unwrap_or(text));
-    spelled.or(named)
+    let spelled = spell_non_finite(named.as_deref().unwrap_or(text)).or(named);
+    match colour_uncoloured(spelled.as_deref().unwrap_or(text)) {
+        Some((coloured, white)) => Some((coloured, white)),
+        None => spelled.map(|text| (text, 0)),
+    }
+}
+
+/// Whether `line` is a `v` statement of exactly `numbers` words after the `v`.
+fn vertex_of(line: &str, numbers: usize) -> bool {
+    let mut words = line.split_whitespace();
+    words.next() == Some("v") && words.count() == numbers
+}
+
+/// A file whose vertices give colours (`v x y z r g b`, as scans and MeshLab write) on some
+/// `v` lines only: the others (`v x y z`) are given white (`1 1 1`), so their faces show their
+/// material's colour, where tobj refuses the file. `None` when the text has no such mix;
+/// else the text and how many vertices were made white.
+fn colour_uncoloured(text: &str) -> Option<(String, usize)> {
+    let lines = || text.lines().map(str::trim_start);
+    if !lines().any(|l| vertex_of(l, 6)) || !lines().any(|l| vertex_of(l, 3)) {
+        return None;
+    }
+    let white = lines().filter(|l| vertex_of(l, 3)).count();
+    let text = rewrite_lines(text, |line| {
+        vertex_of(line.trim_start(), 3).then(|| format!("{} 1 1 1", line.trim_end()))
+    });
+    Some((text, white))
 }
 
 /// `text` with each line rewritten by `line` (given a line without its line break; `None`
@@ -385,6 +412,12 @@ mod tests {
     #[test]
     fn unnamed_materials_and_old_windows_non_finite_numbers_are_spelled_for_the_readers() {
         let same = "v 1 2 3\nusemtl a\n# usemtl\nf 1 1 1\n";
+        let respell = |text: &str| {
+            respell(text).map(|(text, white)| {
+                assert_eq!(white, 0, "{text:?}");
+                text
+            })
+        };
         assert_eq!(respell(same), None);
         assert_eq!(
             respell("v 0 0 0\r\nusemtl \r\n  usemtl\nf 1 1 1").as_deref(),
@@ -402,6 +435,30 @@ mod tests {
         );
         // Not such a number: left for the reader's error.
         assert_eq!(respell("v 1.#IX 0 0\nv a.#IND 0 0\n"), None);
+    }
+
+    #[test]
+    fn vertices_without_a_colour_among_coloured_ones_are_made_white() {
+        let text = "v 0 0 0\r\nv 0 0 1 0 0 1\n  v 0 1 0 \nv 1 0 0 1 0.6 0.3\nf 1 2 3\n";
+        assert_eq!(
+            respell(text),
+            Some((
+                "v 0 0 0 1 1 1\r\nv 0 0 1 0 0 1\n  v 0 1 0 1 1 1\nv 1 0 0 1 0.6 0.3\nf 1 2 3\n"
+                    .to_string(),
+                2
+            ))
+        );
+        // Every vertex coloured, or none, or a weight `w` (four numbers): as it was.
+        assert_eq!(respell("v 0 0 0 1 0 0\nv 1 0 0 0 1 0\n"), None);
+        assert_eq!(respell("v 0 0 0\nv 1 0 0 1\n"), None);
+        // With an unnamed material too: both.
+        assert_eq!(
+            respell("usemtl\nv 0 0 0\nv 1 0 0 1 0 0\n"),
+            Some((
+                "usemtl (no name)\nv 0 0 0 1 1 1\nv 1 0 0 1 0 0\n".to_string(),
+                1
+            ))
+        );
     }
 
     #[test]
