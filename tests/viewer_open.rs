@@ -444,3 +444,77 @@ fn a_file_opened_before_the_first_frame_is_rendered_at_the_panes_size() {
         "rendered at {w}x{hh}, not at the 1280×800 window's pane"
     );
 }
+
+/// A bare OBJ's first look is framed by the loader for 640×480; shown in a pane narrower than
+/// 4:3 (the settings panel beside it at 1600×1000), a long model lost both ends. Opened in
+/// the viewer it is framed again for the pane, whether the file came in before the pane's size
+/// was known or after: every corner of a bar ten times as long as it is high lies inside the
+/// image.
+#[test]
+fn a_bare_obj_opened_in_a_narrow_pane_is_framed_for_that_pane() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("bar.obj");
+    let corners: Vec<glam::Vec3> = (0..8)
+        .map(|i| {
+            let pick = |bit: usize, lo: f32, hi: f32| if i & bit != 0 { hi } else { lo };
+            glam::Vec3::new(pick(4, -5.0, 5.0), pick(2, 0.0, 1.0), pick(1, -0.5, 0.5))
+        })
+        .collect();
+    let mut obj: String = corners
+        .iter()
+        .map(|p| format!("v {} {} {}\n", p.x, p.y, p.z))
+        .collect();
+    obj.push_str("f 1 2 4 3\nf 5 7 8 6\nf 1 5 6 2\nf 3 4 8 7\nf 1 3 7 5\nf 2 6 8 4\n");
+    std::fs::write(&path, obj).expect("write");
+    for in_before_the_pane in [true, false] {
+        let open = path.clone();
+        let gate = Gate::new((!in_before_the_pane).then_some(OpenStage::Parse));
+        let hook_gate = gate.clone();
+        let mut h = window_with(small_default(), [900.0, 1000.0], move |app| {
+            app.set_view(4, true);
+            hook_gate.install(app);
+            app.command(Command::OpenFile(open.clone()));
+            app.apply();
+            if in_before_the_pane {
+                // In before the window's first frame.
+                frames_until(app, "the open did not finish", |a| {
+                    a.scene().source.as_deref() == Some(open.as_path())
+                });
+            }
+        });
+        let what = if in_before_the_pane {
+            "in before the pane"
+        } else {
+            "in after the pane"
+        };
+        steps_until(&mut h, "the render did not take the pane's size", |a| {
+            let pane = a.render.pane_seen(&a.workspace.prefs);
+            pane.is_some() && pane == Some(a.render_size())
+        });
+        gate.hold_at(None);
+        steps_until(&mut h, "the open did not finish", |a| {
+            a.files.opening().is_none() && a.scene().source.as_deref() == Some(path.as_path())
+        });
+        let (w, hh) = h.state().render_size();
+        let aspect = w as f32 / hh as f32;
+        assert!(
+            aspect < 1.2,
+            "{what}: the pane is {w}x{hh}, not narrower than 4:3"
+        );
+        let camera = h.state().scene().camera.clone();
+        let forward = (camera.look_at - camera.position).normalize();
+        let right = forward.cross(camera.up).normalize();
+        let up = right.cross(forward);
+        let tan_v = (0.5 * camera.fov_y_deg).to_radians().tan();
+        for p in &corners {
+            let d = *p - camera.position;
+            let (x, y, z) = (d.dot(right), d.dot(up), d.dot(forward));
+            assert!(
+                z > 0.0 && (x / z).abs() <= tan_v * aspect && (y / z).abs() <= tan_v,
+                "{what}: corner {p} lies outside the {w}x{hh} image (camera {camera:?})"
+            );
+        }
+        // The working scene, the one a save writes and Home returns to, has that camera too.
+        assert_eq!(h.state().working.scene.camera, camera, "{what}");
+    }
+}

@@ -126,6 +126,9 @@ pub struct ViewerApp {
     /// The lesson under way and its panel.
     pub lesson: lesson_panel::LessonState,
     pending: Vec<Command>,
+    /// A scene just opened whose first look is still to be framed for the render pane, once
+    /// the pane's size is known ([`Self::frame_bare_obj_for`]).
+    frame_on_pane: bool,
 }
 
 impl ViewerApp {
@@ -175,6 +178,7 @@ impl ViewerApp {
             workspace,
             lesson: Default::default(),
             pending: Vec::new(),
+            frame_on_pane: true,
         };
         // A built-in scene without notes needs no word at start; a file gets its summary.
         let scene = app.render.scene();
@@ -268,6 +272,11 @@ impl ViewerApp {
             .set_threads(self.working.settings.threads)
         {
             self.messages.error(e);
+        }
+        if let Some(pane) = self.render.pane(&self.workspace.prefs)
+            && std::mem::take(&mut self.frame_on_pane)
+        {
+            self.frame_bare_obj_for(pane);
         }
         let edit = &mut self.working.scene;
         // An edit is held to the loader's rules; a bad one is refused and the scene stays.
