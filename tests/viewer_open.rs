@@ -466,31 +466,36 @@ fn a_bare_obj_opened_in_a_narrow_pane_is_framed_for_that_pane() {
         .collect();
     obj.push_str("f 1 2 4 3\nf 5 7 8 6\nf 1 5 6 2\nf 3 4 8 7\nf 1 3 7 5\nf 2 6 8 4\n");
     std::fs::write(&path, obj).expect("write");
-    for in_before_the_pane in [true, false] {
+    // The file in before the window's first frame; begun then but in after the pane's size
+    // was taken; begun once the pane's size is known (the Scene menu's open).
+    for what in [
+        "in before the pane",
+        "in after the pane",
+        "opened in the pane",
+    ] {
         let open = path.clone();
-        let gate = Gate::new((!in_before_the_pane).then_some(OpenStage::Parse));
+        let gate = Gate::new((what == "in after the pane").then_some(OpenStage::Parse));
         let hook_gate = gate.clone();
         let mut h = window_with(small_default(), [900.0, 1000.0], move |app| {
             app.set_view(4, true);
             hook_gate.install(app);
-            app.command(Command::OpenFile(open.clone()));
-            app.apply();
-            if in_before_the_pane {
-                // In before the window's first frame.
+            if what != "opened in the pane" {
+                app.command(Command::OpenFile(open.clone()));
+                app.apply();
+            }
+            if what == "in before the pane" {
                 frames_until(app, "the open did not finish", |a| {
                     a.scene().source.as_deref() == Some(open.as_path())
                 });
             }
         });
-        let what = if in_before_the_pane {
-            "in before the pane"
-        } else {
-            "in after the pane"
-        };
         steps_until(&mut h, "the render did not take the pane's size", |a| {
             let pane = a.render.pane_seen(&a.workspace.prefs);
             pane.is_some() && pane == Some(a.render_size())
         });
+        if what == "opened in the pane" {
+            h.state_mut().command(Command::OpenFile(path.clone()));
+        }
         gate.hold_at(None);
         steps_until(&mut h, "the open did not finish", |a| {
             a.files.opening().is_none() && a.scene().source.as_deref() == Some(path.as_path())

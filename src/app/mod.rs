@@ -127,7 +127,7 @@ pub struct ViewerApp {
     pub lesson: lesson_panel::LessonState,
     pending: Vec<Command>,
     /// A scene just opened whose first look is still to be framed for the render pane, once
-    /// the pane's size is known ([`Self::frame_bare_obj_for`]).
+    /// the pane's size is known ([`opening::frame_for_pane`]).
     frame_on_pane: bool,
 }
 
@@ -276,7 +276,7 @@ impl ViewerApp {
         if let Some(pane) = self.render.pane(&self.workspace.prefs)
             && std::mem::take(&mut self.frame_on_pane)
         {
-            self.frame_bare_obj_for(pane);
+            opening::frame_for_pane(&mut self.working.scene, pane);
         }
         let edit = &mut self.working.scene;
         // An edit is held to the loader's rules; a bad one is refused and the scene stays.

@@ -91,34 +91,17 @@ impl ViewerApp {
         self.files.watch(&self.working.scene, &mut self.messages);
         self.render.pending_build = None;
         self.start_generation(tracer, Reach::RenderAndSceneView);
-        // The open was fitted to the pane as it was when it began: none yet for a file named
-        // on the command line (opened before the window's first frame), or another one if the
-        // window was resized while the file loaded. At the pane's size as it is now.
-        // A bare OBJ's first look is framed for the pane: now if its size is known, else once
-        // it is (the restart the pane's first size starts).
+        // The open was fitted and framed for the pane as it was when it began: none yet for a
+        // file named on the command line (opened before the window's first frame), or another
+        // one if the window was resized while the file loaded. For the pane as it is now, or
+        // once its size is known (the restart the pane's first size starts).
         let pane = self.render.pane(&self.workspace.prefs);
-        self.frame_on_pane = pane.is_none();
-        if let Some(size) = pane
-            && (self.frame_bare_obj_for(size)
-                || opening::fit_render(self.render.scene_size, pane, self.render.max_side).render
-                    != self.render.size())
-        {
+        let fitted = opening::fit_render(self.render.scene_size, pane, self.render.max_side);
+        let for_another = fitted.render != self.render.size();
+        self.frame_on_pane = pane.is_none() || for_another;
+        if pane.is_some() && for_another {
             self.restart(false, Reach::RenderAndSceneView);
         }
-    }
-
-    /// A bare OBJ's first look, framed by the loader for the scene's 640×480, framed again for
-    /// the `pane` it is shown in (its sides were cut off in a pane narrower than 4:3, as the
-    /// settings panel leaves one at 1600×1000); true when the camera moved. A room's camera,
-    /// or a scene that is no bare OBJ, stays.
-    pub(super) fn frame_bare_obj_for(&mut self, pane: (u32, u32)) -> bool {
-        let scene = &mut self.working.scene;
-        let size = (scene.render.width, scene.render.height);
-        let before = scene.camera.clone();
-        (scene.render.width, scene.render.height) = pane;
-        crate::scene::first_look::refit_bare_obj(scene);
-        (scene.render.width, scene.render.height) = size;
-        scene.camera != before
     }
 
     /// Makes `s` the working copy, named `label`: nothing of the old scene stays picked, the

@@ -161,6 +161,17 @@ pub struct Fit {
     pub message: Option<String>,
 }
 
+/// A bare OBJ's first look, framed by the loader for the scene's own size (640×480), framed
+/// again for the render `pane` it is shown in: in a pane narrower than 4:3 (the settings panel
+/// beside it at 1600×1000) a long model lost both ends. A room's camera, or a scene that is no
+/// bare OBJ, stays ([`crate::scene::first_look::refit_bare_obj`]).
+pub fn frame_for_pane(scene: &mut Scene, pane: (u32, u32)) {
+    let size = (scene.render.width, scene.render.height);
+    (scene.render.width, scene.render.height) = pane;
+    crate::scene::first_look::refit_bare_obj(scene);
+    (scene.render.width, scene.render.height) = size;
+}
+
 /// The one rule for the render size: the pane's pixels (`pane`, when the render follows it)
 /// or the scene's size, scaled down to fit the GPU and the memory budget (a shrunk scene
 /// size says so; `raytree render` renders the full size).
@@ -415,8 +426,10 @@ fn run(request: &Request, cancel: &AtomicBool, progress: &OpenProgress) -> Optio
     let kept = request.reload.as_ref().filter(|(shown, _)| {
         edit.triangles == shown.scene.triangles && edit.spheres == shown.scene.spheres
     });
-    if let Some((_, camera)) = kept {
-        edit.camera = camera.clone();
+    match (kept, request.pane) {
+        (Some((_, camera)), _) => edit.camera = camera.clone(),
+        (None, Some(pane)) => frame_for_pane(&mut edit, pane),
+        (None, None) => {}
     }
     edit.place_lights();
     let fit = fit_render(

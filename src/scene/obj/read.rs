@@ -40,10 +40,7 @@ pub(super) const UNNAMED_MATERIAL: &str = "(no name)";
 pub(super) fn respell(text: &str) -> Option<(String, usize)> {
     let named = name_unnamed_usemtl(text);
     let spelled = spell_non_finite(named.as_deref().unwrap_or(text)).or(named);
-    match colour_uncoloured(spelled.as_deref().unwrap_or(text)) {
-        Some((coloured, white)) => Some((coloured, white)),
-        None => spelled.map(|text| (text, 0)),
-    }
+    colour_uncoloured(spelled.as_deref().unwrap_or(text)).or_else(|| spelled.map(|t| (t, 0)))
 }
 
 /// Whether `line` is a `v` statement of exactly `numbers` words after the `v`.
