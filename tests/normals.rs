@@ -420,6 +420,105 @@ fn map_kd_multiplies_kd_and_the_tree_shows_uv_and_texel() {
 }
 
 #[test]
+fn an_obj_that_names_no_material_takes_the_texture_named_for_it() {
+    // Model packs (tinyrenderer's heads, raylib's buildings) ship `<name>_diffuse.<ext>` beside
+    // an OBJ with texture coordinates and no material library. An image named for the OBJ
+    // without `_diffuse` (a render saved beside it) is not taken.
+    let dir = tempfile::tempdir().expect("temp dir");
+    std::fs::write(dir.path().join("tri.obj"), TRI).expect("obj");
+    std::fs::write(
+        dir.path().join("tri_diffuse.PNG"),
+        png_bytes(1, 1, &[255, 0, 0]),
+    )
+    .expect("png");
+    std::fs::write(dir.path().join("tri.png"), png_bytes(1, 1, &[0, 0, 255])).expect("png");
+    let scene_file = dir.path().join("s.toml");
+    std::fs::write(
+        &scene_file,
+        format!("{CAMERA}[[mesh]]\nfile = \"tri.obj\"\n"),
+    )
+    .expect("toml");
+    // Found whatever the case of its name, as every file a model names is.
+    let note = "tri.obj: no material library gives its faces a material; `tri_diffuse.png` beside it, named for it, is taken as their texture.";
+    // Through a scene file and opened bare: the same texture, red at the centre pixel.
+    for file in [scene_file.clone(), dir.path().join("tri.obj")] {
+        let scene = load_scene_file(&file).unwrap_or_else(|e| panic!("{e}"));
+        assert!(
+            scene.warnings.len() == 1 && scene.warnings[0].ends_with(note),
+            "{}: {:?}",
+            file.display(),
+            scene.warnings
+        );
+        assert_eq!(scene.textures.len(), 1);
+        let (width, height) = (scene.render.width, scene.render.height);
+        let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());
+        let tree = pixel_tree(&tracer, width / 2, height / 2).expect("centre pixel");
+        let hit = tree.root.hit.as_ref().expect("hit");
+        assert_eq!(hit.texel, Some(Vec3::X), "{}", file.display());
+        let local = tree.root.local.expect("shaded");
+        assert!(
+            local.diffuse.x > 0.0 && local.diffuse.y == 0.0 && local.diffuse.z == 0.0,
+            "{local:?}"
+        );
+        assert!(
+            local.ambient.y == 0.0 && local.ambient.z == 0.0,
+            "{local:?}"
+        );
+    }
+    // Faces without texture coordinates, or with a material of their own, keep theirs; an
+    // image of that name that cannot be read is one sentence, and the default grey stays.
+    std::fs::write(dir.path().join("m.mtl"), "newmtl a\nKd 0 1 0\n").expect("mtl");
+    let red = png_bytes(1, 1, &[255, 0, 0]);
+    for (name, obj, material, warning) in [
+        (
+            "flat",
+            "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n",
+            "default",
+            None,
+        ),
+        (
+            "own",
+            &*format!("mtllib m.mtl\nusemtl a\n{TRI}"),
+            "own/a",
+            None,
+        ),
+        (
+            "bad",
+            TRI,
+            "default",
+            Some(
+                "bad.obj: cannot use `bad_diffuse.png`, the texture named for it, on its faces without a material (",
+            ),
+        ),
+    ] {
+        std::fs::write(dir.path().join(format!("{name}.obj")), obj).expect("obj");
+        let image: &[u8] = if name == "bad" { b"not an image" } else { &red };
+        std::fs::write(dir.path().join(format!("{name}_diffuse.png")), image).expect("image");
+        let scene = load_scene_file(&dir.path().join(format!("{name}.obj")))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(scene.textures.is_empty(), "{name}: {:?}", scene.warnings);
+        let used = scene.material(scene.triangles[0].material);
+        assert_eq!(used.name, material, "{name}");
+        assert!(used.diffuse_map.is_none(), "{name}");
+        match warning {
+            Some(w) => assert!(
+                scene
+                    .warnings
+                    .iter()
+                    .any(|x| x.contains(w) && x.ends_with("they keep the default grey.")),
+                "{name}: {:?}",
+                scene.warnings
+            ),
+            None => assert!(
+                !scene.warnings.iter().any(|x| x.contains("diffuse")),
+                "{name}: {:?}",
+                scene.warnings
+            ),
+        }
+    }
+}
+
+#[test]
 fn map_kd_scale_and_offset_move_the_texture_on_the_texture_coordinates() {
     // The centre pixel meets TRI at (0, 0): barycentric (¼, ¼, ½), so uv = (0.25, 0.5). The
     // texture is two texels, red | blue, whose centres lie at u = 0.25 and 0.75; `-s` and `-o`

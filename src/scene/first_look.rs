@@ -69,7 +69,7 @@ pub(crate) fn load_obj_scene(
         .count();
     let mut washed = Vec::new();
     for m in &mut scene.materials {
-        if m.ambient == Vec3::ONE && m.name.starts_with(&prefix) {
+        if m.ambient == Vec3::ONE && m.diffuse != Vec3::ONE && m.name.starts_with(&prefix) {
             m.ambient = m.diffuse;
             washed.push(format!("`{}`", short(&m.name[prefix.len()..])));
         }

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use glam::Vec2;
 
-use super::paths::sibling;
+use super::paths::{file_stem, sibling};
 use super::read::quietly;
 use super::request::MeshRequest;
 use crate::scene::budget::{MemoryLimit, memory_limit};
@@ -147,6 +147,21 @@ pub(super) fn load_texture(
         return fail(first_reason.unwrap_or_default(), warnings);
     };
     let path = &paths[i];
+    match add_texture(scene, path, &bytes) {
+        Ok(id) => {
+            if i > 0 {
+                elsewhere.push((file.to_string(), tails[i].clone()));
+            }
+            Some(id)
+        }
+        Err(reason) => fail(reason, warnings),
+    }
+}
+
+/// The image `bytes` read from `path` decoded into the scene's textures within what the memory
+/// budget has left, or the reason it cannot be. One file named two ways (`Tex\Wood.png`,
+/// `tex/wood.PNG`) or two copies of one image are one texture.
+fn add_texture(scene: &mut Scene, path: &str, bytes: &[u8]) -> Result<TextureId, String> {
     let limit = memory_limit();
     let used: u64 = scene
         .textures
@@ -157,26 +172,54 @@ pub(super) fn load_texture(
         bytes: limit.bytes.saturating_sub(used),
         source: limit.source,
     };
-    let decoded = quietly(|| decode_texture(path, &bytes, &left))
-        .unwrap_or_else(|()| Err("the image reader failed on it".into()));
-    match decoded {
-        Ok(texture) => {
-            if i > 0 {
-                elsewhere.push((file.to_string(), tails[i].clone()));
-            }
-            // One file named two ways (`Tex\Wood.png`, `tex/wood.PNG`) or two copies of one
-            // image: one texture.
-            let same = scene.textures.iter().position(|t| {
-                (t.width, t.height) == (texture.width, texture.height) && t.texels == texture.texels
-            });
-            if let Some(t) = same {
-                return Some(TextureId(t as u32));
-            }
-            scene.textures.push(Arc::new(texture));
-            Some(TextureId(scene.textures.len() as u32 - 1))
-        }
-        Err(reason) => fail(reason, warnings),
+    let texture = quietly(|| decode_texture(path, bytes, &left))
+        .unwrap_or_else(|()| Err("the image reader failed on it".into()))?;
+    let same = scene.textures.iter().position(|t| {
+        (t.width, t.height) == (texture.width, texture.height) && t.texels == texture.texels
+    });
+    if let Some(t) = same {
+        return Ok(TextureId(t as u32));
     }
+    scene.textures.push(Arc::new(texture));
+    Ok(TextureId(scene.textures.len() as u32 - 1))
+}
+
+/// The extensions tried for a texture named for its OBJ ([`named_diffuse`]).
+const NAMED_DIFFUSE_EXTENSIONS: &[&str] = &["png", "tga", "jpg", "jpeg", "bmp"];
+
+/// The diffuse texture a model pack ships beside an OBJ that names no material, named for the
+/// OBJ: `<stem>_diffuse.<ext>` (tinyrenderer's `african_head_diffuse.tga`, raylib's
+/// `castle_diffuse.png`), `ext` one of [`NAMED_DIFFUSE_EXTENSIONS`] (the resolver finds a file
+/// whatever the case of its name, `.TGA` for `.tga`). Its id and
+/// file name, or `None` when there is none; one found that cannot be used is a warning.
+pub(super) fn named_diffuse(
+    scene: &mut Scene,
+    req: &MeshRequest,
+    warnings: &mut Vec<String>,
+) -> Option<(TextureId, String)> {
+    let stem = file_stem(req.key)?;
+    for e in NAMED_DIFFUSE_EXTENSIONS {
+        let name = format!("{stem}_diffuse.{e}");
+        let path = sibling(req.key, &name);
+        if let Some(t) = scene.textures.iter().position(|t| t.name == path) {
+            return Some((TextureId(t as u32), name));
+        }
+        let Ok(bytes) = (req.resolve_bytes)(&path) else {
+            continue;
+        };
+        return match add_texture(scene, &path, &bytes) {
+            Ok(id) => Some((id, name)),
+            Err(reason) => {
+                warnings.push(format!(
+                    "{}: cannot use `{}`, the texture named for it, on its faces without a material ({reason}); they keep the default grey.",
+                    req.label,
+                    short_path(&name)
+                ));
+                None
+            }
+        };
+    }
+    None
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@ use super::attributes::{Corners, finish_attributes};
 use super::corners::{self, FaceCorners};
 use super::faces::{Faces, Given, PLACED, dropped, keep_placed, wind_as_normals};
 use super::memory::check_memory;
-use super::mtl::{Libraries, mtl_material, warn_unknown_usemtl};
+use super::mtl::{Libraries, mtl_material, named_material, warn_unknown_usemtl};
 use super::parse::Facts;
 use super::read::{ObjProblem, join_continued_lines, read_models, respell, scan};
 use super::request::MeshRequest;
@@ -208,6 +208,9 @@ struct MeshBuild<'a> {
     mtl_materials: &'a [tobj::Material],
     /// The scene material of each MTL material, made when first used.
     mtl_ids: Vec<Option<MaterialId>>,
+    /// The material of textured faces without one, once looked for: the texture named for the
+    /// OBJ ([`named_material`]), if there is one.
+    named: Option<Option<MaterialId>>,
     linear: Mat3,
     /// Normals go through the inverse transpose, which keeps them perpendicular to the placed
     /// surface (and on its outside when a mirroring scale swaps the corners).
@@ -259,6 +262,7 @@ impl<'a> MeshBuild<'a> {
             req,
             mtl_materials,
             mtl_ids: vec![None; mtl_materials.len()],
+            named: None,
             linear,
             normal_matrix: linear.inverse().transpose(),
             mirrors: req.placement.mirrors(),
@@ -408,8 +412,8 @@ impl<'a> MeshBuild<'a> {
         )
     }
 
-    /// The material of a model's faces: the override, its MTL material (made on first use), or
-    /// the scene's default.
+    /// The material of a model's faces: the override, its MTL material (made on first use), the
+    /// texture named for the OBJ when they have texture coordinates, or the scene's default.
     fn material(
         &mut self,
         scene: &mut Scene,
@@ -430,6 +434,13 @@ impl<'a> MeshBuild<'a> {
                         &mut self.textures_elsewhere,
                     )
                 })
+            }
+            (None, _) if !mesh.texcoords.is_empty() => {
+                let (req, warnings) = (self.req, &mut self.warnings);
+                let named = self
+                    .named
+                    .get_or_insert_with(|| named_material(scene, req, warnings));
+                named.unwrap_or_else(|| scene.default_material())
             }
             (None, _) => scene.default_material(),
         }

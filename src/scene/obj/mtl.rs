@@ -8,7 +8,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use super::maps::{candidates, load_texture, texture_statement};
+use super::maps::{candidates, load_texture, named_diffuse, texture_statement};
 use super::parse::Facts;
 use super::paths::sibling;
 use super::read::UNNAMED_MATERIAL;
@@ -290,6 +290,40 @@ pub(super) fn mtl_material(
         material.ambient_map_placement = placement(&m.ambient_texture);
     }
     id
+}
+
+/// The material of an OBJ's textured faces that no material library gives one, when a texture
+/// named for the OBJ lies beside it ([`named_diffuse`]): `<object>/<texture file>`, white under
+/// the texture for both the diffuse and the ambient term (a `[[material]]` of that name sets
+/// its colours, as for an MTL material), with a note saying where the texture came from.
+pub(super) fn named_material(
+    scene: &mut Scene,
+    req: &MeshRequest,
+    warnings: &mut Vec<String>,
+) -> Option<MaterialId> {
+    let (texture, file) = named_diffuse(scene, req, warnings)?;
+    let name = format!("{}/{file}", req.object_name);
+    let i = match scene.materials.iter().position(|m| m.name == name) {
+        Some(i) => i,
+        None => {
+            scene.materials.push(Material {
+                name,
+                ambient: Vec3::ONE,
+                diffuse: Vec3::ONE,
+                ..Material::default()
+            });
+            scene.materials.len() - 1
+        }
+    };
+    let material = &mut scene.materials[i];
+    material.diffuse_map = Some(texture);
+    material.ambient_map = Some(texture);
+    warnings.push(format!(
+        "{}: no material library gives its faces a material; `{}` beside it, named for it, is taken as their texture.",
+        req.label,
+        short_path(&file)
+    ));
+    Some(MaterialId(i as u32))
 }
 
 /// Maps an MTL material to the Phong material: Ka→ambient, Kd→diffuse, Ks→specular,
