@@ -1025,3 +1025,71 @@ fn a_pipe_is_seen_from_outside_not_from_inside_its_hole() {
     let scene = load(dir.path(), "hall.obj", &hall);
     assert_warned(&scene, "hall.obj", &["(a room)"]);
 }
+
+#[test]
+fn a_shell_open_below_is_seen_from_outside_and_a_tray_from_above_with_z_up() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    // A toy brick: walls and a top around a hollow, open at the bottom. From inside its walls
+    // face the middle as a room's do, but nothing is underfoot.
+    let mut brick = String::new();
+    let mut base = 0;
+    let (lo, hi) = (Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 1.2, 1.0));
+    cuboid(&mut brick, &mut base, lo, hi, false, &[2]);
+    let hollow = (Vec3::new(-0.9, 0.0, -0.9), Vec3::new(0.9, 1.1, 0.9));
+    cuboid(&mut brick, &mut base, hollow.0, hollow.1, true, &[2]);
+    let scene = load(dir.path(), "brick.obj", &brick);
+    let p = scene.camera.position;
+    assert!(
+        !inside(p, &scene),
+        "brick: the camera stands inside, at {p}"
+    );
+    assert_not_warned(&scene, "brick.obj", "(a room)");
+    let c = covered(&scene);
+    assert!(c > 0.05 && c < 0.9, "brick: it covers {c} of the image");
+    // With a floor under the same walls it is a room, seen from inside.
+    let mut room = brick.clone();
+    cuboid(
+        &mut room,
+        &mut base,
+        Vec3::new(-0.9, 0.0, -0.9),
+        Vec3::new(0.9, 0.02, 0.9),
+        false,
+        &[],
+    );
+    let scene = load(dir.path(), "floored.obj", &room);
+    assert!(inside(scene.camera.position, &scene), "floored: outside");
+    assert_warned(&scene, "floored.obj", &["(a room)"]);
+
+    // A tray written z-up (robotics and CAD files are): a base, walls 0.7 high around it, and
+    // a shelf over a fifth of it. Open above once z is up, as the shelf aside most of the sky
+    // from inside is: seen from above, outside, z up.
+    let mut tray = String::new();
+    let mut base = 0;
+    let mut part = |lo: [f32; 3], hi: [f32; 3]| {
+        cuboid(
+            &mut tray,
+            &mut base,
+            Vec3::from(lo),
+            Vec3::from(hi),
+            false,
+            &[],
+        );
+    };
+    part([-1.0, -1.0, 0.0], [1.0, 1.0, 0.02]);
+    part([-1.0, -1.0, 0.0], [-0.95, 1.0, 0.7]);
+    part([0.95, -1.0, 0.0], [1.0, 1.0, 0.7]);
+    part([-1.0, -1.0, 0.0], [1.0, -0.95, 0.7]);
+    part([-1.0, 0.95, 0.0], [1.0, 1.0, 0.7]);
+    part([-1.0, -1.0, 0.68], [-0.4, 1.0, 0.7]);
+    let scene = load(dir.path(), "tray.obj", &tray);
+    assert_eq!(scene.camera.up, Vec3::Z, "tray: {:?}", scene.warnings);
+    let (p, (_, hi)) = (scene.camera.position, scene.bounds().expect("bounds"));
+    assert!(!inside(p, &scene) && p.z > hi.z, "tray: camera at {p}");
+    assert!(forward(&scene).z < -0.3, "tray: looks down into it");
+    assert_warned(
+        &scene,
+        "tray.obj",
+        &["open towards +z (a tray, a box without a lid): +z is taken as up"],
+    );
+    assert_not_warned(&scene, "tray.obj", "(a room)");
+}

@@ -129,6 +129,7 @@ pub(crate) fn load_obj_scene(
     // A room is wider and longer than it is high. Seen y-up, a room whose z extent is clearly
     // its lowest (below `ROOM_Z_UP` of its y extent) was written z-up (3ds Max, SketchUp's
     // z-up exports, CAD): it is looked at again with +z up, and taken so if it is a room then.
+    // So is a tray or a box without a lid, open above once z is up.
     let extent = hi - lo;
     if up == Vec3::Y
         && look.room.is_some()
@@ -136,11 +137,18 @@ pub(crate) fn load_obj_scene(
         && extent.z < ROOM_Z_UP * extent.x
     {
         let z_up = first_view(&scene.triangles, lo, hi, Vec3::Z, aspect);
-        if z_up.room.is_some() {
+        let what = match (z_up.room.is_some(), z_up.open_above) {
+            (true, _) => Some("the room is lower in z than it is wide and deep (in x and y)"),
+            (false, true) => Some(
+                "the model is lower in z than it is wide and deep (in x and y), with walls around its middle open towards +z (a tray, a box without a lid)",
+            ),
+            (false, false) => None,
+        };
+        if let Some(what) = what {
             (up, look) = (Vec3::Z, z_up);
-            scene.warnings.push(format!(
-                "{label}: the room is lower in z than it is wide and deep (in x and y): +z is taken as up."
-            ));
+            scene
+                .warnings
+                .push(format!("{label}: {what}: +z is taken as up."));
         }
     }
     let camera = look.camera;
@@ -298,6 +306,8 @@ fn up_axis(triangles: &[Triangle], lo: Vec3, hi: Vec3) -> Vec3 {
 struct FirstView {
     camera: Camera,
     room: Option<Room>,
+    /// Walls around the middle without a ceiling (a stage set, a tray), seen from above.
+    open_above: bool,
 }
 
 #[derive(Clone, Copy)]
@@ -401,26 +411,34 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
         }
     }
     let probes = probe_points(triangles, &curve, &points, &dirs, (lo, hi));
-    if !probes.iter().any(|p| p.in_room()) || through_tube(triangles, &curve, center, (lo, hi)) {
+    let inside: Vec<(Vec3, &Probe)> = points
+        .iter()
+        .zip(&probes)
+        .filter(|(_, p)| p.in_room())
+        .map(|(&point, p)| (point, p))
+        .collect();
+    let outside = || {
         let (front, elevation) = flat_front(triangles, half, up, front);
-        return FirstView {
+        FirstView {
             camera: frame_outside(triangles, center, up, front, elevation, aspect),
             room: None,
-        };
+            open_above: false,
+        }
+    };
+    if inside.is_empty() || through_tube(triangles, &curve, center, (lo, hi)) {
+        return outside();
     }
-    // Open above (walls without a ceiling, a stage set): seen from outside and higher up, so
-    // the key light above shines in and the inside shows.
+    // Open above (walls without a ceiling, a stage set, a tray): most rays upwards from the
+    // points inside meet nothing, a cover over part of it (a shelf, a lid half on)
+    // notwithstanding. Seen from outside and higher up, so the key light above shines in and
+    // the inside shows.
     let skyward = dirs.iter().filter(|d| d.dot(up) > 0.5).count();
-    let sky = probes
-        .iter()
-        .filter(|p| p.in_room())
-        .map(|p| p.open_up(&dirs, up))
-        .min()
-        .unwrap_or(0);
-    if 2 * sky > skyward {
+    let sky: usize = inside.iter().map(|(_, p)| p.open_up(&dirs, up)).sum();
+    if 2 * sky > skyward * inside.len() {
         return FirstView {
             camera: frame_outside(triangles, center, up, front, 0.8, aspect),
             room: None,
+            open_above: true,
         };
     }
     // Which wall the camera stands at: the most open one if a wall has an opening, else the
@@ -464,38 +482,51 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
         .find(|(_, p)| p.free())
         .map(|(l, _)| *l)
         .unwrap_or(center);
-    if let Some((wall, (fraction, door))) = open_wall {
-        if fraction >= OPEN_SIDE {
-            // Open on one side (a Cornell box, a stage set): seen through the opening, level,
-            // the whole room in view, as the Cornell box's own camera does.
+    if let Some((wall, (fraction, _))) = open_wall
+        && fraction >= OPEN_SIDE
+    {
+        // Open on one side (a Cornell box, a stage set): seen through the opening, level,
+        // the whole room in view, as the Cornell box's own camera does.
+        return FirstView {
+            camera: frame_outside(triangles, center, up, wall, 0.0, aspect),
+            room: Some(Room {
+                light,
+                entry: Entry::OpenSide,
+            }),
+            open_above: false,
+        };
+    }
+    // The camera would stand inside. A room stands on a floor: straight down from most of the
+    // points inside it, the ray meets something. A shell open below (a toy brick, a bell, a
+    // cup upside down) is a thing, seen from outside.
+    let down: Vec<(Vec3, Vec3)> = inside.iter().map(|&(point, _)| (point, -up)).collect();
+    let floored = nearest(triangles, &curve, &down)
+        .iter()
+        .filter(|(t, _)| t.is_finite())
+        .count();
+    if 2 * floored < inside.len() {
+        return outside();
+    }
+    // A door or a hole in part of the wall: framing the box from outside would show mostly the
+    // wall beside it, so the camera stands in the opening, looking at the middle of the room,
+    // if nothing stands right in front of it.
+    if let Some((_, (_, Some(door)))) = open_wall {
+        let toward = (center - door).normalize_or_zero();
+        let sight = nearest(triangles, &curve, &[(door, toward)])[0].0;
+        if toward != Vec3::ZERO && sight >= 0.5 * door.distance(center) {
             return FirstView {
-                camera: frame_outside(triangles, center, up, wall, 0.0, aspect),
+                camera: Camera {
+                    position: door,
+                    look_at: center,
+                    up,
+                    fov_y_deg: 60.0,
+                },
                 room: Some(Room {
                     light,
-                    entry: Entry::OpenSide,
+                    entry: Entry::Doorway,
                 }),
+                open_above: false,
             };
-        }
-        // A door or a hole in part of the wall: framing the box from outside would show
-        // mostly the wall beside it, so the camera stands in the opening, looking at the
-        // middle of the room, if nothing stands right in front of it.
-        if let Some(door) = door {
-            let toward = (center - door).normalize_or_zero();
-            let sight = nearest(triangles, &curve, &[(door, toward)])[0].0;
-            if toward != Vec3::ZERO && sight >= 0.5 * door.distance(center) {
-                return FirstView {
-                    camera: Camera {
-                        position: door,
-                        look_at: center,
-                        up,
-                        fov_y_deg: 60.0,
-                    },
-                    room: Some(Room {
-                        light,
-                        entry: Entry::Doorway,
-                    }),
-                };
-            }
         }
     }
     let views: Vec<(Vec3, Vec3)> = candidates.clone();
@@ -525,6 +556,7 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
             light,
             entry: Entry::Inside,
         }),
+        open_above: false,
     }
 }
 
