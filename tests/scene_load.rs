@@ -780,7 +780,7 @@ fn textures_named_by_another_machine_are_found_next_to_the_obj() {
         .collect();
     assert_eq!(noted.len(), 1, "{:?}", scene.warnings);
     assert!(
-        noted[0].contains("3 textures are not where the material library says but next to the OBJ: `C:\\Users\\me\\Desktop\\house\\tex\\wood.PNG` as `tex/wood.PNG` and 2 more"),
+        noted[0].contains("3 textures are not where the material library says but found from the OBJ's folder: `C:\\Users\\me\\Desktop\\house\\tex\\wood.PNG` as `tex/wood.PNG` and 2 more"),
         "{}",
         noted[0]
     );
@@ -862,7 +862,7 @@ fn a_material_library_named_by_another_machine_is_found_next_to_the_obj() {
     );
     assert!(
         scene.warnings.iter().any(|w| w.contains(
-            "the material library `C:\\Users\\me\\Desktop\\house\\House.MTL` is not where the OBJ says but next to it, as `House.MTL`"
+            "the material library `C:\\Users\\me\\Desktop\\house\\House.MTL` is not where the OBJ says but found from its folder as `House.MTL`"
         )),
         "{:?}",
         scene.warnings
@@ -880,6 +880,54 @@ fn a_material_library_named_by_another_machine_is_found_next_to_the_obj() {
             && w.contains("No such file")),
         "{:?}",
         lost.warnings
+    );
+}
+
+/// A model pack keeps its textures in a folder beside the models' (bullet3's `data/toys/` names
+/// `E:\develop\bullet3\data\table\table.png`, the file being `data/table/table.png`): a tail
+/// of the path that keeps its folder is found one or two folders up; a bare file name is not
+/// looked for there.
+#[test]
+fn a_texture_in_a_folder_beside_the_models_is_found_by_its_folder() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let checker = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models/checker.png");
+    for folder in ["data/table", "data/toys/box", "elsewhere"] {
+        std::fs::create_dir_all(dir.path().join(folder)).expect("folder");
+    }
+    std::fs::copy(&checker, dir.path().join("data/table/table.png")).expect("copy");
+    std::fs::copy(&checker, dir.path().join("data/stray.png")).expect("copy");
+    std::fs::write(
+        dir.path().join("data/toys/box/sorter.mtl"),
+        "newmtl a\nmap_Kd E:\\develop\\bullet3\\data\\table\\table.png\n\
+         newmtl b\nmap_Kd C:\\stray.png\n",
+    )
+    .expect("write");
+    let mut obj = String::from("mtllib sorter.mtl\nvt 0 0\nvt 1 0\nvt 0 1\n");
+    for (i, m) in ["a", "b"].iter().enumerate() {
+        let x = 2.0 * i as f32;
+        obj += &format!(
+            "usemtl {m}\nv {x} 0 0\nv {} 0 0\nv {x} 1 0\nf {}/1 {}/2 {}/3\n",
+            x + 1.0,
+            3 * i + 1,
+            3 * i + 2,
+            3 * i + 3
+        );
+    }
+    let path = dir.path().join("data/toys/box/sorter.obj");
+    std::fs::write(&path, obj).expect("write");
+    let scene = load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        material(&scene, "sorter/a").diffuse_map.is_some(),
+        "{:?}",
+        scene.warnings
+    );
+    assert!(material(&scene, "sorter/b").diffuse_map.is_none());
+    assert!(
+        scene.warnings.iter().any(|w| w.contains(
+            "a texture is not where the material library says but found from the OBJ's folder: `E:\\develop\\bullet3\\data\\table\\table.png` as `../../table/table.png`"
+        )),
+        "{:?}",
+        scene.warnings
     );
 }
 

@@ -1,5 +1,5 @@
 //! Image textures for MTL `map_Kd` and `map_Ka` (docs/design.md, "Scene files"): PNG, JPEG,
-//! TGA, BMP and TIFF (the formats real models' MTL files name) through the `image` crate,
+//! TGA, BMP, TIFF and GIF (the formats real models' MTL files name) through the `image` crate,
 //! decoded once from sRGB to linear RGB, checked against the memory budget from the image's
 //! header before any texel is decoded. Sampling (bilinear, wrapping) is
 //! [`super::Texture::sample`].
@@ -52,9 +52,9 @@ fn looks_like_tga(bytes: &[u8]) -> bool {
 }
 
 /// What [`decode_texture`] says of a file in none of the formats it reads.
-pub const NOT_AN_IMAGE: &str = "it is not a PNG, JPEG, TGA, BMP, TIFF or DDS image";
+pub const NOT_AN_IMAGE: &str = "it is not a PNG, JPEG, TGA, BMP, TIFF, GIF or DDS image";
 
-/// Decodes PNG, JPEG, TGA, BMP, TIFF or DDS `bytes` into a linear texture named `name`, or says why
+/// Decodes PNG, JPEG, TGA, BMP, TIFF, GIF (its first frame) or DDS `bytes` into a linear texture named `name`, or says why
 /// not in a phrase ([`NOT_AN_IMAGE`], "its 40000x40000 texels would need ..."). The format is
 /// read from the bytes, and for TGA (which has no signature) from a `.tga` ending of `name`,
 /// or from a header that can only be a TGA's (a TGA renamed `.png` by an exporter).
@@ -76,7 +76,13 @@ pub fn decode_texture(name: &str, bytes: &[u8], limit: &MemoryLimit) -> Result<T
         reader.set_format(ImageFormat::Tga);
     }
     match reader.format() {
-        Some(ImageFormat::Png | ImageFormat::Tga | ImageFormat::Bmp | ImageFormat::Tiff) => {}
+        Some(
+            ImageFormat::Png
+            | ImageFormat::Tga
+            | ImageFormat::Bmp
+            | ImageFormat::Tiff
+            | ImageFormat::Gif,
+        ) => {}
         Some(ImageFormat::Jpeg) if !jpeg_is_whole(bytes) => {
             return Err("it is cut short (a JPEG without its end-of-image marker)".into());
         }
@@ -335,7 +341,7 @@ mod tests {
     }
 
     /// The formats real models name besides PNG and JPEG (Sponza's TGA, old exports' BMP,
-    /// Blender's and 3ds Max's TIFF) decode to the same linear texels as the PNG of the image.
+    /// Blender's and 3ds Max's TIFF, old models' GIF) decode to the same linear texels as the PNG of the image.
     #[test]
     fn tga_bmp_and_tiff_decode_like_png() {
         let rgb = [255, 0, 0, 0, 128, 255, 10, 20, 30, 255, 255, 255];
@@ -346,6 +352,7 @@ mod tests {
             ("T.TGA", image::ImageFormat::Tga),
             ("t.bmp", image::ImageFormat::Bmp),
             ("t.tif", image::ImageFormat::Tiff),
+            ("t.gif", image::ImageFormat::Gif),
         ] {
             let mut bytes = Vec::new();
             image

@@ -71,21 +71,36 @@ pub(super) fn texture_statement(value: &str) -> (&str, MapPlacement) {
 /// for a path written on another machine (`C:\Users\me\model\tex\wood.png`, `tex\wood.png`,
 /// `/home/me/model/tex/wood.png`), with `/` for `\` and each shorter tail of it down to the
 /// file name, each next to the OBJ: a model copied from elsewhere keeps its textures beside it.
+/// Last, each tail that keeps a folder (`tex/wood.png`) in the OBJ's folder's parent and its
+/// parent's parent ([`ANCESTORS`]): a model pack whose textures sit in a folder beside the
+/// models' (`data/toys/sorter.obj` naming `E:\dev\data\table\table.png`, found as
+/// `../table/table.png`). A bare file name is not looked for there.
 pub(super) fn candidates(file: &str) -> Vec<String> {
     let mut out = vec![file.to_string()];
     let slashed = file.replace('\\', "/");
     let parts: Vec<&str> = slashed
         .split('/')
-        .filter(|p| !p.is_empty() && *p != "." && !(p.len() == 2 && p.ends_with(':')))
+        .filter(|p| !p.is_empty() && *p != "." && *p != ".." && !(p.len() == 2 && p.ends_with(':')))
         .collect();
-    let tails = (0..parts.len()).map(|i| parts[i..].join("/"));
-    for candidate in std::iter::once(slashed.clone()).chain(tails) {
+    let tails: Vec<String> = (0..parts.len()).map(|i| parts[i..].join("/")).collect();
+    let up = (1..=ANCESTORS).flat_map(|n| {
+        let tails = &tails[..tails.len().saturating_sub(1)];
+        tails.iter().map(move |t| format!("{}{t}", "../".repeat(n)))
+    });
+    let up: Vec<String> = up.collect();
+    for candidate in std::iter::once(slashed.clone())
+        .chain(tails.iter().cloned())
+        .chain(up)
+    {
         if !out.contains(&candidate) {
             out.push(candidate);
         }
     }
     out
 }
+
+/// How many folders above the OBJ's [`candidates`] looks in.
+const ANCESTORS: usize = 2;
 
 /// The texture `value` of MTL statement `key` of material `material`, loaded once per scene
 /// (materials that share a file share the texture); `None` with one warning naming the file
@@ -296,7 +311,15 @@ mod tests {
     #[test]
     fn another_machines_paths_are_tried_as_tails_with_slashes() {
         assert_eq!(candidates("wood.png"), ["wood.png"]);
-        assert_eq!(candidates("tex/wood.png"), ["tex/wood.png", "wood.png"]);
+        assert_eq!(
+            candidates("tex/wood.png"),
+            [
+                "tex/wood.png",
+                "wood.png",
+                "../tex/wood.png",
+                "../../tex/wood.png"
+            ]
+        );
         assert_eq!(
             candidates("C:\\Users\\me\\tex\\wood.png"),
             [
@@ -305,17 +328,33 @@ mod tests {
                 "Users/me/tex/wood.png",
                 "me/tex/wood.png",
                 "tex/wood.png",
-                "wood.png"
+                "wood.png",
+                "../Users/me/tex/wood.png",
+                "../me/tex/wood.png",
+                "../tex/wood.png",
+                "../../Users/me/tex/wood.png",
+                "../../me/tex/wood.png",
+                "../../tex/wood.png",
             ]
         );
         assert_eq!(
-            candidates("/home/u/m/./wood.png"),
+            candidates("/home/u/m/./wood.png")[..5],
             [
                 "/home/u/m/./wood.png",
                 "home/u/m/wood.png",
                 "u/m/wood.png",
                 "m/wood.png",
                 "wood.png"
+            ]
+        );
+        // Written relative to a folder beside the OBJ's: as written, then as tails.
+        assert_eq!(
+            candidates("../maps/wood.png"),
+            [
+                "../maps/wood.png",
+                "maps/wood.png",
+                "wood.png",
+                "../../maps/wood.png"
             ]
         );
     }

@@ -499,7 +499,7 @@ impl<'a> MeshBuild<'a> {
                 n => format!(" and {} more", n - 1),
             };
             warnings.push(format!(
-                "{}: {} not where the material library says but next to the OBJ: `{}` as `{}`{more}.",
+                "{}: {} not where the material library says but found from the OBJ's folder: `{}` as `{}`{more}.",
                 req.label,
                 if n == 1 { "a texture is".to_string() } else { format!("{n} textures are") },
                 short_path(written),

@@ -111,7 +111,7 @@ impl<'r> Libraries<'r> {
         })?;
         if let Some(candidate) = elsewhere {
             self.warnings.borrow_mut().push(format!(
-                "{}: the material library `{name}` is not where the OBJ says but next to it, as `{}`.",
+                "{}: the material library `{name}` is not where the OBJ says but found from its folder as `{}`.",
                 req.label,
                 short_path(&candidate)
             ));
