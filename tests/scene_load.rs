@@ -731,6 +731,23 @@ fn an_error_names_a_material_or_light_by_its_name() {
     assert!(err.contains("material 1"), "{err}");
 }
 
+/// An OBJ of one textured triangle per material of `names`, side by side, from the library
+/// `mtllib`.
+fn textured_triangles(mtllib: &str, names: &[&str]) -> String {
+    let mut obj = format!("mtllib {mtllib}\nvt 0 0\nvt 1 0\nvt 0 1\n");
+    for (i, m) in names.iter().enumerate() {
+        let x = 2.0 * i as f32;
+        obj += &format!(
+            "usemtl {m}\nv {x} 0 0\nv {} 0 0\nv {x} 1 0\nf {}/1 {}/2 {}/3\n",
+            x + 1.0,
+            3 * i + 1,
+            3 * i + 2,
+            3 * i + 3
+        );
+    }
+    obj
+}
+
 /// A model copied from another machine: its MTL names textures by that machine's paths (a
 /// Windows path, a relative path with `\`, another user's absolute path) and in another case
 /// than the files have. Each is found next to the OBJ, with one note listing them; a texture
@@ -751,17 +768,7 @@ fn textures_named_by_another_machine_are_found_next_to_the_obj() {
          newmtl e\nmap_Kd nowhere/gone.png\n",
     )
     .expect("write");
-    let mut obj = String::from("mtllib m.mtl\nvt 0 0\nvt 1 0\nvt 0 1\n");
-    for (i, m) in ["a", "b", "c", "d", "e"].iter().enumerate() {
-        let x = 2.0 * i as f32;
-        obj += &format!(
-            "usemtl {m}\nv {x} 0 0\nv {} 0 0\nv {x} 1 0\nf {}/1 {}/2 {}/3\n",
-            x + 1.0,
-            3 * i + 1,
-            3 * i + 2,
-            3 * i + 3
-        );
-    }
+    let obj = textured_triangles("m.mtl", &["a", "b", "c", "d", "e"]);
     let path = dir.path().join("m.obj");
     std::fs::write(&path, obj).expect("write");
     let scene = load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
@@ -902,17 +909,7 @@ fn a_texture_in_a_folder_beside_the_models_is_found_by_its_folder() {
          newmtl b\nmap_Kd C:\\stray.png\n",
     )
     .expect("write");
-    let mut obj = String::from("mtllib sorter.mtl\nvt 0 0\nvt 1 0\nvt 0 1\n");
-    for (i, m) in ["a", "b"].iter().enumerate() {
-        let x = 2.0 * i as f32;
-        obj += &format!(
-            "usemtl {m}\nv {x} 0 0\nv {} 0 0\nv {x} 1 0\nf {}/1 {}/2 {}/3\n",
-            x + 1.0,
-            3 * i + 1,
-            3 * i + 2,
-            3 * i + 3
-        );
-    }
+    let obj = textured_triangles("sorter.mtl", &["a", "b"]);
     let path = dir.path().join("data/toys/box/sorter.obj");
     std::fs::write(&path, obj).expect("write");
     let scene = load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
