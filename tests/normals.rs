@@ -465,6 +465,20 @@ fn an_obj_that_names_no_material_takes_the_texture_named_for_it() {
             "{local:?}"
         );
     }
+    // Saved as a scene file (the viewer's Save) and loaded back: the same material, with its
+    // texture, whose colours the file now sets.
+    let bare = load_scene_file(&dir.path().join("tri.obj")).unwrap_or_else(|e| panic!("{e}"));
+    let saved = dir.path().join("saved.toml");
+    let text = scene_to_toml(&bare).replace("\ndiffuse = 1.0\n", "\ndiffuse = 0.5\n");
+    std::fs::write(&saved, &text).expect("save");
+    let back = load_scene_file(&saved).unwrap_or_else(|e| panic!("{e}\n{text}"));
+    let used = back.material(back.triangles[0].material);
+    assert_eq!(used.name, "tri/tri_diffuse.png", "{text}");
+    assert!(
+        used.diffuse_map.is_some() && used.ambient_map.is_some(),
+        "{text}"
+    );
+    assert_eq!(used.diffuse, Vec3::splat(0.5), "{text}");
     // Faces without texture coordinates, or with a material of their own, keep theirs; an
     // image of that name that cannot be read is one sentence, and the default grey stays.
     std::fs::write(dir.path().join("m.mtl"), "newmtl a\nKd 0 1 0\n").expect("mtl");
@@ -740,4 +754,46 @@ f 1/1 2/2 3/3\nf 2 4 3\nf 2/2 4 3/3\n",
             "{label}: 1 face gives texture coordinates (`vt`) at some corners only; it is not textured."
         )]
     );
+}
+
+#[test]
+fn blenders_ka_1_on_a_textured_material_takes_the_texture_too() {
+    // A bare OBJ reads `Ka 1` as `Kd`; with `map_Kd` the diffuse colour is the texture's, so
+    // the ambient term is textured too: (0.1 ambient light) × Kd × the red texel, no grey.
+    let dir = tempfile::tempdir().expect("temp dir");
+    std::fs::write(dir.path().join("red.png"), png_bytes(1, 1, &[255, 0, 0])).expect("png");
+    for kd in ["0.8 0.8 0.8", "1 1 1"] {
+        std::fs::write(
+            dir.path().join("t.mtl"),
+            format!("newmtl t\nKa 1 1 1\nKd {kd}\nmap_Kd red.png\n"),
+        )
+        .expect("mtl");
+        std::fs::write(
+            dir.path().join("tri.obj"),
+            format!("mtllib t.mtl\nusemtl t\n{TRI}"),
+        )
+        .expect("obj");
+        let scene = load_scene_file(&dir.path().join("tri.obj")).unwrap_or_else(|e| panic!("{e}"));
+        assert!(
+            scene
+                .warnings
+                .iter()
+                .any(|w| w.contains("`Ka 1` (Blender's default) in `t`")),
+            "Kd {kd}: {:?}",
+            scene.warnings
+        );
+        let (width, height) = (scene.render.width, scene.render.height);
+        let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());
+        let tree = pixel_tree(&tracer, width / 2, height / 2).expect("centre pixel");
+        let ambient = tree.root.local.expect("shaded").ambient;
+        let k: f32 = kd
+            .split_whitespace()
+            .next()
+            .and_then(|x| x.parse().ok())
+            .expect("kd");
+        assert!(
+            (ambient - Vec3::new(0.1 * k, 0.0, 0.0)).abs().max_element() < 1e-5,
+            "Kd {kd}: ambient {ambient}"
+        );
+    }
 }

@@ -67,10 +67,18 @@ pub(crate) fn load_obj_scene(
         .iter()
         .filter(|m| m.name.starts_with(&prefix))
         .count();
+    // The diffuse colour includes its texture: with `map_Kd` and no `map_Ka`, the ambient term
+    // takes the texture too, so a side in shadow shows the texture darkened, not flat grey.
     let mut washed = Vec::new();
     for m in &mut scene.materials {
-        if m.ambient == Vec3::ONE && m.diffuse != Vec3::ONE && m.name.starts_with(&prefix) {
+        let untextured = m.diffuse_map.is_some() && m.ambient_map.is_none();
+        let changes = m.diffuse != Vec3::ONE || untextured;
+        if m.ambient == Vec3::ONE && changes && m.name.starts_with(&prefix) {
             m.ambient = m.diffuse;
+            if untextured {
+                m.ambient_map = m.diffuse_map;
+                m.ambient_map_placement = m.diffuse_map_placement;
+            }
             washed.push(format!("`{}`", short(&m.name[prefix.len()..])));
         }
     }
