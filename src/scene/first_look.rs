@@ -192,13 +192,16 @@ pub(crate) fn load_obj_scene(
     });
     if let Some(room) = look.room {
         scene.warnings.push(format!(
-            "{label}: the model is closed around its middle (a room): {}.",
+            "{label}: {}.",
             match room.entry {
+                // Seen from outside: a Cornell box, a stage set, or a thing (a well under its
+                // roof) whose middle is walled in but for one side.
                 Entry::OpenSide =>
-                    "it is open on one side, so the camera looks in through the opening",
+                    "the model has walls around its middle and is open on one side (as a Cornell box or a stage set is): it is seen level through the opening",
                 Entry::Doorway =>
-                    "one wall has an opening, so the camera stands in it and looks in",
-                Entry::Inside => "the camera starts inside it",
+                    "the model is closed around its middle (a room) and one wall has an opening: the camera stands in it and looks in",
+                Entry::Inside =>
+                    "the model is closed around its middle (a room): the camera starts inside it",
             }
         ));
     }
