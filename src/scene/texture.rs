@@ -54,10 +54,11 @@ fn looks_like_tga(bytes: &[u8]) -> bool {
 /// What [`decode_texture`] says of a file in none of the formats it reads.
 pub const NOT_AN_IMAGE: &str = "it is not a PNG, JPEG, TGA, BMP, TIFF, GIF or DDS image";
 
-/// Decodes PNG, JPEG, TGA, BMP, TIFF, GIF (its first frame) or DDS `bytes` into a linear texture named `name`, or says why
-/// not in a phrase ([`NOT_AN_IMAGE`], "its 40000x40000 texels would need ..."). The format is
-/// read from the bytes, and for TGA (which has no signature) from a `.tga` ending of `name`,
-/// or from a header that can only be a TGA's (a TGA renamed `.png` by an exporter).
+/// Decodes PNG, JPEG, TGA, BMP, TIFF, GIF (its first frame) or DDS `bytes` into a linear texture
+/// named `name`, or says why not in a phrase ([`NOT_AN_IMAGE`], "its 40000x40000 texels would
+/// need ..."). The format is read from the bytes, and for TGA (which has no signature) from a
+/// `.tga` ending of `name`, or from a header that can only be a TGA's (a TGA renamed `.png` by
+/// an exporter).
 /// `limit` is the memory still available: a texture larger than it is refused from its header,
 /// before a texel is decoded. A JPEG cut short (no end-of-image marker after its last scan) is
 /// refused too: the decoder would fill the missing part with grey and say nothing.
@@ -341,9 +342,10 @@ mod tests {
     }
 
     /// The formats real models name besides PNG and JPEG (Sponza's TGA, old exports' BMP,
-    /// Blender's and 3ds Max's TIFF, old models' GIF) decode to the same linear texels as the PNG of the image.
+    /// Blender's and 3ds Max's TIFF, old models' GIF) decode to the same linear texels as the
+    /// PNG of the image.
     #[test]
-    fn tga_bmp_and_tiff_decode_like_png() {
+    fn tga_bmp_tiff_and_gif_decode_like_png() {
         let rgb = [255, 0, 0, 0, 128, 255, 10, 20, 30, 255, 255, 255];
         let image = image::RgbImage::from_raw(2, 2, rgb.to_vec()).expect("2x2");
         let reference = decode_texture("t.png", &png(2, 2, &rgb), &roomy()).expect("png");

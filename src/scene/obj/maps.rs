@@ -87,7 +87,6 @@ pub(super) fn candidates(file: &str) -> Vec<String> {
         let tails = &tails[..tails.len().saturating_sub(1)];
         tails.iter().map(move |t| format!("{}{t}", "../".repeat(n)))
     });
-    let up: Vec<String> = up.collect();
     for candidate in std::iter::once(slashed.clone())
         .chain(tails.iter().cloned())
         .chain(up)
@@ -205,8 +204,8 @@ const NAMED_DIFFUSE_EXTENSIONS: &[&str] = &["png", "tga", "jpg", "jpeg", "bmp"];
 /// The diffuse texture a model pack ships beside an OBJ that names no material, named for the
 /// OBJ: `<stem>_diffuse.<ext>` (tinyrenderer's `african_head_diffuse.tga`, raylib's
 /// `castle_diffuse.png`), `ext` one of [`NAMED_DIFFUSE_EXTENSIONS`] (the resolver finds a file
-/// whatever the case of its name, `.TGA` for `.tga`). Its id and
-/// file name, or `None` when there is none; one found that cannot be used is a warning.
+/// whatever the case of its name, `.TGA` for `.tga`). Its id and file name, or `None` when
+/// there is none; one found that cannot be used is a warning.
 pub(super) fn named_diffuse(
     scene: &mut Scene,
     req: &MeshRequest,
