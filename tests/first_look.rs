@@ -339,6 +339,22 @@ fn walls_without_a_ceiling_are_seen_from_above_outside() {
     assert!(p.y > hi.y, "camera at {p}, not above the walls");
     assert!(forward(&scene).y < -0.3, "looks down into the room");
     assert_readable(&scene, "kitchen.obj", 0.1..0.75, 0.02);
+    // Boxes without a lid, as high as they are wide and higher (a bin, a vase): from inside a
+    // tall one, most rays upwards meet its walls, but its top is open. Seen from above too,
+    // not from inside.
+    for height in [2.0, 3.0, 4.0] {
+        let mut bin = String::new();
+        let (lo, hi) = (Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, height, 1.0));
+        cuboid(&mut bin, &mut 0, lo, hi, true, &[3]);
+        let scene = load(dir.path(), "bin.obj", &bin);
+        let p = scene.camera.position;
+        assert!(
+            !inside(p, &scene) && p.y > hi.y,
+            "bin {height}: camera at {p}"
+        );
+        assert!(forward(&scene).y < -0.3, "bin {height}: looks down into it");
+        assert_not_warned(&scene, "bin.obj", "(a room)");
+    }
 }
 
 /// Cornell-box colours: white, red and green walls of `Kd 1` (no `Ka`).

@@ -354,6 +354,11 @@ const MIN_OPENING: f32 = 0.04;
 /// standing out of it).
 const WALL_DEPTH: f32 = 0.1;
 
+/// Rays from above that run more than this fraction of the model's height into it before
+/// meeting anything pass through an open top (a box without a lid, a bin, a cup): down to
+/// its floor, not onto a lid's studs or handles.
+const ROOF_DEPTH: f32 = 0.5;
+
 /// How many directions each probe point sends rays in.
 const PROBE_DIRS: usize = 48;
 
@@ -439,13 +444,15 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
     if inside.is_empty() || through_tube(triangles, &curve, center, (lo, hi)) {
         return outside();
     }
-    // Open above (walls without a ceiling, a stage set, a tray): most rays upwards from the
-    // points inside meet nothing, a cover over part of it (a shelf, a lid half on)
-    // notwithstanding. Seen from outside and higher up, so the key light above shines in and
-    // the inside shows.
+    // Open above (walls without a ceiling, a stage set, a tray, a box without a lid): of the
+    // rays upwards from the points inside, at least half meet nothing (a cover over part of
+    // it, a shelf or a lid half on, notwithstanding). Seen from outside and higher up, so the
+    // key light above shines in and the inside shows.
     let skyward = dirs.iter().filter(|d| d.dot(up) > 0.5).count();
     let sky: usize = inside.iter().map(|(_, p)| p.open_up(&dirs, up)).sum();
-    if 2 * sky > skyward * inside.len() {
+    let roofless = 4 * sky >= skyward * inside.len()
+        && opening(triangles, &curve, up, (lo, hi), ROOF_DEPTH).0 >= OPEN_SIDE;
+    if roofless || 2 * sky >= skyward * inside.len() {
         return FirstView {
             camera: frame_outside(triangles, center, up, front, 0.8, aspect),
             room: None,
@@ -457,7 +464,7 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
     let walls = [side, -side, front, -front];
     let open_wall = walls
         .into_iter()
-        .map(|w| (w, opening(triangles, &curve, w, (lo, hi))))
+        .map(|w| (w, opening(triangles, &curve, w, (lo, hi), WALL_DEPTH)))
         .filter(|(_, (fraction, _))| *fraction >= MIN_OPENING)
         .max_by(|a, b| a.1.0.total_cmp(&b.1.0));
     let long = if extent(front) >= extent(side) {
@@ -609,6 +616,7 @@ fn opening(
     order: &[u32],
     wall: Vec3,
     (lo, hi): (Vec3, Vec3),
+    past: f32,
 ) -> (f32, Option<Vec3>) {
     const GRID: usize = 16;
     let axis = wall.abs().max_position();
@@ -633,7 +641,7 @@ fn opening(
     let open: Vec<Vec3> = nearest(triangles, order, &rays)
         .iter()
         .zip(&points)
-        .filter(|((dist, _), _)| *dist > outside + WALL_DEPTH * depth)
+        .filter(|((dist, _), _)| *dist > outside + past * depth)
         .map(|(_, &p)| p)
         .collect();
     if open.is_empty() {
