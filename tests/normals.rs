@@ -223,12 +223,12 @@ fn smoothing_groups_without_vn_shade_smooth_and_say_so() {
 
 #[test]
 fn faces_without_vn_in_a_file_with_vn_shade_by_their_groups() {
-    // The roof's first two faces give `vn` (all +x, so they can be told apart); the other two
+    // The roof's first two faces give `vn` (all (0.6, 0, 0.8), so they can be told apart); the other two
     // give none. In one group, the two without `vn` take the normals computed within it: the
     // apex averages all four faces, +z. Under `s off` they stay flat.
     let roof = |group: &str| {
         format!(
-            "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nv 0 0 0.3\nvn 1 0 0\ns 1\n\
+            "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nv 0 0 0.3\nvn 0.6 0 0.8\ns 1\n\
              f 1//1 2//1 5//1\nf 2//1 3//1 5//1\n{group}\nf 3 4 5\nf 4 1 5\n"
         )
     };
@@ -237,7 +237,8 @@ fn faces_without_vn_in_a_file_with_vn_shade_by_their_groups() {
     for face in [0, 1] {
         let kept = a.normals_of(face).expect("the file's normals");
         assert!(
-            kept.iter().all(|n| (*n - Vec3::X).length() < 1e-5),
+            kept.iter()
+                .all(|n| (*n - Vec3::new(0.6, 0.0, 0.8)).length() < 1e-5),
             "{kept:?}"
         );
     }
@@ -796,4 +797,44 @@ fn blenders_ka_1_on_a_textured_material_takes_the_texture_too() {
             "Kd {kd}: ambient {ambient}"
         );
     }
+}
+
+/// Vertex normals written for other faces (raylib's `cube.obj`: the `+z` face given `-x` at its
+/// corners): a face whose three `vn` lie within 5° of its own plane is shaded flat, with one
+/// sentence; one whose normals lean 80° from it keeps them.
+const EDGE_ON: &str = "v -1 -1 0\nv 1 -1 0\nv 0 1 0\n\
+vn 1 0 0\nvn 0 1 0\nvn 1 1 0.05\n\
+f 1//1 2//2 3//3\n";
+const LEANING: &str = "v -1 -1 0\nv 1 -1 0\nv 0 1 0\n\
+vn 1 0 0.18\nvn 0 1 0.18\nvn 1 1 0.25\n\
+f 1//1 2//2 3//3\n";
+
+#[test]
+fn normals_in_the_faces_own_plane_are_dropped_for_the_face_normal() {
+    // The shading normal at the centre pixel, and the warnings.
+    let centre = |name: &'static str, text: &'static str| {
+        let scene = load(
+            &format!("{CAMERA}[[mesh]]\nfile = \"{name}\"\n"),
+            Box::leak(Box::new([(name, text)])),
+        );
+        let warnings = scene.warnings.clone();
+        let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());
+        let hit = pixel_tree(&tracer, 4, 4)
+            .expect("centre")
+            .root
+            .hit
+            .expect("hit");
+        (hit.normal, warnings)
+    };
+    let (normal, warnings) = centre("e.obj", EDGE_ON);
+    assert_eq!(
+        warnings,
+        [
+            "e.obj: 1 face has normals (`vn`) lying in the face's own plane, which no surface has there (they belong to other faces); it is shaded flat."
+        ]
+    );
+    assert_eq!(normal, Vec3::Z, "the face's own normal");
+    let (normal, warnings) = centre("l.obj", LEANING);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert!(normal.z < 0.5, "the file's leaning normals: {normal}");
 }

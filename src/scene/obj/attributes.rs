@@ -20,6 +20,8 @@ pub(super) struct Corners {
     pub bad_normals: usize,
     /// Faces whose `vt` indices are out of range or name non-finite coordinates.
     pub bad_uvs: usize,
+    /// Faces whose three `vn` lie in the face's own plane (they belong to other faces).
+    pub edge_on_normals: usize,
     /// Faces with `vn` (`vt`) at some corners only.
     pub partial_normals: usize,
     pub partial_uvs: usize,
@@ -178,6 +180,13 @@ fn warn_about_corners(
             true,
             ["names", "name"],
             "normals (`vn`) that are out of range, zero or not finite",
+            flat,
+        ),
+        (
+            corners.edge_on_normals,
+            true,
+            ["has", "have"],
+            "normals (`vn`) lying in the face's own plane, which no surface has there (they belong to other faces)",
             flat,
         ),
         (

@@ -208,6 +208,35 @@ pub(super) fn keep_placed(
     }
 }
 
+/// The sine of the angle within which a vertex normal lies in its face's plane for
+/// [`edge_on_normals`] (5°).
+const EDGE_ON: f32 = 0.087;
+
+/// Drops the vertex normals of faces whose three `vn` all lie within 5° of the face's own plane
+/// ([`EDGE_ON`]): no smooth surface has a normal along itself, so they belong to other faces
+/// (a file whose normals were written in another face order); such a face is shaded flat.
+/// `normal_ids` is empty or one per triangle. Returns how many faces.
+pub(super) fn edge_on_normals(
+    triangles: &[Triangle],
+    normals: &[Vec3],
+    normal_ids: &mut [[u32; 3]],
+) -> usize {
+    if normal_ids.len() != triangles.len() {
+        return 0;
+    }
+    (triangles.par_iter().zip(normal_ids.par_iter_mut()))
+        .filter(|(t, n)| {
+            let v = &t.vertices;
+            let face = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
+            n[0] != NO_INDEX
+                && face != Vec3::ZERO
+                && n.iter()
+                    .all(|&i| normals[i as usize].normalize_or_zero().dot(face).abs() < EDGE_ON)
+        })
+        .map(|(_, n)| *n = [NO_INDEX; 3])
+        .count()
+}
+
 /// Turns round the faces wound against their own vertex normals: a face whose three `vn` all
 /// lie on the other side of its plane from the normal its winding gives (a file wound
 /// clockwise, or converted between left- and right-handed axes by negating one coordinate of
