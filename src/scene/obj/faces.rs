@@ -209,75 +209,72 @@ pub(super) fn keep_placed(
 }
 
 /// The sine of the angle within which a vertex normal lies in its face's plane for
-/// [`edge_on_normals`] (5°).
+/// [`fit_normals`] (5°).
 const EDGE_ON: f32 = 0.087;
 
-/// Drops the vertex normals of faces whose three `vn` all lie within 5° of the face's own plane
-/// ([`EDGE_ON`]): no smooth surface has a normal along itself, so they belong to other faces
-/// (a file whose normals were written in another face order); such a face is shaded flat.
-/// `normal_ids` is empty or one per triangle. Returns how many faces.
-pub(super) fn edge_on_normals(
-    triangles: &[Triangle],
-    normals: &[Vec3],
-    normal_ids: &mut [[u32; 3]],
-) -> usize {
-    if normal_ids.len() != triangles.len() {
-        return 0;
-    }
-    (triangles.par_iter().zip(normal_ids.par_iter_mut()))
-        .filter(|(t, n)| {
-            let v = &t.vertices;
-            let face = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
-            n[0] != NO_INDEX
-                && face != Vec3::ZERO
-                && n.iter()
-                    .all(|&i| normals[i as usize].normalize_or_zero().dot(face).abs() < EDGE_ON)
-        })
-        .map(|(_, n)| *n = [NO_INDEX; 3])
-        .count()
+/// What [`fit_normals`] did: faces turned round, and faces whose normals it dropped.
+pub(super) struct Fitted {
+    pub turned: usize,
+    pub edge_on: usize,
 }
 
-/// Turns round the faces wound against their own vertex normals: a face whose three `vn` all
-/// lie on the other side of its plane from the normal its winding gives (a file wound
-/// clockwise, or converted between left- and right-handed axes by negating one coordinate of
-/// its points and normals) gets two corners swapped, with their normal, texture-coordinate and
-/// colour indices (`ids`: normals first, each empty or one per triangle), so that its front is
-/// the side its normals face. Faces without usable `vn` at every corner keep their winding.
-/// Returns how many were turned.
-pub(super) fn wind_as_normals(
+/// Fits each face to its own vertex normals (`normals`, unit length), in one pass. A face whose
+/// three `vn` all lie within 5° of its own plane ([`EDGE_ON`]) loses them and is shaded flat: no
+/// smooth surface has a normal along itself, so they belong to other faces (a file whose
+/// normals were written in another face order). A face whose three `vn` all lie on the other
+/// side of its plane from the normal its winding gives (a file wound clockwise, or converted
+/// between left- and right-handed axes by negating one coordinate of its points and normals)
+/// is turned round: two corners swapped, with their normal, texture-coordinate and colour
+/// indices (`ids`: normals first, each empty or one per triangle), so that its front is the
+/// side its normals face. Faces without usable `vn` at every corner are left as they are.
+pub(super) fn fit_normals(
     triangles: &mut [Triangle],
     normals: &[Vec3],
     ids: [&mut Vec<[u32; 3]>; 3],
-) -> usize {
+) -> Fitted {
     let [normal_ids, uv_ids, color_ids] = ids;
     if normal_ids.len() != triangles.len() {
-        return 0;
+        return Fitted {
+            turned: 0,
+            edge_on: 0,
+        };
     }
-    let against = |t: &Triangle, n: &[u32; 3]| {
-        let v = &t.vertices;
-        let winding = (v[1] - v[0]).cross(v[2] - v[0]);
-        n[0] != NO_INDEX && n.iter().all(|&i| normals[i as usize].dot(winding) < 0.0)
-    };
-    // One pass decides and turns the corners and their normals; the few turned faces' texture
-    // and colour indices follow.
-    let turned: Vec<usize> = (triangles.par_iter_mut().zip(normal_ids.par_iter_mut()))
+    // One pass decides, and turns the corners and their normals or drops the normals; the few
+    // turned faces' texture and colour indices follow. `(k, true)`: face k turned.
+    let fitted: Vec<(usize, bool)> = (triangles.par_iter_mut().zip(normal_ids.par_iter_mut()))
         .enumerate()
         .filter_map(|(k, (t, n))| {
-            against(t, n).then(|| {
+            if n[0] == NO_INDEX {
+                return None;
+            }
+            let v = &t.vertices;
+            let winding = (v[1] - v[0]).cross(v[2] - v[0]);
+            let face = winding.normalize_or_zero();
+            let corner = |i: &u32| normals[*i as usize];
+            if face != Vec3::ZERO && n.iter().all(|i| corner(i).dot(face).abs() < EDGE_ON) {
+                *n = [NO_INDEX; 3];
+                return Some((k, false));
+            }
+            n.iter().all(|i| corner(i).dot(winding) < 0.0).then(|| {
                 t.vertices.swap(1, 2);
                 n.swap(1, 2);
-                k
+                (k, true)
             })
         })
         .collect();
-    for &k in &turned {
+    let mut turned = 0;
+    for &(k, _) in fitted.iter().filter(|(_, turn)| *turn) {
+        turned += 1;
         for ids in [&mut *uv_ids, &mut *color_ids] {
             if let Some(corners) = ids.get_mut(k) {
                 corners.swap(1, 2);
             }
         }
     }
-    turned.len()
+    Fitted {
+        turned,
+        edge_on: fitted.len() - turned,
+    }
 }
 
 #[cfg(test)]
@@ -317,7 +314,7 @@ mod tests {
         let mut uv_ids = vec![[0, 1, 2], [3, 4, 5], [6, 7, 8], [9, 10, 11]];
         let mut color_ids = Vec::new();
         let ids = [&mut normal_ids, &mut uv_ids, &mut color_ids];
-        assert_eq!(wind_as_normals(&mut triangles, &normals, ids), 1);
+        assert_eq!(fit_normals(&mut triangles, &normals, ids).turned, 1);
         assert_eq!(triangles[2].vertices, [Vec3::ZERO, Vec3::Y, Vec3::X]);
         assert_eq!((normal_ids[2], uv_ids[2]), ([2, 4, 3], [6, 8, 7]));
         // A face with one normal on its winding's side, and one without normals, stay.

@@ -11,7 +11,7 @@ use rayon::prelude::*;
 
 use super::attributes::{Corners, finish_attributes};
 use super::corners::{self, FaceCorners};
-use super::faces::{Faces, Given, PLACED, dropped, edge_on_normals, keep_placed, wind_as_normals};
+use super::faces::{Faces, Given, PLACED, dropped, fit_normals, keep_placed};
 use super::memory::check_memory;
 use super::mtl::{Libraries, mtl_material, named_material, warn_unknown_usemtl};
 use super::parse::Facts;
@@ -345,16 +345,13 @@ impl<'a> MeshBuild<'a> {
                 [&mut normal_ids, &mut uv_ids, &mut color_ids],
             );
         }
-        self.corners.edge_on_normals += edge_on_normals(
-            &scene.triangles[start..],
-            &self.attrs.normals,
-            &mut normal_ids,
-        );
-        self.turned += wind_as_normals(
+        let fitted = fit_normals(
             &mut Arc::make_mut(&mut scene.triangles)[start..],
             &self.attrs.normals,
             [&mut normal_ids, &mut uv_ids, &mut color_ids],
         );
+        self.turned += fitted.turned;
+        self.corners.edge_on_normals += fitted.edge_on;
         if let Some(material) = material {
             Arc::make_mut(&mut scene.triangles)[start..]
                 .par_iter_mut()
