@@ -925,6 +925,25 @@ fn with_face_normals(text: &str, wind_back: bool) -> String {
     out + &faces
 }
 
+/// The two balls get the same first look and render alike.
+fn assert_same_look(right: &Scene, back: &Scene) {
+    assert!(
+        back.camera.position.distance(right.camera.position) < 1e-4,
+        "the same first look: {:?} against {:?}",
+        back.camera,
+        right.camera
+    );
+    let (a, b) = (pixels(&right), pixels(&back));
+    let differ = a
+        .iter()
+        .zip(&b)
+        .filter(|(x, y)| (**x - **y).abs().max_element() > 1e-3);
+    assert!(
+        differ.count() * 1000 < a.len(),
+        "the two balls render alike"
+    );
+}
+
 #[test]
 fn a_model_wound_against_its_normals_opens_as_the_normals_say() {
     // Wound clockwise with outward normals (a file converted from left-handed axes by
@@ -947,21 +966,7 @@ fn a_model_wound_against_its_normals_opens_as_the_normals_say() {
         &["its faces are wound clockwise", "`vn`"],
     );
     assert!(!inside(back.camera.position, &back), "outside the ball");
-    assert!(
-        back.camera.position.distance(right.camera.position) < 1e-4,
-        "the same first look: {:?} against {:?}",
-        back.camera,
-        right.camera
-    );
-    let (a, b) = (pixels(&right), pixels(&back));
-    let differ = a
-        .iter()
-        .zip(&b)
-        .filter(|(x, y)| (**x - **y).abs().max_element() > 1e-3);
-    assert!(
-        differ.count() * 1000 < a.len(),
-        "the two balls render alike"
-    );
+    assert_same_look(&right, &back);
     assert_readable(&back, "ball_cw.obj", 0.03..0.6, 0.1);
     // Wound outwards with inward normals (a furnace test's box, made to be seen from inside):
     // a room, so the camera starts inside it and the walls are lit.
@@ -972,6 +977,43 @@ fn a_model_wound_against_its_normals_opens_as_the_normals_say() {
     assert_warned(&furnace, "furnace.obj", &["its faces are wound clockwise"]);
     assert!(inside(furnace.camera.position, &furnace), "inside the box");
     assert_readable(&furnace, "furnace.obj", 0.1..0.9, 0.1);
+}
+
+#[test]
+fn a_thing_wound_inside_out_without_normals_is_seen_from_outside() {
+    // Wound clockwise seen from outside and no `vn`: from its middle every face faces the
+    // point, as a room's walls do, but nothing of it lies on its bounds as walls do. The same
+    // first look as the ball wound right, and the same image.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let text = ball(12, 24);
+    let turned: String = text
+        .lines()
+        .map(
+            |line| match line.split_whitespace().collect::<Vec<_>>()[..] {
+                ["f", a, b, c] => format!("f {a} {c} {b}\n"),
+                _ => format!("{line}\n"),
+            },
+        )
+        .collect();
+    let right = load(dir.path(), "ball.obj", &text);
+    let back = load(dir.path(), "ball_cw.obj", &turned);
+    assert_not_warned(&right, "ball.obj", "wound clockwise");
+    assert_warned(
+        &back,
+        "ball_cw.obj",
+        &[
+            "wound clockwise seen from outside",
+            "no `vn`",
+            "seen from outside",
+        ],
+    );
+    assert_not_warned(&back, "ball_cw.obj", "(a room)");
+    assert_same_look(&right, &back);
+    // A room without `vn` faces inwards too, its walls, floor and ceiling on its bounds: it
+    // stays a room.
+    let room = load(dir.path(), "room.obj", &room(false));
+    assert!(inside(room.camera.position, &room), "the room: outside");
+    assert_not_warned(&room, "room.obj", "wound clockwise");
 }
 
 /// A pipe of `segments` sides with walls of radius `inner` and `outer`, `length` long along

@@ -134,6 +134,16 @@ pub(crate) fn load_obj_scene(
     }
     let aspect = scene.render.width.max(1) as f32 / scene.render.height.max(1) as f32;
     let mut look = first_view(&scene.triangles, lo, hi, up, aspect);
+    // Without `vn`, the winding alone says which side of a face is its front. A model that
+    // opens as a room but whose faces face inwards, with little of its surface on its bounds
+    // (a scanned statue or an animal wound clockwise, where a room's walls, floor and ceiling
+    // lie on its bounds), is a thing wound the wrong way round: seen from outside.
+    if look.room.is_some() && !gives_normals(text) && faces_inward(&scene.triangles, lo, hi) {
+        look = first_view_outside(&scene.triangles, lo, hi, up, aspect);
+        scene.warnings.push(format!(
+            "{label}: the model's faces are wound clockwise seen from outside (they face inwards, and no `vn` says otherwise), yet it is no room: it is seen from outside."
+        ));
+    }
     // A room is wider and longer than it is high. Seen y-up, a room whose z extent is clearly
     // its lowest (below `ROOM_Z_UP` of its y extent) was written z-up (3ds Max, SketchUp's
     // z-up exports, CAD): it is looked at again with +z up, and taken so if it is a room then.
@@ -433,14 +443,7 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
         .filter(|(_, p)| p.in_room())
         .map(|(&point, p)| (point, p))
         .collect();
-    let outside = || {
-        let (front, elevation) = flat_front(triangles, half, up, front);
-        FirstView {
-            camera: frame_outside(triangles, center, up, front, elevation, aspect),
-            room: None,
-            open_above: false,
-        }
-    };
+    let outside = || first_view_outside(triangles, lo, hi, up, aspect);
     if inside.is_empty() || through_tube(triangles, &curve, center, (lo, hi)) {
         return outside();
     }
@@ -576,6 +579,74 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
         }),
         open_above: false,
     }
+}
+
+/// The first view of a model seen from outside: from its front and a little above, or square
+/// to it when it is flat ([`flat_front`]).
+fn first_view_outside(
+    triangles: &[Triangle],
+    lo: Vec3,
+    hi: Vec3,
+    up: Vec3,
+    aspect: f32,
+) -> FirstView {
+    let front = if up == Vec3::Z { -Vec3::Y } else { Vec3::Z };
+    let (front, elevation) = flat_front(triangles, 0.5 * (hi - lo), up, front);
+    FirstView {
+        camera: frame_outside(triangles, 0.5 * (lo + hi), up, front, elevation, aspect),
+        room: None,
+        open_above: false,
+    }
+}
+
+/// Whether an OBJ's text has vertex normals (`vn` lines).
+fn gives_normals(text: &str) -> bool {
+    text.lines().any(|line| {
+        line.trim_start()
+            .strip_prefix("vn")
+            .is_some_and(|rest| rest.starts_with(char::is_whitespace))
+    })
+}
+
+/// The model's enclosed volume, signed by its faces' winding, must be at least this fraction
+/// of its bounds' volume below zero for it to face inwards ([`faces_inward`]).
+const INWARD_VOLUME: f64 = 0.05;
+
+/// A room's walls, floor and ceiling lie on its bounds: a model with at least this fraction of
+/// its surface there faces inwards as a room does ([`faces_inward`]).
+const ON_BOUNDS: f64 = 0.25;
+
+/// Whether the faces face inwards the way a thing turned inside out does: the volume their
+/// winding encloses (about the bounds' centre) is clearly negative, and less than
+/// [`ON_BOUNDS`] of their area lies on the bounds' six faces (within 1 % of the largest
+/// extent), where a room's shell lies.
+fn faces_inward(triangles: &[Triangle], lo: Vec3, hi: Vec3) -> bool {
+    use rayon::prelude::*;
+    let extent = (hi - lo).as_dvec3();
+    let bounds_volume = extent.x * extent.y * extent.z;
+    if !(bounds_volume > 0.0 && bounds_volume.is_finite()) {
+        return false;
+    }
+    let center = (0.5 * (lo + hi)).as_dvec3();
+    let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
+    let near = 0.01 * extent.max_element();
+    let (volume, area, on_bounds) = triangles
+        .par_iter()
+        .map(|t| {
+            let [a, b, c] = t.vertices.map(|v| v.as_dvec3() - center);
+            let area = 0.5 * (b - a).cross(c - a).length();
+            let on = (0..3).any(|axis| {
+                let all = |plane: f64| {
+                    t.vertices
+                        .iter()
+                        .all(|v| (f64::from(v[axis]) - plane).abs() <= near)
+                };
+                all(lo[axis]) || all(hi[axis])
+            });
+            (a.dot(b.cross(c)) / 6.0, area, if on { area } else { 0.0 })
+        })
+        .reduce(|| (0.0, 0.0, 0.0), |x, y| (x.0 + y.0, x.1 + y.1, x.2 + y.2));
+    volume < -INWARD_VOLUME * bounds_volume && on_bounds < ON_BOUNDS * area
 }
 
 /// A hole through the model's middle whose width, both ways across, is under this fraction of
