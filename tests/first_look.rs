@@ -933,7 +933,7 @@ fn assert_same_look(right: &Scene, back: &Scene) {
         back.camera,
         right.camera
     );
-    let (a, b) = (pixels(&right), pixels(&back));
+    let (a, b) = (pixels(right), pixels(back));
     let differ = a
         .iter()
         .zip(&b)
