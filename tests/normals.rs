@@ -372,6 +372,47 @@ fn textured_tri() -> (tempfile::TempDir, std::path::PathBuf) {
 }
 
 #[test]
+fn a_black_kd_under_a_texture_takes_the_texture_as_its_colour() {
+    // Maya writes `Kd 0` under every texture: read as Kd × texel, the texture never shows.
+    let (dir, scene_file) = textured_tri();
+    std::fs::write(dir.path().join("red.png"), png_bytes(1, 1, &[255, 0, 0])).expect("png");
+    let diffuse_at_centre = |mtl: &str| {
+        std::fs::write(dir.path().join("t.mtl"), mtl).expect("mtl");
+        let scene = load_scene_file(&scene_file).unwrap_or_else(|e| panic!("{e}"));
+        let warnings = scene.warnings.clone();
+        let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());
+        let tree = pixel_tree(&tracer, 4, 4).expect("centre pixel");
+        (tree.root.local.expect("shaded").diffuse, warnings)
+    };
+    let (red, warnings) = diffuse_at_centre("newmtl t\nKd 0 0 0\nmap_Kd red.png\n");
+    assert!(
+        red.x > 0.0 && red.y == 0.0 && red.z == 0.0,
+        "the red texel shows: {red}"
+    );
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(
+        warnings[0].contains("material `t` has `Kd 0` under a `map_Kd`")
+            && warnings[0].contains("`Kd 1` is taken"),
+        "{}",
+        warnings[0]
+    );
+    // Its diffuse term is the texel's, as under `Kd 1`.
+    let (white, _) = diffuse_at_centre("newmtl t\nKd 1 1 1\nmap_Kd red.png\n");
+    assert!(red.abs_diff_eq(white, 1e-6), "{red} against {white}");
+    // Without the texture, a black `Kd` stays black; a scene's `[[material]]` of that name
+    // keeps its colours.
+    let (black, warnings) = diffuse_at_centre("newmtl t\nKd 0 0 0\nmap_Kd nope.png\n");
+    assert_eq!(black, Vec3::ZERO, "{warnings:?}");
+    std::fs::write(
+        &scene_file,
+        format!("{CAMERA}[[material]]\nname = \"tri/t\"\ndiffuse = [0, 0, 0]\n\n[[mesh]]\nfile = \"tri.obj\"\n"),
+    )
+    .expect("toml");
+    let (chosen, warnings) = diffuse_at_centre("newmtl t\nKd 0 0 0\nmap_Kd red.png\n");
+    assert_eq!(chosen, Vec3::ZERO, "the scene's own black: {warnings:?}");
+}
+
+#[test]
 fn map_kd_multiplies_kd_and_the_tree_shows_uv_and_texel() {
     let (dir, scene_file) = textured_tri();
     std::fs::write(

@@ -434,6 +434,66 @@ fn mtl_maps_to_phong_materials() {
     );
 }
 
+/// Maya's exporter writes `illum 4` (glass) and a `Tf` on every material, walls and windows
+/// alike, `Tf` meaning opacity: read as plain materials, `Tf` below 1 as glass.
+#[test]
+fn mayas_illum_4_on_every_material_reads_tf_as_opacity() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let obj = "mtllib room.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl wall\nf 1 2 3\nusemtl window\nf 1 2 3\nusemtl frosted\nf 1 2 3\n";
+    let maya = |name: &str, tf: &str| {
+        format!(
+            "newmtl {name}\nillum 4\nKd 0.50 0.50 0.50\nKa 0.00 0.00 0.00\nTf {tf}\nNi 1.00\nKs 0.50 0.50 0.50\n\n"
+        )
+    };
+    let library = maya("wall", "1.00 1.00 1.00")
+        + &maya("window", "0.00 0.00 0.00")
+        + &maya("frosted", "0.25 0.50 0.75");
+    std::fs::write(dir.path().join("room.obj"), obj).expect("write");
+    std::fs::write(dir.path().join("room.mtl"), &library).expect("write");
+    let scene = load_scene_file(&dir.path().join("room.obj")).unwrap_or_else(|e| panic!("{e}"));
+    let wall = material(&scene, "room/wall");
+    assert_eq!(wall.transparency, Vec3::ZERO, "wall: opaque");
+    assert_eq!(wall.reflectivity, Vec3::ZERO, "wall: no mirror");
+    let window = material(&scene, "room/window");
+    assert_eq!(window.transparency, Vec3::ONE, "window: clear");
+    assert_eq!(
+        window.reflectivity,
+        Vec3::splat(0.5),
+        "window: glass reflects Ks"
+    );
+    let frosted = material(&scene, "room/frosted");
+    assert!(
+        frosted.transparency.abs_diff_eq(Vec3::splat(0.5), 1e-6),
+        "frosted: 1 − mean Tf, got {}",
+        frosted.transparency
+    );
+    let note: Vec<&String> = scene
+        .warnings
+        .iter()
+        .filter(|w| w.contains("Maya"))
+        .collect();
+    assert_eq!(note.len(), 1, "{:?}", scene.warnings);
+    assert!(
+        note[0].contains("all 3 materials")
+            && note[0].contains("the 2 with `Tf` below 1 are glass"),
+        "{}",
+        note[0]
+    );
+    // One material with a `d` of its own: the library is no Maya export, and `illum 4`
+    // without `d` stays glass.
+    let library = maya("wall", "1.00 1.00 1.00")
+        + &maya("window", "0.00 0.00 0.00")
+        + "newmtl frosted\nKd 1 1 1\nd 1\nillum 2\n";
+    std::fs::write(dir.path().join("room.mtl"), &library).expect("write");
+    let scene = load_scene_file(&dir.path().join("room.obj")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(material(&scene, "room/wall").transparency, Vec3::splat(0.9));
+    assert!(
+        !scene.warnings.iter().any(|w| w.contains("Maya")),
+        "{:?}",
+        scene.warnings
+    );
+}
+
 #[test]
 fn material_override_ignores_the_mtl_and_missing_mtl_warns() {
     let obj = "mtllib gone.mtl\nusemtl shiny\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";

@@ -13,11 +13,11 @@ use super::attributes::{Corners, finish_attributes};
 use super::corners::{self, FaceCorners};
 use super::faces::{Faces, Given, PLACED, dropped, fit_normals, keep_placed};
 use super::memory::check_memory;
-use super::mtl::{Libraries, mtl_material, named_material, warn_unknown_usemtl};
+use super::mtl::{Libraries, mtl_material, named_material, read_maya_illum, warn_unknown_usemtl};
 use super::parse::Facts;
 use super::read::{ObjProblem, join_continued_lines, read_models, respell, scan};
 use super::request::MeshRequest;
-use crate::scene::diag::short_path;
+use crate::scene::diag::{list_some, short, short_path};
 use crate::scene::{MaterialId, MeshAttributes, MeshPart, NormalsMode, Scene};
 
 /// The name tobj gives the faces before any `o` or `g` (and an `o` or `g` without a name).
@@ -64,13 +64,14 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
     };
     check_memory(scene, req.text.len(), &facts, req.normals)?;
     let libraries = Libraries::new(req);
-    let (mut models, mtl_materials, fast) =
+    let (mut models, mut mtl_materials, fast) =
         read_models(req.text, scanned, |path| libraries.load(path))?;
     if facts.ngons > 0 {
         super::polygons::cut_concave_faces(&mut models, req.text);
     }
     let face_corners = face_corners(req.text, &models, fast, fast_corners)?;
     let (mut warnings, mtl_texts) = libraries.finish();
+    read_maya_illum(&mut mtl_materials, req.label, &mut warnings);
     warn_about_reading(req, &facts, &mtl_materials, &mut warnings);
     if made_white > 0 {
         let (which, give) = match made_white {
@@ -235,6 +236,8 @@ struct MeshBuild<'a> {
     warnings: Vec<String>,
     /// Textures not where the MTL says but found next to the OBJ: (as written, as found).
     textures_elsewhere: Vec<(String, String)>,
+    /// MTL materials whose black `Kd` under a texture was taken as 1 ([`mtl_material`]).
+    black_under_texture: Vec<String>,
     /// The smoothing group of each triangle read (file order), when the mesh is shaded by its
     /// groups ([`MeshBuild::read_groups`]), and of each triangle kept.
     file_groups: Option<Vec<u32>>,
@@ -281,6 +284,7 @@ impl<'a> MeshBuild<'a> {
             corners: Corners::default(),
             warnings,
             textures_elsewhere: Vec::new(),
+            black_under_texture: Vec::new(),
             file_groups: None,
             groups: Vec::new(),
         }
@@ -427,14 +431,19 @@ impl<'a> MeshBuild<'a> {
             (Some(id), _) => id,
             (None, Some(i)) if i < mtl_materials.len() => {
                 *self.mtl_ids[i].get_or_insert_with(|| {
-                    mtl_material(
+                    let (id, brightened) = mtl_material(
                         scene,
                         self.req,
                         &mtl_materials[i],
                         mtl_texts,
                         &mut self.warnings,
                         &mut self.textures_elsewhere,
-                    )
+                    );
+                    if brightened {
+                        self.black_under_texture
+                            .push(format!("`{}`", short(&mtl_materials[i].name)));
+                    }
+                    id
                 })
             }
             (None, _) if !mesh.texcoords.is_empty() => {
@@ -506,6 +515,17 @@ impl<'a> MeshBuild<'a> {
                 if n == 1 { "a texture is".to_string() } else { format!("{n} textures are") },
                 short_path(written),
                 short_path(found),
+            ));
+        }
+        if !self.black_under_texture.is_empty() {
+            let names = &self.black_under_texture;
+            let which = match names.len() {
+                1 => format!("material {} has", names[0]),
+                _ => format!("materials {} have", list_some(names)),
+            };
+            warnings.push(format!(
+                "{}: {which} `Kd 0` under a `map_Kd` (as Maya writes), which would never show the texture: `Kd 1` is taken, the texture being the colour.",
+                req.label
             ));
         }
         scene.warnings.extend(self.warnings);

@@ -239,8 +239,67 @@ pub(super) fn warn_unknown_usemtl(
     }
 }
 
+/// `illum 4` with a `Tf` and no `d` or `Tr` on every material, as Maya's exporter writes
+/// every material whatever it is: `illum 4` there is no glass and no mirror, and `Tf` is the
+/// material's opacity (`Tf 1` opaque, `Tf 0` clear: walls and windows), where by the MTL
+/// definition it filters light passing through. Each such material is read as a plain one
+/// (`illum 2`) with `d` the mean of its `Tf`; one below 1 stays glass (`illum 4`), its
+/// transparency `1 − Tf`. One note says so. Other libraries are left as they are.
+pub(crate) fn read_maya_illum(
+    materials: &mut [tobj::Material],
+    label: &str,
+    warnings: &mut Vec<String>,
+) {
+    let filter = |m: &tobj::Material| -> Option<f32> {
+        let words: Vec<f32> = m
+            .unknown_param
+            .get("Tf")?
+            .split_whitespace()
+            .map(|w| w.parse::<f32>().ok().filter(|x| (0.0..=1.0).contains(x)))
+            .collect::<Option<_>>()?;
+        (!words.is_empty()).then(|| words.iter().sum::<f32>() / words.len() as f32)
+    };
+    let maya = !materials.is_empty()
+        && materials.iter().all(|m| {
+            m.illumination_model == Some(4)
+                && m.dissolve.is_none()
+                && !m.unknown_param.contains_key("Tr")
+                && filter(m).is_some()
+        });
+    if !maya {
+        return;
+    }
+    let mut clear = 0;
+    for m in materials.iter_mut() {
+        let opacity = filter(m).unwrap_or(1.0);
+        m.dissolve = Some(opacity);
+        if opacity >= 1.0 {
+            m.illumination_model = Some(2);
+        } else {
+            clear += 1;
+        }
+    }
+    let n = materials.len();
+    let all = if n == 1 {
+        "its one material".to_string()
+    } else {
+        format!("all {n} materials")
+    };
+    let glass = match clear {
+        0 => String::new(),
+        1 => "; the 1 with `Tf` below 1 is glass, its transparency 1 − Tf".to_string(),
+        k => format!("; the {k} with `Tf` below 1 are glass, their transparency 1 − Tf"),
+    };
+    warnings.push(format!(
+        "{label}: `illum 4` (glass) with `Tf` and no `d` on {all}, as Maya writes every material: read as plain materials, `Tf` as their opacity{glass}."
+    ));
+}
+
 /// The scene material for an MTL material: `<object>/<mtl name>`, reusing a scene material of
 /// that name if the scene file defines one (so edited materials survive a save and reload).
+/// A new material whose `Kd` is black under a `map_Kd` that loads (Maya writes `Kd 0` under
+/// every texture) takes `Kd 1`, the texture being its colour, as the texture would otherwise
+/// never show; the second value says so, for the caller's note.
 pub(super) fn mtl_material(
     scene: &mut Scene,
     req: &MeshRequest,
@@ -248,14 +307,14 @@ pub(super) fn mtl_material(
     mtl_texts: &[(String, String)],
     warnings: &mut Vec<String>,
     textures_elsewhere: &mut Vec<(String, String)>,
-) -> MaterialId {
+) -> (MaterialId, bool) {
     let name = format!("{}/{}", req.object_name, m.name);
-    let id = match scene.materials.iter().position(|x| x.name == name) {
-        Some(i) => MaterialId(i as u32),
+    let (id, fresh) = match scene.materials.iter().position(|x| x.name == name) {
+        Some(i) => (MaterialId(i as u32), false),
         None => {
             let material = material_from_mtl(m, name, req.label, warnings);
             scene.materials.push(material);
-            MaterialId(scene.materials.len() as u32 - 1)
+            (MaterialId(scene.materials.len() as u32 - 1), true)
         }
     };
     // Textures come from the MTL even when a `[[material]]` of this name overrides its
@@ -289,7 +348,11 @@ pub(super) fn mtl_material(
         material.ambient_map = ambient;
         material.ambient_map_placement = placement(&m.ambient_texture);
     }
-    id
+    let brightened = fresh && diffuse.is_some() && material.diffuse == Vec3::ZERO;
+    if brightened {
+        material.diffuse = Vec3::ONE;
+    }
+    (id, brightened)
 }
 
 /// The material of an OBJ's textured faces that no material library gives one, when a texture
