@@ -419,12 +419,8 @@ impl Probe {
 fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32) -> FirstView {
     let center = 0.5 * (lo + hi);
     let half = 0.5 * (hi - lo);
-    // The horizontal axes, and the model's "front": +z for y-up OBJ files, -y for z-up ones.
-    let (side, front) = if up == Vec3::Z {
-        (Vec3::X, -Vec3::Y)
-    } else {
-        (Vec3::X, Vec3::Z)
-    };
+    // The horizontal axes: one across, and the model's front ([`model_front`]).
+    let (side, front) = (Vec3::X, model_front(up));
     let extent = |axis: Vec3| (half * axis).length();
     let dirs = directions(PROBE_DIRS);
     let curve = morton_order(triangles);
@@ -581,6 +577,11 @@ fn first_view(triangles: &[Triangle], lo: Vec3, hi: Vec3, up: Vec3, aspect: f32)
     }
 }
 
+/// A model's front, the side the camera looks from: +z for y-up OBJ files, -y for z-up ones.
+fn model_front(up: Vec3) -> Vec3 {
+    if up == Vec3::Z { -Vec3::Y } else { Vec3::Z }
+}
+
 /// The first view of a model seen from outside: from its front and a little above, or square
 /// to it when it is flat ([`flat_front`]).
 fn first_view_outside(
@@ -590,8 +591,7 @@ fn first_view_outside(
     up: Vec3,
     aspect: f32,
 ) -> FirstView {
-    let front = if up == Vec3::Z { -Vec3::Y } else { Vec3::Z };
-    let (front, elevation) = flat_front(triangles, 0.5 * (hi - lo), up, front);
+    let (front, elevation) = flat_front(triangles, 0.5 * (hi - lo), up, model_front(up));
     FirstView {
         camera: frame_outside(triangles, 0.5 * (lo + hi), up, front, elevation, aspect),
         room: None,

@@ -245,7 +245,7 @@ pub(super) fn warn_unknown_usemtl(
 /// definition it filters light passing through. Each such material is read as a plain one
 /// (`illum 2`) with `d` the mean of its `Tf`; one below 1 stays glass (`illum 4`), its
 /// transparency `1 − Tf`. One note says so. Other libraries are left as they are.
-pub(crate) fn read_maya_illum(
+pub(super) fn read_maya_illum(
     materials: &mut [tobj::Material],
     label: &str,
     warnings: &mut Vec<String>,
