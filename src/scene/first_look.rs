@@ -135,9 +135,9 @@ pub(crate) fn load_obj_scene(
     let aspect = scene.render.width.max(1) as f32 / scene.render.height.max(1) as f32;
     let mut look = first_view(&scene.triangles, lo, hi, up, aspect);
     // Without `vn`, the winding alone says which side of a face is its front. A model that
-    // opens as a room but whose faces face inwards, with little of its surface on its bounds
-    // (a scanned statue or an animal wound clockwise, where a room's walls, floor and ceiling
-    // lie on its bounds), is a thing wound the wrong way round: seen from outside.
+    // opens as a room but whose faces face inwards and cover little of its bounds' sides (a
+    // scanned statue or an animal wound clockwise, where a room's walls, floor and ceiling lie
+    // on its bounds), is a thing wound the wrong way round: seen from outside.
     if look.room.is_some() && !gives_normals(text) && faces_inward(&scene.triangles, lo, hi) {
         look = first_view_outside(&scene.triangles, lo, hi, up, aspect);
         scene.warnings.push(format!(
@@ -612,25 +612,27 @@ fn gives_normals(text: &str) -> bool {
 /// of its bounds' volume below zero for it to face inwards ([`faces_inward`]).
 const INWARD_VOLUME: f64 = 0.05;
 
-/// A room's walls, floor and ceiling lie on its bounds: a model with at least this fraction of
-/// its surface there faces inwards as a room does ([`faces_inward`]).
-const ON_BOUNDS: f64 = 0.25;
+/// A room's walls, floor and ceiling lie on its bounds: a model whose faces cover at least
+/// this fraction of its bounds' six sides faces inwards as a room does ([`faces_inward`]).
+const ON_BOUNDS: f64 = 0.15;
 
 /// Whether the faces face inwards the way a thing turned inside out does: the volume their
-/// winding encloses (about the bounds' centre) is clearly negative, and less than
-/// [`ON_BOUNDS`] of their area lies on the bounds' six faces (within 1 % of the largest
-/// extent), where a room's shell lies.
+/// winding encloses (about the bounds' centre) is clearly negative, and the faces lying on
+/// the bounds' six sides (within 1 % of the largest extent), where a room's shell lies, cover
+/// less than [`ON_BOUNDS`] of them. (Measured against the sides, not the model's own area, so
+/// that a room full of furniture still counts as a room.)
 fn faces_inward(triangles: &[Triangle], lo: Vec3, hi: Vec3) -> bool {
     use rayon::prelude::*;
     let extent = (hi - lo).as_dvec3();
     let bounds_volume = extent.x * extent.y * extent.z;
+    let sides = 2.0 * (extent.x * extent.y + extent.y * extent.z + extent.z * extent.x);
     if !(bounds_volume > 0.0 && bounds_volume.is_finite()) {
         return false;
     }
     let center = (0.5 * (lo + hi)).as_dvec3();
     let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
     let near = 0.01 * extent.max_element();
-    let (volume, area, on_bounds) = triangles
+    let (volume, on_bounds) = triangles
         .par_iter()
         .map(|t| {
             let [a, b, c] = t.vertices.map(|v| v.as_dvec3() - center);
@@ -643,10 +645,10 @@ fn faces_inward(triangles: &[Triangle], lo: Vec3, hi: Vec3) -> bool {
                 };
                 all(lo[axis]) || all(hi[axis])
             });
-            (a.dot(b.cross(c)) / 6.0, area, if on { area } else { 0.0 })
+            (a.dot(b.cross(c)) / 6.0, if on { area } else { 0.0 })
         })
-        .reduce(|| (0.0, 0.0, 0.0), |x, y| (x.0 + y.0, x.1 + y.1, x.2 + y.2));
-    volume < -INWARD_VOLUME * bounds_volume && on_bounds < ON_BOUNDS * area
+        .reduce(|| (0.0, 0.0), |x, y| (x.0 + y.0, x.1 + y.1));
+    volume < -INWARD_VOLUME * bounds_volume && on_bounds < ON_BOUNDS * sides
 }
 
 /// A hole through the model's middle whose width, both ways across, is under this fraction of
