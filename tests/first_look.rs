@@ -1014,6 +1014,28 @@ fn a_thing_wound_inside_out_without_normals_is_seen_from_outside() {
     let room = load(dir.path(), "room.obj", &room(false));
     assert!(inside(room.camera.position, &room), "the room: outside");
     assert_not_warned(&room, "room.obj", "wound clockwise");
+    // So does a store room whose stacks of boxes along two walls have five times the area of
+    // its walls, floor and ceiling: those cover its bounds all the same.
+    let mut store = String::new();
+    let mut base = 0;
+    let hi = Vec3::new(3.0, 4.0, 4.0);
+    cuboid(&mut store, &mut base, -hi.with_y(0.0), hi, true, &[]);
+    for x in [-2.9f32, -2.45, -2.0, 1.6, 2.05, 2.5] {
+        for i in 0..22 {
+            for j in 0..12 {
+                let lo = Vec3::new(x, 0.32 * j as f32, -3.9 + 0.35 * i as f32);
+                let size = Vec3::new(0.4, 0.3, 0.3);
+                cuboid(&mut store, &mut base, lo, lo + size, false, &[]);
+            }
+        }
+    }
+    let store = load(dir.path(), "store.obj", &store);
+    assert!(
+        inside(store.camera.position, &store),
+        "the store room: outside"
+    );
+    assert_warned(&store, "store.obj", &["(a room)"]);
+    assert_not_warned(&store, "store.obj", "wound clockwise");
 }
 
 /// A pipe of `segments` sides with walls of radius `inner` and `outer`, `length` long along
