@@ -1009,6 +1009,12 @@ fn a_thing_wound_inside_out_without_normals_is_seen_from_outside() {
     );
     assert_not_warned(&back, "ball_cw.obj", "(a room)");
     assert_same_look(&right, &back);
+    // With `vn` facing inwards as its winding does (a furnace test's sphere, made to be seen
+    // from inside), the file says which side is the front: it is still read as walls round
+    // its middle.
+    let furnace = load(dir.path(), "sphere.obj", &with_face_normals(&turned, false));
+    assert_not_warned(&furnace, "sphere.obj", "wound clockwise");
+    assert_warned(&furnace, "sphere.obj", &["walls around its middle"]);
     // A room without `vn` faces inwards too, its walls, floor and ceiling on its bounds: it
     // stays a room.
     let room = load(dir.path(), "room.obj", &room(false));

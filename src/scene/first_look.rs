@@ -138,7 +138,7 @@ pub(crate) fn load_obj_scene(
     // opens as a room but whose faces face inwards and cover little of its bounds' sides (a
     // scanned statue or an animal wound clockwise, where a room's walls, floor and ceiling lie
     // on its bounds), is a thing wound the wrong way round: seen from outside.
-    if look.room.is_some() && !gives_normals(text) && faces_inward(&scene.triangles, lo, hi) {
+    if look.room.is_some() && faces_inward(&scene.triangles, lo, hi) && !gives_normals(text) {
         look = first_view_outside(&scene.triangles, lo, hi, up, aspect);
         scene.warnings.push(format!(
             "{label}: the model's faces are wound clockwise seen from outside (they face inwards, and no `vn` says otherwise), yet it is no room: it is seen from outside."
@@ -599,12 +599,14 @@ fn first_view_outside(
     }
 }
 
-/// Whether an OBJ's text has vertex normals (`vn` lines).
+/// Whether an OBJ's text has vertex normals (`vn` lines, indented or not). A search for the
+/// statement, not a walk over the lines: a million-triangle file without any is read through.
 fn gives_normals(text: &str) -> bool {
-    text.lines().any(|line| {
-        line.trim_start()
-            .strip_prefix("vn")
-            .is_some_and(|rest| rest.starts_with(char::is_whitespace))
+    text.match_indices("vn").any(|(at, _)| {
+        let before = text[..at].trim_end_matches([' ', '\t']);
+        let after = text[at + 2..].chars().next();
+        (before.is_empty() || before.ends_with('\n'))
+            && after.is_some_and(|c| c == ' ' || c == '\t')
     })
 }
 
@@ -1053,5 +1055,30 @@ fn nothing_to_show(label: &str, text: &str) -> String {
         None => format!(
             "{label}: {lead}: its {faces} faces all have zero area or fewer than three corners."
         ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::gives_normals;
+
+    #[test]
+    fn vertex_normals_are_found_as_statements_only() {
+        for text in [
+            "vn 0 0 1\n",
+            "v 0 0 0\nvn 0 1 0\nf 1//1 1//1 1//1\n",
+            "v 0 0 0\r\n  vn\t0 1 0\r\n",
+        ] {
+            assert!(gives_normals(text), "{text:?}");
+        }
+        for text in [
+            "",
+            "v 0 0 0\nf 1 2 3\n",
+            "usemtl vn\nvt 0 0\n",
+            "# vn 0 0 1\n",
+            "o avn 1\nvnx 1 2 3\n",
+        ] {
+            assert!(!gives_normals(text), "{text:?}");
+        }
     }
 }
