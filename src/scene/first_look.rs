@@ -55,7 +55,7 @@ pub(crate) fn load_obj_scene(
         let at = p.line.map(|l| format!(":{l}")).unwrap_or_default();
         SceneError(format!("{label}{at}: cannot load the OBJ: {}.", p.reason))
     })?;
-    if added == 0 {
+    if added.triangles == 0 {
         return Err(SceneError(nothing_to_show(label, text)));
     }
     // A readable first look: a low ambient light, so that Blender's `Ka 1` does
@@ -138,7 +138,7 @@ pub(crate) fn load_obj_scene(
     // opens as a room but whose faces face inwards and cover little of its bounds' sides (a
     // scanned statue or an animal wound clockwise, where a room's walls, floor and ceiling lie
     // on its bounds), is a thing wound the wrong way round: seen from outside.
-    if look.room.is_some() && faces_inward(&scene.triangles, lo, hi) && !gives_normals(text) {
+    if look.room.is_some() && !added.gives_normals && faces_inward(&scene.triangles, lo, hi) {
         look = first_view_outside(&scene.triangles, lo, hi, up, aspect);
         scene.warnings.push(format!(
             "{label}: the model's faces are wound clockwise seen from outside (they face inwards, and no `vn` says otherwise), yet it is no room: it is seen from outside."
@@ -599,17 +599,6 @@ fn first_view_outside(
     }
 }
 
-/// Whether an OBJ's text has vertex normals (`vn` lines, indented or not). A search for the
-/// statement, not a walk over the lines: a million-triangle file without any is read through.
-fn gives_normals(text: &str) -> bool {
-    text.match_indices("vn").any(|(at, _)| {
-        let before = text[..at].trim_end_matches([' ', '\t']);
-        let after = text[at + 2..].chars().next();
-        (before.is_empty() || before.ends_with('\n'))
-            && after.is_some_and(|c| c == ' ' || c == '\t')
-    })
-}
-
 /// The model's enclosed volume, signed by its faces' winding, must be at least this fraction
 /// of its bounds' volume below zero for it to face inwards ([`faces_inward`]).
 const INWARD_VOLUME: f64 = 0.05;
@@ -1055,30 +1044,5 @@ fn nothing_to_show(label: &str, text: &str) -> String {
         None => format!(
             "{label}: {lead}: its {faces} faces all have zero area or fewer than three corners."
         ),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::gives_normals;
-
-    #[test]
-    fn vertex_normals_are_found_as_statements_only() {
-        for text in [
-            "vn 0 0 1\n",
-            "v 0 0 0\nvn 0 1 0\nf 1//1 1//1 1//1\n",
-            "v 0 0 0\r\n  vn\t0 1 0\r\n",
-        ] {
-            assert!(gives_normals(text), "{text:?}");
-        }
-        for text in [
-            "",
-            "v 0 0 0\nf 1 2 3\n",
-            "usemtl vn\nvt 0 0\n",
-            "# vn 0 0 1\n",
-            "o avn 1\nvnx 1 2 3\n",
-        ] {
-            assert!(!gives_normals(text), "{text:?}");
-        }
     }
 }

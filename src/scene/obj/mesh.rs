@@ -23,9 +23,18 @@ use crate::scene::{MaterialId, MeshAttributes, MeshPart, NormalsMode, Scene};
 /// The name tobj gives the faces before any `o` or `g` (and an `o` or `g` without a name).
 const UNNAMED: &str = "unnamed_object";
 
+/// What [`add_mesh`] added.
+pub(crate) struct Added {
+    /// Triangles added.
+    pub triangles: usize,
+    /// The file has vertex normals (`vn` statements): they, not the winding alone, say which
+    /// side of a face is its front.
+    pub gives_normals: bool,
+}
+
 /// Adds the OBJ's triangles (placed, degenerate ones dropped) and the MTL materials they use
-/// to `scene`; returns how many triangles were added.
-pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, ObjProblem> {
+/// to `scene`.
+pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<Added, ObjProblem> {
     let joined = join_continued_lines(req.text);
     let with_joined;
     let req = match &joined {
@@ -123,7 +132,10 @@ pub(crate) fn add_mesh(scene: &mut Scene, req: &MeshRequest) -> Result<usize, Ob
         build.add_model(scene, &model.mesh, &mtl_texts);
         add_part(scene, req, &model.name, start);
     }
-    Ok(build.finish(scene, &face_corners))
+    Ok(Added {
+        triangles: build.finish(scene, &face_corners),
+        gives_normals: facts.normals > 0,
+    })
 }
 
 /// Names the triangles a model added from `start` on after its `o` or `g` (tobj's model name):

@@ -250,7 +250,14 @@ pub(super) fn read_maya_illum(
     label: &str,
     warnings: &mut Vec<String>,
 ) {
-    let filter = |m: &tobj::Material| -> Option<f32> {
+    // The mean of a material's `Tf`, if it is written as Maya writes every material.
+    let opacity = |m: &tobj::Material| -> Option<f32> {
+        if m.illumination_model != Some(4)
+            || m.dissolve.is_some()
+            || m.unknown_param.contains_key("Tr")
+        {
+            return None;
+        }
         let words: Vec<f32> = m
             .unknown_param
             .get("Tf")?
@@ -259,26 +266,17 @@ pub(super) fn read_maya_illum(
             .collect::<Option<_>>()?;
         (!words.is_empty()).then(|| words.iter().sum::<f32>() / words.len() as f32)
     };
-    let maya = !materials.is_empty()
-        && materials.iter().all(|m| {
-            m.illumination_model == Some(4)
-                && m.dissolve.is_none()
-                && !m.unknown_param.contains_key("Tr")
-                && filter(m).is_some()
-        });
-    if !maya {
+    let opacities: Option<Vec<f32>> = materials.iter().map(opacity).collect();
+    let Some(opacities) = opacities.filter(|o| !o.is_empty()) else {
         return;
-    }
-    let mut clear = 0;
-    for m in materials.iter_mut() {
-        let opacity = filter(m).unwrap_or(1.0);
+    };
+    for (m, &opacity) in materials.iter_mut().zip(&opacities) {
         m.dissolve = Some(opacity);
         if opacity >= 1.0 {
             m.illumination_model = Some(2);
-        } else {
-            clear += 1;
         }
     }
+    let clear = opacities.iter().filter(|&&o| o < 1.0).count();
     let n = materials.len();
     let all = if n == 1 {
         "its one material".to_string()

@@ -340,7 +340,7 @@ impl SceneBuilder<'_> {
             },
         )
         .map_err(|p| cannot(format!("{}{}", short_path(&file), p.with_line())))?;
-        if loaded == 0 {
+        if loaded.triangles == 0 {
             self.scene.warnings.push(format!(
                 "{}: the mesh has no triangles to show.",
                 short_path(&file)
