@@ -11,7 +11,8 @@ use std::sync::Arc;
 use glam::Vec3;
 use raytree::render::render;
 use raytree::scene::{Material, Scene, load_scene_file};
-use raytree::scene_view::cutaway::encloses_render_camera;
+use raytree::scene_view::cutaway::{Cutaway, encloses_render_camera};
+use raytree::scene_view::overview::{Candidate, FOV_Y_DEG, candidates, overview};
 use raytree::trace::{TraceSettings, Tracer};
 
 /// The walls of a closed box `[-3, 3] × [0, 4] × [-4, 4]`, counter-clockwise seen from inside,
@@ -360,10 +361,9 @@ fn walls_without_a_ceiling_are_seen_from_above_outside() {
 /// Cornell-box colours: white, red and green walls of `Kd 1` (no `Ka`).
 const CORNELL_MTL: &str = "newmtl white\nKa 0 0 0\nKd 1 1 1\nKs 0 0 0\n\nnewmtl red\nKa 0 0 0\nKd 1 0 0\nKs 0 0 0\n\nnewmtl green\nKa 0 0 0\nKd 0 1 0\nKs 0 0 0\n";
 
-#[test]
-fn a_box_open_on_one_side_is_seen_through_its_opening_without_clipping_white() {
-    // Open at −z, as the Cornell box's data is; the camera used to stand at +z and see the
-    // back of the box.
+/// A Cornell box 5.5 on a side open at −z (as the Cornell box's data is), white with a red
+/// and a green wall, two white boxes in it: its OBJ text and bounds.
+fn cornell() -> (String, Vec3, Vec3) {
     let mut text = String::from("mtllib cornell.mtl\nusemtl white\n");
     let mut base = 0;
     let (lo, hi) = (Vec3::new(0.0, 0.0, 0.0), Vec3::new(5.5, 5.5, 5.5));
@@ -389,9 +389,22 @@ fn a_box_open_on_one_side_is_seen_through_its_opening_without_clipping_white() {
         false,
         &[],
     );
+    (text, lo, hi)
+}
+
+/// The Cornell box of [`cornell`] loaded from a temporary folder.
+fn load_cornell(dir: &Path) -> Scene {
+    let (text, _, _) = cornell();
+    std::fs::write(dir.join("cornell.mtl"), CORNELL_MTL).expect("write");
+    load(dir, "cornell.obj", &text)
+}
+
+#[test]
+fn a_box_open_on_one_side_is_seen_through_its_opening_without_clipping_white() {
+    // The camera used to stand at +z and see the back of the box.
+    let (_, lo, _) = cornell();
     let dir = tempfile::tempdir().expect("temp dir");
-    std::fs::write(dir.path().join("cornell.mtl"), CORNELL_MTL).expect("write");
-    let scene = load(dir.path(), "cornell.obj", &text);
+    let scene = load_cornell(dir.path());
     assert!(
         scene.camera.position.z < lo.z,
         "camera at {}, not in front of the opening",
@@ -402,6 +415,61 @@ fn a_box_open_on_one_side_is_seen_through_its_opening_without_clipping_white() {
     let key = scene.lights[0].position;
     assert!(inside(key, &scene), "key light at {key}, outside the box");
     assert_readable(&scene, "cornell.obj", 0.15..0.75, 0.01);
+}
+
+/// The directions the scene view may first look from, scored on `scene`, and the one taken.
+fn scene_view_looks(scene: Scene) -> (Vec<Candidate>, usize) {
+    let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());
+    let aspect = 4.0 / 3.0;
+    let all = candidates(&tracer, aspect, FOV_Y_DEG);
+    let chosen = overview(&tracer, aspect, FOV_Y_DEG, Cutaway::Auto);
+    let taken = all
+        .iter()
+        .position(|c| c.camera == chosen)
+        .expect("the first look is one of the candidates");
+    let sees: Vec<f32> = all.iter().map(|c| c.sees).collect();
+    eprintln!("sees {sees:?}, taken {taken}");
+    (all, taken)
+}
+
+/// The scene view's first look at a box open on one side sees into it: from its preferred
+/// side, beside the render camera, it saw the outside of a side wall.
+#[test]
+fn the_scene_view_first_looks_into_a_box_open_on_one_side() {
+    let (_, lo, _) = cornell();
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (all, taken) = scene_view_looks(load_cornell(dir.path()));
+    let best = all.iter().map(|c| c.sees).fold(0.0, f32::max);
+    assert!(
+        all[0].sees < 0.75 * best,
+        "from beside the box the view sees {} of it, the best {best}",
+        all[0].sees
+    );
+    assert!(taken > 0 && all[taken].sees >= 0.8 * best);
+    let eye = all[taken].camera.position;
+    assert!(
+        eye.z < lo.z,
+        "the view's eye {eye} is not on the opening's side"
+    );
+}
+
+/// Where the preferred side sees the scene (Whitted's spheres on their floor) or the render
+/// camera stands in a closed room (the cut-away opens it from there), the first look keeps it.
+#[test]
+fn the_scene_view_first_looks_from_beside_the_render_camera_where_that_sees() {
+    let open = raytree::scene::load_builtin("default").expect("built-in");
+    let (all, taken) = scene_view_looks(open);
+    assert_eq!(taken, 0);
+    let best = all.iter().map(|c| c.sees).fold(0.0, f32::max);
+    assert!(
+        all[0].sees > 0.8 * best,
+        "{} of the best {best}",
+        all[0].sees
+    );
+    let room = raytree::scene::load_builtin("box").expect("built-in");
+    let (all, taken) = scene_view_looks(room.clone());
+    assert!(encloses_render_camera(&room, all[0].camera.position));
+    assert_eq!(taken, 0);
 }
 
 #[test]

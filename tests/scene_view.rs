@@ -13,7 +13,9 @@ mod golden_support;
 use glam::Vec3;
 use golden_support::{golden_path, mismatch, read_png};
 use raytree::scene::{Camera, CameraFrame, Object, ObjectId, ObjectSource, Scene, Sphere};
+use raytree::scene_view::cutaway::Cutaway;
 use raytree::scene_view::occlusion::DepthImage;
+use raytree::scene_view::overview::{FOV_Y_DEG, overview};
 use raytree::scene_view::raster::{Canvas, line_width};
 use raytree::scene_view::{Filter, Segment, Style, headless};
 use raytree::trace::{RayKind, TraceSettings, Tracer};
@@ -256,7 +258,7 @@ fn the_command_refuses_a_view_without_a_frame_in_one_sentence() {
 }
 
 #[test]
-fn the_command_wants_eye_and_target_with_a_scene_view() {
+fn the_command_wants_eye_and_target_together() {
     let (code, err) = refused(&["--scene-view", "v.png", "--target", "0,0,0"]);
     assert_eq!(code, Some(2));
     assert!(err.contains("--eye"), "{err}");
@@ -270,6 +272,57 @@ fn the_command_wants_eye_and_target_with_a_scene_view() {
     ]);
     assert_eq!(code, Some(2));
     assert!(err.contains("`x` is not a number"), "{err}");
+}
+
+/// Without --eye and --target the view is the viewer's first look: the same picture as from
+/// the camera [`overview`] gives, named with the flags. --up and --fov are of a view given.
+#[test]
+fn without_an_eye_the_command_draws_the_viewers_first_look() {
+    let scene = raytree::scene::load_builtin("default").expect("built-in");
+    let (w, h) = (scene.render.width, scene.render.height);
+    let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());
+    let first = overview(&tracer, w as f32 / h as f32, FOV_Y_DEG, Cutaway::Auto);
+    let dir = tempfile::tempdir().expect("temp dir");
+    let run = |name: &str, extra: &[String]| {
+        let out = raytree()
+            .args([
+                "tree",
+                "default",
+                "--pixel",
+                "250,270",
+                "--scene-view",
+                name,
+            ])
+            .args(extra)
+            .current_dir(dir.path())
+            .output()
+            .expect("runs");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        read_png(&dir.path().join(name), png::ColorType::Rgba, "no golden")
+    };
+    let v3 = |v: Vec3| format!("{},{},{}", v.x, v.y, v.z);
+    let own = run("first.png", &[]);
+    let given = run(
+        "given.png",
+        &[
+            format!("--eye={}", v3(first.position)),
+            format!("--target={}", v3(first.look_at)),
+            format!("--up={}", v3(first.up)),
+            format!("--fov={}", first.fov_y_deg),
+        ],
+    );
+    assert_eq!((own.0, own.1), (w, h));
+    assert!(own == given, "the first look differs from its camera given");
+    let (code, err) = refused(&["--scene-view", "v.png", "--up", "0,0,1"]);
+    assert_eq!(code, Some(2));
+    assert!(err.contains("--eye"), "{err}");
+    let (code, err) = refused(&["--scene-view", "v.png", "--fov", "500"]);
+    assert_eq!(code, Some(1));
+    assert!(err.contains("--fov"), "{err}");
 }
 
 /// A closed room of twelve triangles (-2..2 on each axis, brown walls) around the render
@@ -418,7 +471,6 @@ fn colour_along(
 /// hide them (dimmed over the wall, not their colour).
 #[test]
 fn the_cut_away_shows_the_rays_inside_a_closed_room() {
-    use raytree::scene_view::cutaway::Cutaway;
     let dir = tempfile::tempdir().expect("temp dir");
     let scene = raytree::scene::files::load_scene_file(&closed_room(dir.path())).expect("loads");
     assert_eq!(scene.triangles.len(), 12);

@@ -24,7 +24,6 @@ use std::time::{Duration, Instant};
 
 use eframe::egui::containers::menu::{self, MenuButton, MenuConfig};
 use eframe::egui::{self, Color32, Sense, Ui};
-use glam::Vec3;
 
 use super::film::Film;
 use super::modes::ImageMode;
@@ -35,10 +34,10 @@ use super::workspace::Prefs;
 use super::{Command, tree_view};
 use crate::accel::Accel;
 use crate::render::session::{Session, SessionEvent, View};
-use crate::scene::camera::FRAME_MARGIN;
 use crate::scene::{Camera, CameraFrame, Scene};
 use crate::scene_view::cutaway::{Cutaway, cut_triangles, with_cut};
-use crate::scene_view::{self, Filter, LevelSegments, Segment, Style, box_corner};
+use crate::scene_view::overview::{self, overview};
+use crate::scene_view::{self, Filter, LevelSegments, Segment, Style};
 use crate::trace::{EndReason, Tracer};
 
 /// The longest side of the scene view's image, in pixels.
@@ -132,36 +131,12 @@ impl SceneView {
     }
 
     /// Frames the camera on the scene's bounds and the render camera's eye, from the render
-    /// camera's side (a little above), so the frustum and the rays are seen across.
-    pub fn frame(&mut self, scene: &Scene) {
-        let eye = scene.camera.position;
-        let (lo, hi) = scene
-            .bounds()
-            .map_or((eye - Vec3::ONE, eye + Vec3::ONE), |(lo, hi)| {
-                (lo.min(eye), hi.max(eye))
-            });
-        let view = (scene.camera.look_at - eye).normalize_or(Vec3::NEG_Z);
-        let up = scene.camera.up.normalize_or(Vec3::Y);
-        let side = view.cross(up).normalize_or(Vec3::X);
-        let direction = (side + up * 0.45 - view * 0.25).normalize();
-        let base = Camera {
-            fov_y_deg: 45.0,
-            up,
-            ..scene.camera.clone()
-        };
-        let mut camera = base.framing(lo, hi, direction);
-        // `framing` fits the bounding sphere in the vertical field, which leaves a flat scene
-        // (a floor and a few objects) small in the pane: the camera comes as close as the
-        // box's eight corners allow, in both fields of the pane (the narrower one across
-        // when the pane is narrower than tall), with the same margin.
+    /// camera's side where that sees what it sees ([`overview`]), so the frustum and the rays
+    /// are seen across.
+    pub fn frame(&mut self, tracer: &Tracer) {
         let (w, h) = self.size;
         let aspect = w as f32 / h.max(1) as f32;
-        let tan_y = (0.5 * camera.fov_y_deg).to_radians().min(1.5).tan();
-        let tan_x = aspect * tan_y;
-        if let Some(distance) = corner_fit(lo, hi, direction, up, tan_x, tan_y) {
-            camera.position = camera.look_at + direction * distance;
-        }
-        self.camera = camera;
+        self.camera = overview(tracer, aspect, overview::FOV_Y_DEG, self.cutaway);
         self.framed = true;
         self.framed_view = Some((self.size, self.camera.clone()));
     }
@@ -188,7 +163,7 @@ impl SceneView {
         let resized = matches!(&self.framed_view,
             Some((size, camera)) if *size != self.size && *camera == self.camera);
         if !self.framed || resized {
-            self.frame(&tracer.scene);
+            self.frame(tracer);
         }
         let (w, h) = self.size;
         let view = View {
@@ -422,7 +397,7 @@ fn speed_and_frame(ui: &mut Ui, view: &mut SceneView, tracer: &Arc<Tracer>, labe
         .on_hover_text("frame the scene and the render camera")
         .clicked()
     {
-        view.frame(&tracer.scene);
+        view.frame(tracer);
         view.restart(tracer);
     }
     cutaway_choice(ui, view, tracer);
@@ -745,37 +720,6 @@ pub fn scene_view_ui(
     }
 }
 
-/// The distance from the centre of `lo..hi` along the unit `direction` (from the centre towards
-/// the eye) at which every corner of the box lies inside a view whose half fields have
-/// tangents `tan_x` across and `tan_y` up, with [`FRAME_MARGIN`]; `None` for a degenerate view.
-fn corner_fit(
-    lo: Vec3,
-    hi: Vec3,
-    direction: Vec3,
-    up: Vec3,
-    tan_x: f32,
-    tan_y: f32,
-) -> Option<f32> {
-    let right = up.cross(direction).normalize_or_zero();
-    let upward = direction.cross(right);
-    if right == Vec3::ZERO || !(tan_x > 0.0 && tan_y > 0.0) {
-        return None;
-    }
-    let center = 0.5 * (lo + hi);
-    let mut distance = 0.0f32;
-    for k in 0..8 {
-        let q = box_corner(lo, hi, k) - center;
-        // The corner's depth in front of an eye at `distance` is `distance − q·direction`.
-        let across = q.dot(direction) + FRAME_MARGIN * q.dot(right).abs() / tan_x;
-        let upwards = q.dot(direction) + FRAME_MARGIN * q.dot(upward).abs() / tan_y;
-        distance = distance.max(across).max(upwards);
-    }
-    // Never inside the box's bounding sphere, where the near corners would pass the eye.
-    let radius = 0.5 * (hi - lo).length();
-    let distance = distance.max(1.05 * radius);
-    (distance.is_finite() && distance > 0.0).then_some(distance)
-}
-
 /// Hover on drawn rays: the current tree's node under the pointer lights up everywhere.
 pub(super) fn pick_and_hover_only(
     selection: &mut TreeSelection,
@@ -998,53 +942,5 @@ mod tests {
         }
         let tiny = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(80.0, 30.0));
         assert!(compact_key_layout(tiny).is_none());
-    }
-
-    /// Where a point lands in a view from `eye` towards `target`: tangents across and up.
-    fn tangents(eye: Vec3, target: Vec3, up: Vec3, p: Vec3) -> (f32, f32) {
-        let forward = (target - eye).normalize();
-        let right = forward.cross(up).normalize();
-        let upward = right.cross(forward);
-        let d = p - eye;
-        let depth = d.dot(forward);
-        assert!(depth > 0.0, "{p} is behind the eye");
-        (d.dot(right) / depth, d.dot(upward) / depth)
-    }
-
-    /// A flat floor with a few objects, seen from above at an angle: every corner lies inside
-    /// the view with the margin, one of them on its edge (the fit is tight), and the camera is
-    /// closer than framing the bounding sphere would put it.
-    #[test]
-    fn corner_fit_frames_a_flat_box_tightly() {
-        let (lo, hi) = (Vec3::new(-12.0, 0.0, -12.0), Vec3::new(12.0, 2.0, 12.0));
-        let direction = Vec3::new(1.0, 0.45, 0.25).normalize();
-        let center = 0.5 * (lo + hi);
-        for (tan_x, tan_y) in [(0.41, 0.41), (0.25, 0.41), (0.7, 0.41)] {
-            let d = corner_fit(lo, hi, direction, Vec3::Y, tan_x, tan_y).expect("a distance");
-            let eye = center + direction * d;
-            let mut widest = 0.0f32;
-            for k in 0..8 {
-                let c = box_corner(lo, hi, k);
-                let (x, y) = tangents(eye, center, Vec3::Y, c);
-                let (fx, fy) = (
-                    x.abs() * FRAME_MARGIN / tan_x,
-                    y.abs() * FRAME_MARGIN / tan_y,
-                );
-                assert!(
-                    fx <= 1.0 + 1e-4 && fy <= 1.0 + 1e-4,
-                    "corner {c}: {fx} {fy}"
-                );
-                widest = widest.max(fx).max(fy);
-            }
-            assert!(
-                widest > 0.999,
-                "not tight: the widest corner fills {widest} of the view"
-            );
-            // The sphere's framing, in the narrower of the two fields.
-            let half = tan_x.min(tan_y).atan();
-            let sphere = FRAME_MARGIN * 0.5 * (hi - lo).length() / half.sin();
-            assert!(d < sphere, "{d} against the sphere's {sphere}");
-        }
-        assert_eq!(corner_fit(lo, hi, Vec3::Y, Vec3::Y, 0.4, 0.4), None);
     }
 }

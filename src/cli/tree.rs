@@ -11,6 +11,7 @@ use glam::Vec3;
 use raytree::ray_tree::{self, RayTree};
 use raytree::scene::{Camera, Scene, rules};
 use raytree::scene_view::cutaway::Cutaway;
+use raytree::scene_view::overview::{self, overview};
 use raytree::scene_view::{Filter, headless};
 use raytree::{export, trace::Tracer};
 
@@ -48,7 +49,7 @@ pub fn run_tree(args: &TreeArgs) -> Result<()> {
             args.scene
         );
     }
-    let view = args.view.camera(&scene)?;
+    let view_from = args.view.view_from(&scene)?;
     let tracer = Tracer::new(Arc::new(scene), trace);
     let tree = ray_tree::pixel_tree(&tracer, x, y).context("the pixel has no tree")?;
     if let Some(path) = &args.diagram {
@@ -67,7 +68,8 @@ pub fn run_tree(args: &TreeArgs) -> Result<()> {
             let _ = write!(std::io::stdout(), "{}", ray_tree::tree_text(&tree));
         }
     }
-    if let (Some(path), Some(view)) = (&args.view.scene_view, view) {
+    if let (Some(path), Some(from)) = (&args.view.scene_view, view_from) {
+        let view = from.camera(&tracer, args.view.cutaway);
         write_scene_view(&args.scene, &tracer, &tree, &view, args.view.cutaway, path)?;
     }
     Ok(())
@@ -77,20 +79,22 @@ pub fn run_tree(args: &TreeArgs) -> Result<()> {
 /// `--json`): the picture is written besides, never instead.
 #[derive(Args, Debug)]
 pub struct SceneViewArgs {
-    /// Also draw the tree in 3D over the scene seen from --eye towards --target, with the
-    /// render camera and the lights, as a PNG of the scene's size (--width, --height).
-    #[arg(long, value_name = "OUT.png", requires_all = ["eye", "target"])]
+    /// Also draw the tree in 3D over the scene, with the render camera and the lights, as a
+    /// PNG of the scene's size (--width, --height): seen from --eye towards --target, or
+    /// without them from where the viewer's scene view first looks.
+    #[arg(long, value_name = "OUT.png")]
     scene_view: Option<PathBuf>,
     /// The scene view's eye, as X,Y,Z.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true, requires = "scene_view")]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true, requires_all = ["scene_view", "target"])]
     eye: Option<Vec3>,
     /// The point the scene view looks at, as X,Y,Z.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true, requires = "scene_view")]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true, requires_all = ["scene_view", "eye"])]
     target: Option<Vec3>,
-    /// The scene view's up direction, as X,Y,Z.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,1,0", requires = "scene_view")]
-    up: Vec3,
-    /// The scene view's vertical field of view in degrees [default: the scene camera's].
+    /// The scene view's up direction, as X,Y,Z [default: 0,1,0].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true, requires = "eye")]
+    up: Option<Vec3>,
+    /// The scene view's vertical field of view in degrees [default: the scene camera's with
+    /// --eye, else the viewer's 45].
     #[arg(
         long,
         value_name = "DEG",
@@ -124,10 +128,32 @@ pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
     Ok(Vec3::new(parse(x)?, parse(y)?, parse(z)?))
 }
 
+/// Where `--scene-view` looks from.
+enum ViewFrom {
+    /// `--eye` towards `--target`.
+    Given(Camera),
+    /// Where the viewer's scene view first looks from, with this vertical field of view.
+    Overview(f32),
+}
+
+impl ViewFrom {
+    /// The view camera for the scene of `tracer` in an image of its size.
+    fn camera(&self, tracer: &Tracer, cutaway: Cutaway) -> Camera {
+        match self {
+            ViewFrom::Given(camera) => camera.clone(),
+            ViewFrom::Overview(fov_y_deg) => {
+                let render = &tracer.scene.render;
+                let aspect = render.width as f32 / render.height.max(1) as f32;
+                overview(tracer, aspect, *fov_y_deg, cutaway)
+            }
+        }
+    }
+}
+
 impl SceneViewArgs {
-    /// The view camera of `--scene-view` (`None` without it), held to the scene file's rule
-    /// in the words of the flags; the file name is checked too, all before any work is done.
-    fn camera(&self, scene: &Scene) -> Result<Option<Camera>> {
+    /// Where `--scene-view` looks from (`None` without it), held to the scene file's rule in
+    /// the words of the flags; the file name is checked too, all before any work is done.
+    fn view_from(&self, scene: &Scene) -> Result<Option<ViewFrom>> {
         let Some(path) = &self.scene_view else {
             return Ok(None);
         };
@@ -141,28 +167,45 @@ impl SceneViewArgs {
                 path.display()
             );
         }
+        let (Some(eye), Some(target)) = (self.eye, self.target) else {
+            // Only the field of view can be wrong: the camera is checked on a stand-in.
+            let fov_y_deg = self.fov.unwrap_or(overview::FOV_Y_DEG);
+            check_view(&Camera {
+                position: Vec3::Z,
+                look_at: Vec3::ZERO,
+                up: Vec3::Y,
+                fov_y_deg,
+            })?;
+            return Ok(Some(ViewFrom::Overview(fov_y_deg)));
+        };
         let view = Camera {
-            position: self.eye.unwrap_or_default(),
-            look_at: self.target.unwrap_or_default(),
-            up: self.up,
+            position: eye,
+            look_at: target,
+            up: self.up.unwrap_or(Vec3::Y),
             fov_y_deg: self.fov.unwrap_or(scene.camera.fov_y_deg),
         };
-        if let Err(v) = rules::check_camera(&view) {
-            let flag = match v.field {
-                "position" => "--eye",
-                "look_at" => "--target",
-                "up" => "--up",
-                _ => "--fov",
-            };
-            let phrase = v
-                .phrase
-                .replace("`position`", "--eye")
-                .replace("`look_at`", "--target");
-            let got = v.value.map(|x| format!(", got {x}")).unwrap_or_default();
-            bail!("the scene view's {flag} {phrase}{got}");
-        }
-        Ok(Some(view))
+        check_view(&view)?;
+        Ok(Some(ViewFrom::Given(view)))
     }
+}
+
+/// `view` held to the scene file's rule for a camera, in the words of the flags.
+fn check_view(view: &Camera) -> Result<()> {
+    if let Err(v) = rules::check_camera(view) {
+        let flag = match v.field {
+            "position" => "--eye",
+            "look_at" => "--target",
+            "up" => "--up",
+            _ => "--fov",
+        };
+        let phrase = v
+            .phrase
+            .replace("`position`", "--eye")
+            .replace("`look_at`", "--target");
+        let got = v.value.map(|x| format!(", got {x}")).unwrap_or_default();
+        bail!("the scene view's {flag} {phrase}{got}");
+    }
+    Ok(())
 }
 
 /// Renders the scene view of `tree` from `view` at the scene's size and writes it as a PNG

@@ -1,0 +1,239 @@
+//! Where the scene view first looks from (docs/viewer.md, "The scene view's first look"):
+//! across the render camera's rays, from the side where it sees what the render camera sees.
+//!
+//! The view frames the scene's bounds and the render camera's eye. Its preferred side is to the
+//! render camera's right, a little above and behind, where the frustum and the rays are seen
+//! across rather than end on. That side fails for a model seen through an opening (a Cornell
+//! box, a room without its front wall): from beside it the view sees the outside of a side
+//! wall. So each of a few directions, in order of preference, is scored on a grid of the points
+//! the render camera sees: the share of them in plain sight of its eye. The first direction
+//! that sees nearly as many as the best one is taken.
+
+use glam::Vec3;
+
+use super::box_corner;
+use super::cutaway::Cutaway;
+use crate::geometry::Ray;
+use crate::scene::camera::FRAME_MARGIN;
+use crate::scene::{Camera, CameraFrame};
+use crate::trace::Tracer;
+
+/// The directions tried, from the target towards the eye, in the render camera's frame (across
+/// to its right, up, back behind it), most preferred first: its right side a little above and
+/// behind; the left side; both sides higher and further behind; over its shoulder; high above
+/// either side.
+pub const DIRECTIONS: [[f32; 3]; 7] = [
+    [1.0, 0.45, 0.25],
+    [-1.0, 0.45, 0.25],
+    [0.8, 0.7, 1.0],
+    [-0.8, 0.7, 1.0],
+    [0.3, 0.8, 1.0],
+    [1.0, 1.6, 0.25],
+    [-1.0, 1.6, 0.25],
+];
+
+/// A less preferred direction is taken only when the preferred ones see less than this share
+/// of what it sees: a side view that sees most of the scene stays.
+const PREFERENCE: f32 = 0.8;
+
+/// The grid of the render camera's image whose points a direction is scored on.
+const GRID: (u32, u32) = (32, 24);
+
+/// The scene view's vertical field of view in the viewer.
+pub const FOV_Y_DEG: f32 = 45.0;
+
+/// A direction's camera and the share of the render camera's points its eye sees.
+#[derive(Clone, Debug)]
+pub struct Candidate {
+    pub camera: Camera,
+    pub sees: f32,
+}
+
+/// The scene view's first camera for `tracer`'s scene in a view of `aspect` (width over height)
+/// with a vertical field of `fov_y_deg`: the first of [`candidates`] that sees at least
+/// [`PREFERENCE`] of what the best sees. When the cut-away would be active from the preferred
+/// eye (the render camera inside a closed model), that eye is kept: the cut opens the walls
+/// for it.
+pub fn overview(tracer: &Tracer, aspect: f32, fov_y_deg: f32, cutaway: Cutaway) -> Camera {
+    let all = candidates(tracer, aspect, fov_y_deg);
+    if cutaway.active(&tracer.scene, all[0].camera.position) {
+        return all[0].camera.clone();
+    }
+    let best = all.iter().map(|c| c.sees).fold(0.0f32, f32::max);
+    all.iter()
+        .find(|c| c.sees >= PREFERENCE * best)
+        .unwrap_or(&all[0])
+        .camera
+        .clone()
+}
+
+/// Every direction of [`DIRECTIONS`], framed, with the share of the render camera's points its
+/// eye sees (0 for all when the render camera sees nothing).
+pub fn candidates(tracer: &Tracer, aspect: f32, fov_y_deg: f32) -> Vec<Candidate> {
+    let points = seen_points(tracer);
+    let scene = &tracer.scene;
+    let eye = scene.camera.position;
+    let view = (scene.camera.look_at - eye).normalize_or(Vec3::NEG_Z);
+    let up = scene.camera.up.normalize_or(Vec3::Y);
+    let side = view.cross(up).normalize_or(Vec3::X);
+    let (lo, hi) = scene
+        .bounds()
+        .map_or((eye - Vec3::ONE, eye + Vec3::ONE), |(lo, hi)| {
+            (lo.min(eye), hi.max(eye))
+        });
+    let base = Camera {
+        fov_y_deg,
+        up,
+        ..scene.camera.clone()
+    };
+    DIRECTIONS
+        .iter()
+        .map(|&[a, b, c]| {
+            let direction = (side * a + up * b - view * c).normalize();
+            let camera = framed(&base, lo, hi, direction, aspect);
+            let seen = points
+                .iter()
+                .filter(|&&p| in_sight(tracer, camera.position, p))
+                .count();
+            let sees = seen as f32 / points.len().max(1) as f32;
+            Candidate { camera, sees }
+        })
+        .collect()
+}
+
+/// `base` framed on `lo..hi` from `direction`, as close as the box's corners allow in both
+/// fields of a view of `aspect`.
+fn framed(base: &Camera, lo: Vec3, hi: Vec3, direction: Vec3, aspect: f32) -> Camera {
+    let mut camera = base.framing(lo, hi, direction);
+    // `framing` fits the bounding sphere in the vertical field, which leaves a flat scene (a
+    // floor and a few objects) small in the pane: the camera comes as close as the box's eight
+    // corners allow, in both fields of the pane (the narrower one across when the pane is
+    // narrower than tall), with the same margin.
+    let tan_y = (0.5 * camera.fov_y_deg).to_radians().min(1.5).tan();
+    let tan_x = aspect * tan_y;
+    if let Some(distance) = corner_fit(lo, hi, direction, base.up, tan_x, tan_y) {
+        camera.position = camera.look_at + direction * distance;
+    }
+    camera
+}
+
+/// The points the render camera sees at the centres of a [`GRID`] over its image.
+fn seen_points(tracer: &Tracer) -> Vec<Vec3> {
+    let scene = &tracer.scene;
+    let (w, h) = (scene.render.width.max(1), scene.render.height.max(1));
+    let frame = CameraFrame::new(&scene.camera, w, h);
+    let (gx, gy) = GRID;
+    let mut points = Vec::with_capacity((gx * gy) as usize);
+    for j in 0..gy {
+        for i in 0..gx {
+            let x = (i as f32 + 0.5) * w as f32 / gx as f32;
+            let y = (j as f32 + 0.5) * h as f32 / gy as f32;
+            let ray = frame.ray(x, y);
+            if let Some(t) = tracer.first_hit_t(&ray) {
+                let p = ray.origin + ray.dir * t;
+                if p.is_finite() {
+                    points.push(p);
+                }
+            }
+        }
+    }
+    points
+}
+
+/// Whether nothing stands between `eye` and the surface point `p` (a hit short of it by more
+/// than a thousandth of the way is something in front).
+fn in_sight(tracer: &Tracer, eye: Vec3, p: Vec3) -> bool {
+    let to = p - eye;
+    let distance = to.length();
+    if !(distance > 0.0 && distance.is_finite()) {
+        return false;
+    }
+    let ray = Ray::new(eye, to / distance);
+    tracer
+        .first_hit_t(&ray)
+        .is_none_or(|t| t >= distance * (1.0 - 1e-3))
+}
+
+/// The distance from the centre of `lo..hi` along the unit `direction` (from the centre towards
+/// the eye) at which every corner of the box lies inside a view whose half fields have
+/// tangents `tan_x` across and `tan_y` up, with [`FRAME_MARGIN`]; `None` for a degenerate view.
+pub fn corner_fit(
+    lo: Vec3,
+    hi: Vec3,
+    direction: Vec3,
+    up: Vec3,
+    tan_x: f32,
+    tan_y: f32,
+) -> Option<f32> {
+    let right = up.cross(direction).normalize_or_zero();
+    let upward = direction.cross(right);
+    if right == Vec3::ZERO || !(tan_x > 0.0 && tan_y > 0.0) {
+        return None;
+    }
+    let center = 0.5 * (lo + hi);
+    let mut distance = 0.0f32;
+    for k in 0..8 {
+        let q = box_corner(lo, hi, k) - center;
+        // The corner's depth in front of an eye at `distance` is `distance − q·direction`.
+        let across = q.dot(direction) + FRAME_MARGIN * q.dot(right).abs() / tan_x;
+        let upwards = q.dot(direction) + FRAME_MARGIN * q.dot(upward).abs() / tan_y;
+        distance = distance.max(across).max(upwards);
+    }
+    // Never inside the box's bounding sphere, where the near corners would pass the eye.
+    let radius = 0.5 * (hi - lo).length();
+    let distance = distance.max(1.05 * radius);
+    (distance.is_finite() && distance > 0.0).then_some(distance)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Where a point lands in a view from `eye` towards `target`: tangents across and up.
+    fn tangents(eye: Vec3, target: Vec3, up: Vec3, p: Vec3) -> (f32, f32) {
+        let forward = (target - eye).normalize();
+        let right = forward.cross(up).normalize();
+        let upward = right.cross(forward);
+        let d = p - eye;
+        let depth = d.dot(forward);
+        assert!(depth > 0.0, "{p} is behind the eye");
+        (d.dot(right) / depth, d.dot(upward) / depth)
+    }
+
+    /// A flat floor with a few objects, seen from above at an angle: every corner lies inside
+    /// the view with the margin, one of them on its edge (the fit is tight), and the camera is
+    /// closer than framing the bounding sphere would put it.
+    #[test]
+    fn corner_fit_frames_a_flat_box_tightly() {
+        let (lo, hi) = (Vec3::new(-12.0, 0.0, -12.0), Vec3::new(12.0, 2.0, 12.0));
+        let direction = Vec3::new(1.0, 0.45, 0.25).normalize();
+        let center = 0.5 * (lo + hi);
+        for (tan_x, tan_y) in [(0.41, 0.41), (0.25, 0.41), (0.7, 0.41)] {
+            let d = corner_fit(lo, hi, direction, Vec3::Y, tan_x, tan_y).expect("a distance");
+            let eye = center + direction * d;
+            let mut widest = 0.0f32;
+            for k in 0..8 {
+                let c = box_corner(lo, hi, k);
+                let (x, y) = tangents(eye, center, Vec3::Y, c);
+                let (fx, fy) = (
+                    x.abs() * FRAME_MARGIN / tan_x,
+                    y.abs() * FRAME_MARGIN / tan_y,
+                );
+                assert!(
+                    fx <= 1.0 + 1e-4 && fy <= 1.0 + 1e-4,
+                    "corner {c}: {fx} {fy}"
+                );
+                widest = widest.max(fx).max(fy);
+            }
+            assert!(
+                widest > 0.999,
+                "not tight: the widest corner fills {widest} of the view"
+            );
+            // The sphere's framing, in the narrower of the two fields.
+            let half = tan_x.min(tan_y).atan();
+            let sphere = FRAME_MARGIN * 0.5 * (hi - lo).length() / half.sin();
+            assert!(d < sphere, "{d} against the sphere's {sphere}");
+        }
+        assert_eq!(corner_fit(lo, hi, Vec3::Y, Vec3::Y, 0.4, 0.4), None);
+    }
+}
