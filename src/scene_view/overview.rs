@@ -6,8 +6,8 @@
 //! across rather than end on. That side fails for a model seen through an opening (a Cornell
 //! box, a room without its front wall): from beside it the view sees the outside of a side
 //! wall. So each of a few directions, in order of preference, is scored on a grid of the points
-//! the render camera sees: the share of them in plain sight of its eye. The first direction
-//! that sees nearly as many as the best one is taken.
+//! the render camera sees: the share of them in plain sight of its eye and not seen edge on.
+//! The first direction that sees nearly as many as the best one is taken.
 
 use glam::Vec3;
 
@@ -36,13 +36,18 @@ pub const DIRECTIONS: [[f32; 3]; 7] = [
 /// of what it sees: a side view that sees most of the scene stays.
 const PREFERENCE: f32 = 0.8;
 
+/// A point seen at a cosine below this (more than 78° from face on) is not shown: the view
+/// sees its surface edge on.
+const GRAZING: f32 = 0.2;
+
 /// The grid of the render camera's image whose points a direction is scored on.
 const GRID: (u32, u32) = (32, 24);
 
 /// The scene view's vertical field of view in the viewer.
 pub const FOV_Y_DEG: f32 = 45.0;
 
-/// A direction's camera and the share of the render camera's points its eye sees.
+/// A direction's camera and the share of the render camera's points its eye sees (unhidden
+/// and within [`GRAZING`] of edge on).
 #[derive(Clone, Debug)]
 pub struct Candidate {
     pub camera: Camera,
@@ -93,7 +98,10 @@ pub fn candidates(tracer: &Tracer, aspect: f32, fov_y_deg: f32) -> Vec<Candidate
             let camera = framed(&base, lo, hi, direction, aspect);
             let seen = points
                 .iter()
-                .filter(|&&p| in_sight(tracer, camera.position, p))
+                .filter(|&&(p, n)| {
+                    let cos = n.dot((camera.position - p).normalize_or_zero()).abs();
+                    cos >= GRAZING && in_sight(tracer, camera.position, p)
+                })
                 .count();
             let sees = seen as f32 / points.len().max(1) as f32;
             Candidate { camera, sees }
@@ -117,8 +125,9 @@ fn framed(base: &Camera, lo: Vec3, hi: Vec3, direction: Vec3, aspect: f32) -> Ca
     camera
 }
 
-/// The points the render camera sees at the centres of a [`GRID`] over its image.
-fn seen_points(tracer: &Tracer) -> Vec<Vec3> {
+/// The points the render camera sees at the centres of a [`GRID`] over its image, with the
+/// normals there.
+fn seen_points(tracer: &Tracer) -> Vec<(Vec3, Vec3)> {
     let scene = &tracer.scene;
     let (w, h) = (scene.render.width.max(1), scene.render.height.max(1));
     let frame = CameraFrame::new(&scene.camera, w, h);
@@ -129,10 +138,10 @@ fn seen_points(tracer: &Tracer) -> Vec<Vec3> {
             let x = (i as f32 + 0.5) * w as f32 / gx as f32;
             let y = (j as f32 + 0.5) * h as f32 / gy as f32;
             let ray = frame.ray(x, y);
-            if let Some(t) = tracer.first_hit_t(&ray) {
+            if let Some((t, normal)) = tracer.first_hit_normal(&ray) {
                 let p = ray.origin + ray.dir * t;
                 if p.is_finite() {
-                    points.push(p);
+                    points.push((p, normal));
                 }
             }
         }
