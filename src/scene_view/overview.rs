@@ -47,7 +47,7 @@ const GRID: (u32, u32) = (32, 24);
 pub const FOV_Y_DEG: f32 = 45.0;
 
 /// A direction's camera and the share of the render camera's points its eye sees (unhidden
-/// and within [`GRAZING`] of edge on).
+/// and within `GRAZING` of edge on).
 #[derive(Clone, Debug)]
 pub struct Candidate {
     pub camera: Camera,
@@ -56,7 +56,7 @@ pub struct Candidate {
 
 /// The scene view's first camera for `tracer`'s scene in a view of `aspect` (width over height)
 /// with a vertical field of `fov_y_deg`: the first of [`candidates`] that sees at least
-/// [`PREFERENCE`] of what the best sees. When the cut-away would be active from the preferred
+/// `PREFERENCE` of what the best sees. When the cut-away would be active from the preferred
 /// eye (the render camera inside a closed model), that eye is kept: the cut opens the walls
 /// for it.
 pub fn overview(tracer: &Tracer, aspect: f32, fov_y_deg: f32, cutaway: Cutaway) -> Camera {
@@ -125,7 +125,7 @@ fn framed(base: &Camera, lo: Vec3, hi: Vec3, direction: Vec3, aspect: f32) -> Ca
     camera
 }
 
-/// The points the render camera sees at the centres of a [`GRID`] over its image, with the
+/// The points the render camera sees at the centres of a `GRID` over its image, with the
 /// normals there.
 fn seen_points(tracer: &Tracer) -> Vec<(Vec3, Vec3)> {
     let scene = &tracer.scene;
