@@ -131,7 +131,7 @@ impl SceneView {
     }
 
     /// Frames the camera on the scene's bounds and the render camera's eye, from the render
-    /// camera's side where that sees what it sees ([`overview`]), so the frustum and the rays
+    /// camera's side where that sees what it sees ([`overview()`]), so the frustum and the rays
     /// are seen across.
     pub fn frame(&mut self, tracer: &Tracer) {
         let (w, h) = self.size;
