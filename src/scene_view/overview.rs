@@ -60,10 +60,11 @@ pub struct Candidate {
 /// eye (the render camera inside a closed model), that eye is kept: the cut opens the walls
 /// for it.
 pub fn overview(tracer: &Tracer, aspect: f32, fov_y_deg: f32, cutaway: Cutaway) -> Camera {
-    let all = candidates(tracer, aspect, fov_y_deg);
-    if cutaway.active(&tracer.scene, all[0].camera.position) {
-        return all[0].camera.clone();
+    let framings = framings(tracer, aspect, fov_y_deg);
+    if cutaway.active(&tracer.scene, framings[0].position) {
+        return framings[0].clone();
     }
+    let all = scored(tracer, framings);
     let best = all.iter().map(|c| c.sees).fold(0.0f32, f32::max);
     all.iter()
         .find(|c| c.sees >= PREFERENCE * best)
@@ -75,7 +76,11 @@ pub fn overview(tracer: &Tracer, aspect: f32, fov_y_deg: f32, cutaway: Cutaway) 
 /// Every direction of [`DIRECTIONS`], framed, with the share of the render camera's points its
 /// eye sees (0 for all when the render camera sees nothing).
 pub fn candidates(tracer: &Tracer, aspect: f32, fov_y_deg: f32) -> Vec<Candidate> {
-    let points = seen_points(tracer);
+    scored(tracer, framings(tracer, aspect, fov_y_deg))
+}
+
+/// The camera of each direction of [`DIRECTIONS`], framed on the scene and the render camera.
+fn framings(tracer: &Tracer, aspect: f32, fov_y_deg: f32) -> Vec<Camera> {
     let scene = &tracer.scene;
     let eye = scene.camera.position;
     let view = (scene.camera.look_at - eye).normalize_or(Vec3::NEG_Z);
@@ -95,12 +100,23 @@ pub fn candidates(tracer: &Tracer, aspect: f32, fov_y_deg: f32) -> Vec<Candidate
         .iter()
         .map(|&[a, b, c]| {
             let direction = (side * a + up * b - view * c).normalize();
-            let camera = framed(&base, lo, hi, direction, aspect);
+            framed(&base, lo, hi, direction, aspect)
+        })
+        .collect()
+}
+
+/// Each camera with the share of the render camera's points its eye sees.
+fn scored(tracer: &Tracer, cameras: Vec<Camera>) -> Vec<Candidate> {
+    let points = seen_points(tracer);
+    cameras
+        .into_iter()
+        .map(|camera| {
+            let eye = camera.position;
             let seen = points
                 .iter()
                 .filter(|&&(p, n)| {
-                    let cos = n.dot((camera.position - p).normalize_or_zero()).abs();
-                    cos >= GRAZING && in_sight(tracer, camera.position, p)
+                    let cos = n.dot((eye - p).normalize_or_zero()).abs();
+                    cos >= GRAZING && in_sight(tracer, eye, p)
                 })
                 .count();
             let sees = seen as f32 / points.len().max(1) as f32;

@@ -26,23 +26,17 @@ pub(super) const PLACEHOLDER_SURFACE: SurfaceHit = SurfaceHit {
 
 impl Tracer {
     /// The distance along `ray` to the closest object and that object's unit geometric normal
-    /// there (as modelled, whichever side the ray meets): where the scene view's first look
+    /// there (facing the ray): where the scene view's first look
     /// scores what a view shows face on.
     pub fn first_hit_normal(&self, ray: &Ray) -> Option<(f32, Vec3)> {
         let hit = self
             .accel
             .closest_hit(self.methods(), ray, 0.0, f32::INFINITY)?;
-        let scene = &self.scene;
-        let prim = hit.prim as usize;
-        let normal = match scene.spheres.get(prim) {
-            Some(s) => ray.origin + ray.dir * hit.t - s.center,
-            None => {
-                let v = &scene.triangles.get(prim - scene.spheres.len())?.vertices;
-                (v[1] - v[0]).cross(v[2] - v[0])
-            }
-        };
-        let normal = normal.normalize_or_zero();
-        (normal != Vec3::ZERO).then_some((hit.t, normal))
+        let (surface, _) = self.surface(ray, &hit);
+        surface
+            .geometric_normal
+            .is_finite()
+            .then_some((hit.t, surface.geometric_normal))
     }
 
     /// Hit point, its error bound, normals, object, material, barycentrics and texture.
