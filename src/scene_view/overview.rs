@@ -5,9 +5,13 @@
 //! render camera's right, a little above and behind, where the frustum and the rays are seen
 //! across rather than end on. That side fails for a model seen through an opening (a Cornell
 //! box, a room without its front wall): from beside it the view sees the outside of a side
-//! wall. So each of a few directions, in order of preference, is scored on a grid of the points
-//! the render camera sees: the share of them in plain sight of its eye and not seen edge on.
-//! The first direction that sees nearly as many as the best one is taken.
+//! wall. So each of a few directions, in order of preference, is scored on what the render
+//! camera sees: the points it sees on a grid over its image, and points along the rays to them
+//! inside the scene's bounds. A direction's score is the share of those points in plain sight
+//! of its eye (a surface point also not seen edge on). The rays count because the tree is
+//! drawn along them: a view over a wall's top or past its end sees the points of a facade that
+//! every view sees, but not the rays that go into the room behind it. The first direction that
+//! sees nearly as many as the best one is taken.
 
 use glam::Vec3;
 
@@ -20,11 +24,12 @@ use crate::trace::Tracer;
 
 /// The directions tried, from the target towards the eye, in the render camera's frame (across
 /// to its right, up, back behind it), most preferred first: its right side a little above and
-/// behind; the left side; both sides higher and further behind; over its shoulder; high above
-/// either side.
-pub const DIRECTIONS: [[f32; 3]; 7] = [
+/// behind; the left side; over its right shoulder, a little above it; both sides higher and
+/// further behind; high over its shoulder; high above either side.
+pub const DIRECTIONS: [[f32; 3]; 8] = [
     [1.0, 0.45, 0.25],
     [-1.0, 0.45, 0.25],
+    [0.5, 0.25, 1.0],
     [0.8, 0.7, 1.0],
     [-0.8, 0.7, 1.0],
     [0.3, 0.8, 1.0],
@@ -46,8 +51,8 @@ const GRID: (u32, u32) = (32, 24);
 /// The scene view's vertical field of view in the viewer.
 pub const FOV_Y_DEG: f32 = 45.0;
 
-/// A direction's camera and the share of the render camera's points its eye sees (unhidden
-/// and within `GRAZING` of edge on).
+/// A direction's camera and the share of the render camera's points its eye sees: unhidden,
+/// and for a surface point not within `GRAZING` of edge on.
 #[derive(Clone, Debug)]
 pub struct Candidate {
     pub camera: Camera,
@@ -107,19 +112,18 @@ fn framings(tracer: &Tracer, aspect: f32, fov_y_deg: f32) -> Vec<Camera> {
 
 /// Each camera with the share of the render camera's points its eye sees.
 fn scored(tracer: &Tracer, cameras: Vec<Camera>) -> Vec<Candidate> {
-    let points = seen_points(tracer);
+    let (hits, along) = seen_points(tracer);
+    let total = (hits.len() + along.len()).max(1) as f32;
     cameras
         .into_iter()
         .map(|camera| {
             let eye = camera.position;
-            let seen = points
-                .iter()
-                .filter(|&&(p, n)| {
-                    let cos = n.dot((eye - p).normalize_or_zero()).abs();
-                    cos >= GRAZING && in_sight(tracer, eye, p)
-                })
-                .count();
-            let sees = seen as f32 / points.len().max(1) as f32;
+            let hits_seen = hits.iter().filter(|&&(p, n)| {
+                let cos = n.dot((eye - p).normalize_or_zero()).abs();
+                cos >= GRAZING && in_sight(tracer, eye, p)
+            });
+            let along_seen = along.iter().filter(|&&p| in_sight(tracer, eye, p));
+            let sees = (hits_seen.count() + along_seen.count()) as f32 / total;
             Candidate { camera, sees }
         })
         .collect()
@@ -141,28 +145,58 @@ fn framed(base: &Camera, lo: Vec3, hi: Vec3, direction: Vec3, aspect: f32) -> Ca
     camera
 }
 
+/// How many points along a ray are scored per length of the scene's bounds' diagonal.
+const ALONG: f32 = 16.0;
+
 /// The points the render camera sees at the centres of a `GRID` over its image, with the
-/// normals there.
-fn seen_points(tracer: &Tracer) -> Vec<(Vec3, Vec3)> {
+/// normals there; and points along the rays to them, inside the scene's bounds, evenly spaced.
+fn seen_points(tracer: &Tracer) -> (Vec<(Vec3, Vec3)>, Vec<Vec3>) {
     let scene = &tracer.scene;
     let (w, h) = (scene.render.width.max(1), scene.render.height.max(1));
     let frame = CameraFrame::new(&scene.camera, w, h);
+    let Some((lo, hi)) = scene.bounds() else {
+        return (Vec::new(), Vec::new());
+    };
+    let spacing = (hi - lo).length() / ALONG;
     let (gx, gy) = GRID;
-    let mut points = Vec::with_capacity((gx * gy) as usize);
+    let mut hits = Vec::with_capacity((gx * gy) as usize);
+    let mut along = Vec::new();
     for j in 0..gy {
         for i in 0..gx {
             let x = (i as f32 + 0.5) * w as f32 / gx as f32;
             let y = (j as f32 + 0.5) * h as f32 / gy as f32;
             let ray = frame.ray(x, y);
-            if let Some((t, normal)) = tracer.first_hit_normal(&ray) {
-                let p = ray.origin + ray.dir * t;
-                if p.is_finite() {
-                    points.push((p, normal));
-                }
+            let Some((t, normal)) = tracer.first_hit_normal(&ray) else {
+                continue;
+            };
+            let p = ray.origin + ray.dir * t;
+            if !p.is_finite() {
+                continue;
+            }
+            hits.push((p, normal));
+            let mut s = entry(ray.origin, ray.dir, lo, hi) + 0.5 * spacing;
+            while s < t && spacing > 0.0 {
+                along.push(ray.origin + ray.dir * s);
+                s += spacing;
             }
         }
     }
-    points
+    (hits, along)
+}
+
+/// Where the ray `o + t·d` (t ≥ 0) enters the box `lo..hi`.
+fn entry(o: Vec3, d: Vec3, lo: Vec3, hi: Vec3) -> f32 {
+    let mut t = 0.0f32;
+    for axis in 0..3 {
+        if d[axis] != 0.0 {
+            let (a, b) = (
+                (lo[axis] - o[axis]) / d[axis],
+                (hi[axis] - o[axis]) / d[axis],
+            );
+            t = t.max(a.min(b));
+        }
+    }
+    t
 }
 
 /// Whether nothing stands between `eye` and the surface point `p` (a hit short of it by more
