@@ -1294,3 +1294,100 @@ fn a_shell_open_below_is_seen_from_outside_and_a_tray_from_above_with_z_up() {
     );
     assert_not_warned(&scene, "tray.obj", "(a room)");
 }
+
+/// The torus of assets/models without its material, as OBJ text, and how many vertices it has.
+fn bare_torus() -> (String, usize) {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/models/torus.obj"),
+    )
+    .expect("torus.obj");
+    let kept: Vec<&str> = text
+        .lines()
+        .filter(|l| !l.starts_with("mtllib") && !l.starts_with("usemtl"))
+        .collect();
+    let vertices = kept.iter().filter(|l| l.starts_with("v ")).count();
+    (kept.join("\n") + "\n", vertices)
+}
+
+/// The share of a 64 × 48 grid over the scene's image whose rays first meet the torus of
+/// [`bare_torus`] (major radius 1, tube 0.35, about the origin in y = 0).
+fn torus_share(scene: &Scene) -> f32 {
+    let tracer = Tracer::new(Arc::new(scene.clone()), TraceSettings::default());
+    let (w, h) = (scene.render.width, scene.render.height);
+    let frame = raytree::scene::CameraFrame::new(&scene.camera, w, h);
+    let (gx, gy) = (64, 48);
+    let mut on = 0;
+    for j in 0..gy {
+        for i in 0..gx {
+            let x = (i as f32 + 0.5) * w as f32 / gx as f32;
+            let y = (j as f32 + 0.5) * h as f32 / gy as f32;
+            let ray = frame.ray(x, y);
+            if let Some(t) = tracer.first_hit_t(&ray) {
+                let p = ray.origin + ray.dir * t;
+                let ring = (Vec3::new(p.x, 0.0, p.z).length() - 1.0).hypot(p.y);
+                on += usize::from(ring < 0.36);
+            }
+        }
+    }
+    on as f32 / (gx * gy) as f32
+}
+
+/// A model on a ground plane hundreds of times its size (as a Blender scene with a large plane
+/// under it is exported): framing the bounds made the model a speck on the plane.
+#[test]
+fn a_model_on_a_ground_plane_far_larger_than_it_is_framed_on_the_model() {
+    let (mut text, n) = bare_torus();
+    text += "v -500 -0.35 -500\nv 500 -0.35 -500\nv 500 -0.35 500\nv -500 -0.35 500\n";
+    text += &format!("f {} {} {} {}\n", n + 1, n + 4, n + 3, n + 2);
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = load(dir.path(), "on_plane.obj", &text);
+    assert_warned(&scene, "on_plane.obj", &["small part of its bounds"]);
+    let share = torus_share(&scene);
+    assert!(share > 0.25, "the torus covers {share} of the image");
+    // A model alone is framed on its bounds, as before, and fills as much.
+    let alone = load(dir.path(), "alone.obj", &bare_torus().0);
+    assert_not_warned(&alone, "alone.obj", "small part of its bounds");
+    let alone_share = torus_share(&alone);
+    assert!(
+        share > 0.8 * alone_share,
+        "on the plane {share}, alone {alone_share}"
+    );
+}
+
+/// A model inside a tunnel a hundred times its length, open at both ends (a train in a subway
+/// scene): framed on the model from outside, the camera would see the tunnel's wall; it stands
+/// inside the tunnel and sees the model end on.
+#[test]
+fn a_model_in_a_long_tunnel_is_seen_from_inside_the_tunnel() {
+    let (mut text, n) = bare_torus();
+    let mut base = n;
+    let (lo, hi) = (Vec3::new(-200.0, -0.35, -1.8), Vec3::new(200.0, 2.0, 1.8));
+    cuboid(&mut text, &mut base, lo, hi, true, &[0, 1]);
+    let dir = tempfile::tempdir().expect("temp dir");
+    let scene = load(dir.path(), "tunnel.obj", &text);
+    assert_warned(
+        &scene,
+        "tunnel.obj",
+        &["small part of its bounds", "from inside the rest"],
+    );
+    let eye = scene.camera.position;
+    assert!(
+        eye.y > lo.y && eye.y < hi.y && eye.z > lo.z && eye.z < hi.z,
+        "the eye {eye} is outside the tunnel"
+    );
+    let share = torus_share(&scene);
+    assert!(share > 0.1, "the torus covers {share} of the image");
+    let key = scene.lights[0].position;
+    assert!(key.y < hi.y, "the key light at {key} is above the tunnel");
+    // The scene view frames the model and the render camera, not the tunnel, and draws its
+    // stubs and normal ticks in proportion to the model.
+    let extent = raytree::scene_view::extent(&scene);
+    assert!(extent < 10.0, "the scene view's extent is {extent}");
+    let tracer = Tracer::new(Arc::new(scene.clone()), TraceSettings::default());
+    let view = overview(&tracer, 4.0 / 3.0, FOV_Y_DEG, Cutaway::Auto);
+    assert!(
+        view.position.length() < 20.0,
+        "the scene view looks from {}",
+        view.position
+    );
+}

@@ -133,13 +133,19 @@ pub(crate) fn load_obj_scene(
         ));
     }
     let aspect = scene.render.width.max(1) as f32 / scene.render.height.max(1) as f32;
-    let mut look = first_view(&scene.triangles, lo, hi, up, aspect);
+    // A model whose detail is a small part of its bounds is framed on its detail.
+    let detail = detail(&scene.triangles, lo, hi);
+    let (framed, (lo, hi)) = match &detail {
+        Some(d) => (&d.triangles[..], d.bounds),
+        None => (&scene.triangles[..], (lo, hi)),
+    };
+    let mut look = first_view(framed, lo, hi, up, aspect);
     // Without `vn`, the winding alone says which side of a face is its front. A model that
     // opens as a room but whose faces face inwards and cover little of its bounds' sides (a
     // scanned statue or an animal wound clockwise, where a room's walls, floor and ceiling lie
     // on its bounds), is a thing wound the wrong way round: seen from outside.
-    if look.room.is_some() && !added.gives_normals && faces_inward(&scene.triangles, lo, hi) {
-        look = first_view_outside(&scene.triangles, lo, hi, up, aspect);
+    if look.room.is_some() && !added.gives_normals && faces_inward(framed, lo, hi) {
+        look = first_view_outside(framed, lo, hi, up, aspect);
         scene.warnings.push(format!(
             "{label}: the model's faces are wound clockwise seen from outside (they face inwards, and no `vn` says otherwise), yet it is no room: it is seen from outside."
         ));
@@ -154,7 +160,7 @@ pub(crate) fn load_obj_scene(
         && extent.z < ROOM_Z_UP * extent.y
         && extent.z < ROOM_Z_UP * extent.x
     {
-        let z_up = first_view(&scene.triangles, lo, hi, Vec3::Z, aspect);
+        let z_up = first_view(framed, lo, hi, Vec3::Z, aspect);
         let what = match (z_up.room.is_some(), z_up.open_above) {
             (true, _) => Some("the room is lower in z than it is wide and deep (in x and y)"),
             (false, true) => Some(
@@ -168,6 +174,23 @@ pub(crate) fn load_obj_scene(
                 .warnings
                 .push(format!("{label}: {what}: +z is taken as up."));
         }
+    }
+    // Framed on its detail from outside, the camera may stand behind the rest of the model (a
+    // tunnel's wall): it moves to where the rest leaves it room to see.
+    let outside = |p: Vec3| !(p.cmpge(lo).all() && p.cmple(hi).all());
+    if let Some(d) = &detail {
+        let moved = outside(look.camera.position)
+            .then(|| d.clear_view(&scene.triangles, &look.camera, aspect))
+            .flatten();
+        let how = if let Some(camera) = moved {
+            (look.camera, look.room) = (camera, None);
+            ", from inside the rest, which hides it from outside"
+        } else {
+            ""
+        };
+        scene.warnings.push(format!(
+            "{label}: most of the model's faces lie in a small part of its bounds (a model on a ground plane far larger than it, a train in a long tunnel): the camera frames that part{how}."
+        ));
     }
     let camera = look.camera;
     if check_camera(&camera).is_err() {
@@ -183,7 +206,14 @@ pub(crate) fn load_obj_scene(
         Some(room) => room.light,
         // Above the camera and a little in front of it, so the side we see is lit and
         // shadows fall behind and below the model.
-        None => camera.position + up * (0.5 * distance) + forward * (0.2 * distance),
+        None => {
+            let above = camera.position + forward * (0.2 * distance);
+            // Framed on its detail, the camera may stand inside the rest (a tunnel): the
+            // light stays under what is above it.
+            let room =
+                (detail.as_ref()).map_or(f32::INFINITY, |_| free_run(&scene.triangles, above, up));
+            above + up * (0.5 * distance).min(0.8 * room)
+        }
     };
     scene.lights.push(Light {
         name: "key".into(),
@@ -233,10 +263,18 @@ pub fn refit_bare_obj(scene: &mut Scene) {
     let Some((lo, hi)) = scene.bounds() else {
         return;
     };
-    let center = 0.5 * (lo + hi);
     let camera = scene.camera.clone();
     let outside = !(camera.position.cmpge(lo).all() && camera.position.cmple(hi).all());
-    if !bare || !outside || camera.look_at.distance(center) > 1e-4 * (hi - lo).length() {
+    if !bare || !outside {
+        return;
+    }
+    let detail = detail(&scene.triangles, lo, hi);
+    let (framed, (lo, hi)) = match &detail {
+        Some(d) => (&d.triangles[..], d.bounds),
+        None => (&scene.triangles[..], (lo, hi)),
+    };
+    let center = 0.5 * (lo + hi);
+    if camera.look_at.distance(center) > 1e-4 * (hi - lo).length() {
         return;
     }
     let back = camera.position - center;
@@ -245,24 +283,169 @@ pub fn refit_bare_obj(scene: &mut Scene) {
         return;
     }
     let aspect = scene.render.width.max(1) as f32 / scene.render.height.max(1) as f32;
-    let framed = frame_outside(
-        &scene.triangles,
-        center,
-        camera.up,
-        back / distance,
-        0.0,
-        aspect,
-    );
-    let scale = framed.position.distance(center) / distance;
-    if check_camera(&framed).is_err() || !scale.is_finite() {
+    let refit = frame_outside(framed, center, camera.up, back / distance, 0.0, aspect);
+    let scale = refit.position.distance(center) / distance;
+    if check_camera(&refit).is_err() || !scale.is_finite() {
         return;
     }
-    scene.camera.position = framed.position;
+    scene.camera.position = refit.position;
     for light in &mut scene.lights {
         if light.name == "key" && !light.follow_camera {
             light.position = center + (light.position - center) * scale;
         }
     }
+}
+
+/// The share of a model's triangles its detail is looked for in ([`detail`]).
+const DETAIL: f32 = 0.75;
+
+/// A model whose detail ([`detail`]) spans less than this fraction of its bounds' diagonal is
+/// framed on its detail.
+const SMALL_DETAIL: f32 = 0.1;
+
+/// Where most of a model's faces lie, when that is a small part of its bounds.
+pub(super) struct Detail {
+    /// The bounds of `triangles`.
+    pub(super) bounds: (Vec3, Vec3),
+    /// The triangles in it.
+    triangles: Vec<Triangle>,
+}
+
+/// How many bins per axis [`detail`] counts the triangles' centroids in.
+const DETAIL_BINS: usize = 1024;
+
+/// A model's detail, when it lies in a small part of its bounds `lo..hi` (a model on a ground
+/// plane hundreds of times its size, a train in a tunnel a hundred times its length): per
+/// axis, the shortest run of [`DETAIL_BINS`] bins across the bounds that holds [`DETAIL`] of
+/// the triangles' centroids; the triangles with every corner in the box of those runs grown by
+/// half its size each way. None when that box spans [`SMALL_DETAIL`] of the bounds' diagonal
+/// or more.
+pub(super) fn detail(triangles: &[Triangle], lo: Vec3, hi: Vec3) -> Option<Detail> {
+    use rayon::prelude::*;
+    let n = triangles.len();
+    let k = (DETAIL * n as f32).ceil() as usize;
+    let size = hi - lo;
+    if n == 0 || size.length().is_nan() || size.length() <= 0.0 {
+        return None;
+    }
+    let bin = |v: f32, axis: usize| {
+        let f = (v - lo[axis]) / size[axis] * DETAIL_BINS as f32;
+        (f.max(0.0) as usize).min(DETAIL_BINS - 1)
+    };
+    let counts = (triangles.par_iter())
+        .fold(
+            || vec![[0usize; 3]; DETAIL_BINS],
+            |mut counts, t| {
+                let c = (t.vertices[0] + t.vertices[1] + t.vertices[2]) / 3.0;
+                for axis in 0..3 {
+                    counts[bin(c[axis], axis)][axis] += 1;
+                }
+                counts
+            },
+        )
+        .reduce(
+            || vec![[0usize; 3]; DETAIL_BINS],
+            |mut a, b| {
+                for (x, y) in a.iter_mut().zip(b) {
+                    for axis in 0..3 {
+                        x[axis] += y[axis];
+                    }
+                }
+                a
+            },
+        );
+    let (mut a, mut b) = (lo, hi);
+    for axis in 0..3 {
+        // The shortest run of bins from `start` to `end` (inclusive) holding `k`.
+        let (mut start, mut held, mut best) = (0, 0, (0, DETAIL_BINS - 1));
+        for end in 0..DETAIL_BINS {
+            held += counts[end][axis];
+            while held - counts[start][axis] >= k && start < end {
+                held -= counts[start][axis];
+                start += 1;
+            }
+            if held >= k && end - start < best.1 - best.0 {
+                best = (start, end);
+            }
+        }
+        let width = size[axis] / DETAIL_BINS as f32;
+        a[axis] = lo[axis] + best.0 as f32 * width;
+        b[axis] = lo[axis] + (best.1 + 1) as f32 * width;
+    }
+    let small = (b - a).length() < SMALL_DETAIL * size.length();
+    if !small {
+        return None;
+    }
+    let grow = 0.5 * (b - a);
+    let (a, b) = (a - grow, b + grow);
+    let inside: Vec<Triangle> = (triangles.par_iter())
+        .filter(|t| {
+            t.vertices
+                .iter()
+                .all(|v| v.cmpge(a).all() && v.cmple(b).all())
+        })
+        .copied()
+        .collect();
+    let corners = inside.iter().flat_map(|t| t.vertices);
+    let bounds = corners.fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), v| (lo.min(v), hi.max(v)),
+    );
+    (!inside.is_empty()).then_some(Detail {
+        bounds,
+        triangles: inside,
+    })
+}
+
+impl Detail {
+    /// None when nothing else of the model (`all`) stands between the eye of `camera`, framed
+    /// on the detail, and the detail; else a camera that sees the detail from the first side
+    /// (front, back, right, left) where the rest leaves room enough to frame it, or from the
+    /// side with the most room, as close as that room allows (a train seen end on, from inside
+    /// its tunnel).
+    fn clear_view(&self, all: &[Triangle], camera: &Camera, aspect: f32) -> Option<Camera> {
+        let center = camera.look_at;
+        let eye = camera.position;
+        let toward = (center - eye).normalize_or_zero();
+        let ray = [(eye, toward)];
+        let in_front = nearest(all, &morton_order(all), &ray)[0].0;
+        let order = morton_order(&self.triangles);
+        let detail_in_front = nearest(&self.triangles, &order, &ray)[0].0;
+        if toward == Vec3::ZERO || in_front >= detail_in_front * (1.0 - 1e-3) {
+            return None;
+        }
+        let up = camera.up;
+        let front = model_front(up);
+        let side = up.cross(front);
+        let half = 0.5 * (self.bounds.1 - self.bounds.0);
+        let sides = [front, -front, side, -side].map(|d| {
+            let framed = frame_outside(&self.triangles, center, up, d, 0.15, aspect);
+            let back = (framed.position - center).normalize_or_zero();
+            // Where the view's line leaves the detail's box, and how far it runs on from there.
+            let exit = (0..3)
+                .filter(|&a| back[a] != 0.0)
+                .map(|a| half[a] / back[a].abs())
+                .fold(f32::INFINITY, f32::min);
+            let room = exit + 0.8 * free_run(all, center + back * exit, back);
+            (framed, back, room)
+        });
+        let fits = sides
+            .iter()
+            .find(|(framed, _, room)| framed.position.distance(center) <= *room);
+        let (framed, back, room) = fits
+            .or_else(|| sides.iter().max_by(|x, y| x.2.total_cmp(&y.2)))
+            .expect("four sides");
+        let distance = framed.position.distance(center).min(*room);
+        Some(Camera {
+            position: center + *back * distance,
+            ..framed.clone()
+        })
+    }
+}
+
+/// How far from `from` along the unit `dir` a ray runs before it meets any of `all`.
+fn free_run(all: &[Triangle], from: Vec3, dir: Vec3) -> f32 {
+    nearest(all, &morton_order(all), &[(from, dir)])[0].0
 }
 
 /// The ambient light of a bare OBJ.

@@ -25,7 +25,7 @@ pub mod texture;
 pub mod toml;
 
 use std::path::PathBuf;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
@@ -516,33 +516,74 @@ impl Scene {
         }
         (lo.x <= hi.x).then_some((lo, hi))
     }
+
+    /// The bounds a view frames: those of where most of the triangles lie when that is a small
+    /// part of the [`Scene::bounds`] (docs/design.md, "A bare `.obj`": a model on a ground
+    /// plane far larger than it, a train in a long tunnel), with the spheres; else the bounds.
+    /// Remembered, as [`Scene::bounds`] is, for the last triangle list asked about.
+    pub fn framing_bounds(&self) -> Option<(Vec3, Vec3)> {
+        let bounds = self.bounds()?;
+        let Some((mut lo, mut hi)) = detail_bounds(&self.triangles) else {
+            return Some(bounds);
+        };
+        for s in &self.spheres {
+            lo = lo.min(s.center - Vec3::splat(s.radius));
+            hi = hi.max(s.center + Vec3::splat(s.radius));
+        }
+        Some((lo, hi))
+    }
+}
+
+/// The bounds of where most of `triangles` lie when that is a small part of their bounds
+/// (`first_look::detail`), remembered for the last list asked about ([`remembered`]).
+fn detail_bounds(triangles: &Arc<Vec<Triangle>>) -> Option<(Vec3, Vec3)> {
+    static LAST: Memo<Option<(Vec3, Vec3)>> = Mutex::new(None);
+    remembered(&LAST, triangles, || {
+        let (lo, hi) = triangle_bounds(triangles);
+        first_look::detail(triangles, lo, hi).map(|d| d.bounds)
+    })
 }
 
 /// The smallest and largest corner of `triangles` (`+inf`, `-inf` when empty), remembered for
-/// the last list asked about. The memo holds a `Weak` of that list: its allocation cannot be
-/// reused while the memo lives, so the same address is the same list, and a list changed
-/// through `Arc::make_mut` while the memo refers to it moves to a new allocation.
+/// the last list asked about ([`remembered`]).
 fn triangle_bounds(triangles: &Arc<Vec<Triangle>>) -> (Vec3, Vec3) {
-    type Memo = Option<(std::sync::Weak<Vec<Triangle>>, (Vec3, Vec3))>;
-    static LAST: std::sync::Mutex<Memo> = std::sync::Mutex::new(None);
-    if let Ok(last) = LAST.lock()
-        && let Some((list, bounds)) = &*last
+    static LAST: Memo<(Vec3, Vec3)> = Mutex::new(None);
+    remembered(&LAST, triangles, || {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for t in triangles.iter() {
+            for v in t.vertices {
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+        }
+        (lo, hi)
+    })
+}
+
+/// What was worked out for the last triangle list asked about, with a `Weak` of that list.
+type Memo<T> = Mutex<Option<(std::sync::Weak<Vec<Triangle>>, T)>>;
+
+/// `compute()` for `triangles`, or what `memo` holds when it was worked out for the same list.
+/// The memo holds a `Weak` of that list: its allocation cannot be reused while the memo lives,
+/// so the same address is the same list, and a list changed through `Arc::make_mut` while the
+/// memo refers to it moves to a new allocation.
+fn remembered<T: Copy>(
+    memo: &Memo<T>,
+    triangles: &Arc<Vec<Triangle>>,
+    compute: impl FnOnce() -> T,
+) -> T {
+    if let Ok(last) = memo.lock()
+        && let Some((list, value)) = &*last
         && std::ptr::eq(list.as_ptr(), Arc::as_ptr(triangles))
     {
-        return *bounds;
+        return *value;
     }
-    let mut lo = Vec3::splat(f32::INFINITY);
-    let mut hi = Vec3::splat(f32::NEG_INFINITY);
-    for t in triangles.iter() {
-        for v in t.vertices {
-            lo = lo.min(v);
-            hi = hi.max(v);
-        }
+    let value = compute();
+    if let Ok(mut last) = memo.lock() {
+        *last = Some((Arc::downgrade(triangles), value));
     }
-    if let Ok(mut last) = LAST.lock() {
-        *last = Some((Arc::downgrade(triangles), (lo, hi)));
-    }
-    (lo, hi)
+    value
 }
 
 #[cfg(test)]

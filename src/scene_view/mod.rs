@@ -240,11 +240,12 @@ pub fn node_at<'a>(root: &'a Node, path: &[usize]) -> Option<&'a Node> {
     Some(node)
 }
 
-/// The scene's size (the diagonal of its bounds, at least 1e-3; 10 for an empty scene): how
-/// long rays that hit nothing, stubs and normal ticks are drawn.
+/// The scene's size (the diagonal of the bounds a view frames, [`Scene::framing_bounds`], at
+/// least 1e-3; 10 for an empty scene): how long rays that hit nothing, stubs and normal ticks
+/// are drawn.
 pub fn extent(scene: &Scene) -> f32 {
     scene
-        .bounds()
+        .framing_bounds()
         .map(|(lo, hi)| (hi - lo).length())
         .unwrap_or(10.0)
         .max(1e-3)

@@ -48,6 +48,9 @@ const GRAZING: f32 = 0.2;
 /// The grid of the render camera's image whose points a direction is scored on.
 const GRID: (u32, u32) = (32, 24);
 
+/// The part of the scene a view frames ([`crate::scene::Scene::framing_bounds`]).
+type Bounds = Option<(Vec3, Vec3)>;
+
 /// The scene view's vertical field of view in the viewer.
 pub const FOV_Y_DEG: f32 = 45.0;
 
@@ -65,11 +68,12 @@ pub struct Candidate {
 /// eye (the render camera inside a closed model), that eye is kept: the cut opens the walls
 /// for it.
 pub fn overview(tracer: &Tracer, aspect: f32, fov_y_deg: f32, cutaway: Cutaway) -> Camera {
-    let framings = framings(tracer, aspect, fov_y_deg);
+    let bounds = tracer.scene.framing_bounds();
+    let framings = framings(tracer, bounds, aspect, fov_y_deg);
     if cutaway.active(&tracer.scene, framings[0].position) {
         return framings[0].clone();
     }
-    let all = scored(tracer, framings);
+    let all = scored(tracer, bounds, framings);
     let best = all.iter().map(|c| c.sees).fold(0.0f32, f32::max);
     all.iter()
         .find(|c| c.sees >= PREFERENCE * best)
@@ -81,21 +85,20 @@ pub fn overview(tracer: &Tracer, aspect: f32, fov_y_deg: f32, cutaway: Cutaway) 
 /// Every direction of [`DIRECTIONS`], framed, with the share of the render camera's points its
 /// eye sees (0 for all when the render camera sees nothing).
 pub fn candidates(tracer: &Tracer, aspect: f32, fov_y_deg: f32) -> Vec<Candidate> {
-    scored(tracer, framings(tracer, aspect, fov_y_deg))
+    let bounds = tracer.scene.framing_bounds();
+    scored(tracer, bounds, framings(tracer, bounds, aspect, fov_y_deg))
 }
 
 /// The camera of each direction of [`DIRECTIONS`], framed on the scene and the render camera.
-fn framings(tracer: &Tracer, aspect: f32, fov_y_deg: f32) -> Vec<Camera> {
+fn framings(tracer: &Tracer, bounds: Bounds, aspect: f32, fov_y_deg: f32) -> Vec<Camera> {
     let scene = &tracer.scene;
     let eye = scene.camera.position;
     let view = (scene.camera.look_at - eye).normalize_or(Vec3::NEG_Z);
     let up = scene.camera.up.normalize_or(Vec3::Y);
     let side = view.cross(up).normalize_or(Vec3::X);
-    let (lo, hi) = scene
-        .bounds()
-        .map_or((eye - Vec3::ONE, eye + Vec3::ONE), |(lo, hi)| {
-            (lo.min(eye), hi.max(eye))
-        });
+    let (lo, hi) = bounds.map_or((eye - Vec3::ONE, eye + Vec3::ONE), |(lo, hi)| {
+        (lo.min(eye), hi.max(eye))
+    });
     let base = Camera {
         fov_y_deg,
         up,
@@ -111,8 +114,8 @@ fn framings(tracer: &Tracer, aspect: f32, fov_y_deg: f32) -> Vec<Camera> {
 }
 
 /// Each camera with the share of the render camera's points its eye sees.
-fn scored(tracer: &Tracer, cameras: Vec<Camera>) -> Vec<Candidate> {
-    let (hits, along) = seen_points(tracer);
+fn scored(tracer: &Tracer, bounds: Bounds, cameras: Vec<Camera>) -> Vec<Candidate> {
+    let (hits, along) = seen_points(tracer, bounds);
     let total = (hits.len() + along.len()).max(1) as f32;
     cameras
         .into_iter()
@@ -150,11 +153,11 @@ const ALONG: f32 = 16.0;
 
 /// The points the render camera sees at the centres of a `GRID` over its image, with the
 /// normals there; and points along the rays to them, inside the scene's bounds, evenly spaced.
-fn seen_points(tracer: &Tracer) -> (Vec<(Vec3, Vec3)>, Vec<Vec3>) {
+fn seen_points(tracer: &Tracer, bounds: Bounds) -> (Vec<(Vec3, Vec3)>, Vec<Vec3>) {
     let scene = &tracer.scene;
     let (w, h) = (scene.render.width.max(1), scene.render.height.max(1));
     let frame = CameraFrame::new(&scene.camera, w, h);
-    let Some((lo, hi)) = scene.bounds() else {
+    let Some((lo, hi)) = bounds else {
         return (Vec::new(), Vec::new());
     };
     let spacing = (hi - lo).length() / ALONG;
