@@ -135,10 +135,7 @@ pub(crate) fn load_obj_scene(
     let aspect = scene.render.width.max(1) as f32 / scene.render.height.max(1) as f32;
     // A model whose detail is a small part of its bounds is framed on its detail.
     let detail = detail(&scene.triangles, lo, hi);
-    let (framed, (lo, hi)) = match &detail {
-        Some(d) => (&d.triangles[..], d.bounds),
-        None => (&scene.triangles[..], (lo, hi)),
-    };
+    let (framed, (lo, hi)) = Detail::framed(&detail, &scene.triangles, (lo, hi));
     let mut look = first_view(framed, lo, hi, up, aspect);
     // Without `vn`, the winding alone says which side of a face is its front. A model that
     // opens as a room but whose faces face inwards and cover little of its bounds' sides (a
@@ -269,10 +266,7 @@ pub fn refit_bare_obj(scene: &mut Scene) {
         return;
     }
     let detail = detail(&scene.triangles, lo, hi);
-    let (framed, (lo, hi)) = match &detail {
-        Some(d) => (&d.triangles[..], d.bounds),
-        None => (&scene.triangles[..], (lo, hi)),
-    };
+    let (framed, (lo, hi)) = Detail::framed(&detail, &scene.triangles, (lo, hi));
     let center = 0.5 * (lo + hi);
     if camera.look_at.distance(center) > 1e-4 * (hi - lo).length() {
         return;
@@ -398,6 +392,17 @@ pub(super) fn detail(triangles: &[Triangle], lo: Vec3, hi: Vec3) -> Option<Detai
 }
 
 impl Detail {
+    /// What a first look frames: the detail's triangles and bounds, or else `all` and `bounds`.
+    fn framed<'a>(
+        detail: &'a Option<Detail>,
+        all: &'a [Triangle],
+        bounds: (Vec3, Vec3),
+    ) -> (&'a [Triangle], (Vec3, Vec3)) {
+        detail
+            .as_ref()
+            .map_or((all, bounds), |d| (&d.triangles[..], d.bounds))
+    }
+
     /// None when nothing else of the model (`all`) stands between the eye of `camera`, framed
     /// on the detail, and the detail; else a camera that sees the detail from the first side
     /// (front, back, right, left) where the rest leaves room enough to frame it, or from the
