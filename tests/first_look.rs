@@ -1391,3 +1391,22 @@ fn a_model_in_a_long_tunnel_is_seen_from_inside_the_tunnel() {
         view.position
     );
 }
+
+/// A scene a fifth across seen from a million away: the points along the render camera's rays
+/// are counted, where stepping by the scene's spacing, under half a step of f32 there, never
+/// ended.
+#[test]
+fn the_scene_view_first_looks_at_a_tiny_scene_from_far_away() {
+    let mut scene = raytree::scene::load_builtin("default").expect("built-in");
+    scene.triangles = Arc::new(Vec::new());
+    scene.spheres.truncate(1);
+    scene.spheres[0].center = Vec3::ZERO;
+    scene.spheres[0].radius = 0.1;
+    scene.camera.position = Vec3::new(0.0, 0.0, 1e6);
+    scene.camera.look_at = Vec3::ZERO;
+    scene.camera.fov_y_deg = 2e-5;
+    let tracer = Tracer::new(Arc::new(scene), TraceSettings::default());
+    let all = candidates(&tracer, 4.0 / 3.0, FOV_Y_DEG);
+    let best = all.iter().map(|c| c.sees).fold(0.0, f32::max);
+    assert!(best > 0.0, "no direction sees the sphere: {all:?}");
+}

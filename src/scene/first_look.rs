@@ -207,8 +207,9 @@ pub(crate) fn load_obj_scene(
             let above = camera.position + forward * (0.2 * distance);
             // Framed on its detail, the camera may stand inside the rest (a tunnel): the
             // light stays under what is above it.
-            let room =
-                (detail.as_ref()).map_or(f32::INFINITY, |_| free_run(&scene.triangles, above, up));
+            let room = (detail.as_ref()).map_or(f32::INFINITY, |_| {
+                free_run(&scene.triangles, &morton_order(&scene.triangles), above, up)
+            });
             above + up * (0.5 * distance).min(0.8 * room)
         }
     };
@@ -413,7 +414,8 @@ impl Detail {
         let eye = camera.position;
         let toward = (center - eye).normalize_or_zero();
         let ray = [(eye, toward)];
-        let in_front = nearest(all, &morton_order(all), &ray)[0].0;
+        let all_order = morton_order(all);
+        let in_front = nearest(all, &all_order, &ray)[0].0;
         let order = morton_order(&self.triangles);
         let detail_in_front = nearest(&self.triangles, &order, &ray)[0].0;
         if toward == Vec3::ZERO || in_front >= detail_in_front * (1.0 - 1e-3) {
@@ -431,7 +433,7 @@ impl Detail {
                 .filter(|&a| back[a] != 0.0)
                 .map(|a| half[a] / back[a].abs())
                 .fold(f32::INFINITY, f32::min);
-            let room = exit + 0.8 * free_run(all, center + back * exit, back);
+            let room = exit + 0.8 * free_run(all, &all_order, center + back * exit, back);
             (framed, back, room)
         });
         let fits = sides
@@ -439,7 +441,7 @@ impl Detail {
             .find(|(framed, _, room)| framed.position.distance(center) <= *room);
         let (framed, back, room) = fits
             .or_else(|| sides.iter().max_by(|x, y| x.2.total_cmp(&y.2)))
-            .expect("four sides");
+            .unwrap_or(&sides[0]);
         let distance = framed.position.distance(center).min(*room);
         Some(Camera {
             position: center + *back * distance,
@@ -448,9 +450,10 @@ impl Detail {
     }
 }
 
-/// How far from `from` along the unit `dir` a ray runs before it meets any of `all`.
-fn free_run(all: &[Triangle], from: Vec3, dir: Vec3) -> f32 {
-    nearest(all, &morton_order(all), &[(from, dir)])[0].0
+/// How far from `from` along the unit `dir` a ray runs before it meets any of `all` (in
+/// `order`, [`morton_order`]).
+fn free_run(all: &[Triangle], order: &[u32], from: Vec3, dir: Vec3) -> f32 {
+    nearest(all, order, &[(from, dir)])[0].0
 }
 
 /// The ambient light of a bare OBJ.

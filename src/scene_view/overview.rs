@@ -177,10 +177,12 @@ fn seen_points(tracer: &Tracer, bounds: Bounds) -> (Vec<(Vec3, Vec3)>, Vec<Vec3>
                 continue;
             }
             hits.push((p, normal));
-            let mut s = entry(ray.origin, ray.dir, lo, hi) + 0.5 * spacing;
-            while s < t && spacing > 0.0 {
-                along.push(ray.origin + ray.dir * s);
-                s += spacing;
+            // Counted rather than stepped: far from a small scene, a step of its spacing may
+            // not move `t` at all in f32. No ray runs longer inside the box than its diagonal.
+            let start = entry(ray.origin, ray.dir, lo, hi);
+            let count = ((t - start) / spacing).clamp(0.0, 2.0 * ALONG) as usize;
+            for k in 0..count {
+                along.push(ray.origin + ray.dir * (start + (k as f32 + 0.5) * spacing));
             }
         }
     }
