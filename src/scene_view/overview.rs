@@ -96,9 +96,12 @@ fn framings(tracer: &Tracer, bounds: Bounds, aspect: f32, fov_y_deg: f32) -> Vec
     let view = (scene.camera.look_at - eye).normalize_or(Vec3::NEG_Z);
     let up = scene.camera.up.normalize_or(Vec3::Y);
     let side = view.cross(up).normalize_or(Vec3::X);
-    let (lo, hi) = bounds.map_or((eye - Vec3::ONE, eye + Vec3::ONE), |(lo, hi)| {
-        (lo.min(eye), hi.max(eye))
-    });
+    let (lo, hi) = bounds.unwrap_or((eye - Vec3::ONE, eye + Vec3::ONE));
+    // What is framed: the bounds' corners and the render camera's eye (not the corners of a
+    // box around both, which a far eye would make much larger than either).
+    let mut points: Vec<Vec3> = (0..8).map(|k| box_corner(lo, hi, k)).collect();
+    points.push(eye);
+    let (lo, hi) = (lo.min(eye), hi.max(eye));
     let base = Camera {
         fov_y_deg,
         up,
@@ -108,7 +111,7 @@ fn framings(tracer: &Tracer, bounds: Bounds, aspect: f32, fov_y_deg: f32) -> Vec
         .iter()
         .map(|&[a, b, c]| {
             let direction = (side * a + up * b - view * c).normalize();
-            framed(&base, lo, hi, direction, aspect)
+            framed(&base, (lo, hi), &points, direction, aspect)
         })
         .collect()
 }
@@ -132,17 +135,24 @@ fn scored(tracer: &Tracer, bounds: Bounds, cameras: Vec<Camera>) -> Vec<Candidat
         .collect()
 }
 
-/// `base` framed on `lo..hi` from `direction`, as close as the box's corners allow in both
-/// fields of a view of `aspect`.
-fn framed(base: &Camera, lo: Vec3, hi: Vec3, direction: Vec3, aspect: f32) -> Camera {
+/// `base` aimed at the centre of the box `lo..hi` from `direction`, as close as `points` allow
+/// in both fields of a view of `aspect`.
+fn framed(
+    base: &Camera,
+    (lo, hi): (Vec3, Vec3),
+    points: &[Vec3],
+    direction: Vec3,
+    aspect: f32,
+) -> Camera {
     let mut camera = base.framing(lo, hi, direction);
     // `framing` fits the bounding sphere in the vertical field, which leaves a flat scene (a
-    // floor and a few objects) small in the pane: the camera comes as close as the box's eight
-    // corners allow, in both fields of the pane (the narrower one across when the pane is
-    // narrower than tall), with the same margin.
+    // floor and a few objects) small in the pane: the camera comes as close as the points
+    // allow, in both fields of the pane (the narrower one across when the pane is narrower
+    // than tall), with the same margin.
     let tan_y = (0.5 * camera.fov_y_deg).to_radians().min(1.5).tan();
     let tan_x = aspect * tan_y;
-    if let Some(distance) = corner_fit(lo, hi, direction, base.up, tan_x, tan_y) {
+    let center = 0.5 * (lo + hi);
+    if let Some(distance) = points_fit(center, points, direction, base.up, tan_x, tan_y) {
         camera.position = camera.look_at + direction * distance;
     }
     camera
@@ -229,22 +239,37 @@ pub fn corner_fit(
     tan_x: f32,
     tan_y: f32,
 ) -> Option<f32> {
+    let corners: Vec<Vec3> = (0..8).map(|k| box_corner(lo, hi, k)).collect();
+    points_fit(0.5 * (lo + hi), &corners, direction, up, tan_x, tan_y)
+}
+
+/// The distance from `center` along the unit `direction` at which every one of `points` lies
+/// inside a view aimed at `center` whose half fields have tangents `tan_x` across and `tan_y`
+/// up, with [`FRAME_MARGIN`], and outside the sphere about `center` through the farthest
+/// point; `None` for a degenerate view.
+fn points_fit(
+    center: Vec3,
+    points: &[Vec3],
+    direction: Vec3,
+    up: Vec3,
+    tan_x: f32,
+    tan_y: f32,
+) -> Option<f32> {
     let right = up.cross(direction).normalize_or_zero();
     let upward = direction.cross(right);
     if right == Vec3::ZERO || !(tan_x > 0.0 && tan_y > 0.0) {
         return None;
     }
-    let center = 0.5 * (lo + hi);
-    let mut distance = 0.0f32;
-    for k in 0..8 {
-        let q = box_corner(lo, hi, k) - center;
-        // The corner's depth in front of an eye at `distance` is `distance − q·direction`.
+    let (mut distance, mut radius) = (0.0f32, 0.0f32);
+    for &p in points {
+        let q = p - center;
+        // The point's depth in front of an eye at `distance` is `distance − q·direction`.
         let across = q.dot(direction) + FRAME_MARGIN * q.dot(right).abs() / tan_x;
         let upwards = q.dot(direction) + FRAME_MARGIN * q.dot(upward).abs() / tan_y;
         distance = distance.max(across).max(upwards);
+        radius = radius.max(q.length());
     }
-    // Never inside the box's bounding sphere, where the near corners would pass the eye.
-    let radius = 0.5 * (hi - lo).length();
+    // Never inside that sphere, where the near points would pass the eye.
     let distance = distance.max(1.05 * radius);
     (distance.is_finite() && distance > 0.0).then_some(distance)
 }
@@ -299,5 +324,32 @@ mod tests {
             assert!(d < sphere, "{d} against the sphere's {sphere}");
         }
         assert_eq!(corner_fit(lo, hi, Vec3::Y, Vec3::Y, 0.4, 0.4), None);
+    }
+
+    /// A box and an eye far in front of it, framed as points: every point in the view, and
+    /// the camera closer than framing the box around both, whose far corners beside the eye
+    /// are not there.
+    #[test]
+    fn points_fit_frames_a_far_eye_closer_than_the_box_around_it() {
+        let (lo, hi) = (Vec3::ZERO, Vec3::splat(5.5));
+        let eye = Vec3::new(2.75, 2.75, -20.0);
+        let mut points: Vec<Vec3> = (0..8).map(|k| box_corner(lo, hi, k)).collect();
+        points.push(eye);
+        let (blo, bhi) = (lo.min(eye), hi.max(eye));
+        let center = 0.5 * (blo + bhi);
+        let direction = Vec3::new(0.5, 0.25, -1.0).normalize();
+        let (tan_x, tan_y) = (0.55, 0.41);
+        let d = points_fit(center, &points, direction, Vec3::Y, tan_x, tan_y).expect("a distance");
+        let view_eye = center + direction * d;
+        for &p in &points {
+            let (x, y) = tangents(view_eye, center, Vec3::Y, p);
+            assert!(
+                x.abs() * FRAME_MARGIN <= tan_x * (1.0 + 1e-4)
+                    && y.abs() * FRAME_MARGIN <= tan_y * (1.0 + 1e-4),
+                "{p} is outside the view"
+            );
+        }
+        let boxed = corner_fit(blo, bhi, direction, Vec3::Y, tan_x, tan_y).expect("a distance");
+        assert!(d < 0.9 * boxed, "{d} against the box's {boxed}");
     }
 }
