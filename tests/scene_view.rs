@@ -144,6 +144,75 @@ fn the_part_behind_a_sphere_is_drawn_dimmed_not_left_out() {
     assert!(clear > 200, "in the clear: {clear}");
 }
 
+/// A black ball (no ambient, diffuse or specular) against a black background: the headless
+/// scene view draws its outline, a ring of dark grey at the ball's edge as the ball projects,
+/// while its inside and the background stay black.
+#[test]
+fn a_black_ball_on_black_keeps_its_outline() {
+    let mut scene = Scene::default();
+    scene.render.background = Vec3::ZERO;
+    let material = scene.default_material();
+    let m = &mut scene.materials[material.0 as usize];
+    (m.ambient, m.diffuse, m.specular) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
+    scene.objects.push(Object {
+        name: "ball".into(),
+        source: ObjectSource::Sphere,
+    });
+    let (center, radius) = (Vec3::new(0.0, 0.5, 0.0), 1.0);
+    scene.spheres.push(Sphere {
+        center,
+        radius,
+        material,
+        object: ObjectId(0),
+    });
+    let camera = Camera {
+        position: Vec3::new(0.0, 0.5, 6.0),
+        look_at: center,
+        up: Vec3::Y,
+        fov_y_deg: 40.0,
+    };
+    let (w, h) = (200u32, 150u32);
+    let canvas = headless::scene_view_image(
+        &scene,
+        TraceSettings::default(),
+        &[],
+        &camera,
+        w,
+        h,
+        &Filter::default(),
+        Cutaway::Off,
+    )
+    .expect("a picture");
+    // The ball's outline in pixels: its angular radius asin(r / d) against the half field.
+    let half = (20.0f32).to_radians().tan();
+    let ring = (radius / 6.0f32).asin().tan() / half * h as f32 / 2.0;
+    let (cx, cy) = (w as f32 / 2.0, h as f32 / 2.0);
+    let mut grey = 0;
+    for (i, p) in canvas.rgba().chunks(4).enumerate() {
+        let (x, y) = ((i as u32 % w) as f32 + 0.5, (i as u32 / w) as f32 + 0.5);
+        let r = ((x - cx).powi(2) + (y - cy).powi(2)).sqrt();
+        if p[0] > 0 {
+            grey += 1;
+            assert!(p[0] == p[1] && p[1] == p[2], "grey at ({x}, {y}): {p:?}");
+            // Linear 0.05 is about 63 in sRGB.
+            assert!(
+                (55..=70).contains(&p[0]),
+                "outline level at ({x}, {y}): {p:?}"
+            );
+            assert!(
+                (r - ring).abs() < 2.0,
+                "lit at ({x}, {y}), {r} from the centre, the ring at {ring}"
+            );
+        }
+    }
+    // The ring is about one pixel wide all round.
+    assert!(
+        grey as f32 > 0.8 * std::f32::consts::TAU * ring
+            && grey as f32 <= 2.5 * std::f32::consts::TAU * ring,
+        "{grey} grey pixels for a ring of radius {ring}"
+    );
+}
+
 /// The default scene's glass sphere seen from the right of the render camera, at 320 × 240:
 /// pixel (125, 135) looks into the glass sphere, so its tree refracts through it; the picture
 /// shows the frustum, the image plane with the pixel's cross, both lights and the tree.

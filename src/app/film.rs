@@ -6,9 +6,10 @@ use glam::Vec3;
 
 use super::modes::{ImageMode, mode_color};
 use super::viewport::DisplayState;
-use crate::render::session::TileUpdate;
+use crate::render::session::{Pass, TileUpdate};
 use crate::render::{Image, Rect};
 use crate::scene_view::occlusion::DepthImage;
+use crate::scene_view::outline::{Seen, lift, on_outline};
 use crate::trace::SampleInfo;
 
 /// The film of one image size; [`Film::resize`] starts it over at another.
@@ -20,6 +21,12 @@ pub struct Film {
     beauty: Vec<Vec3>,
     /// Facts of each pixel's sample 0 (or of its preview block's sample).
     aux: Vec<SampleInfo>,
+    /// Whether the render is drawn with the scene view's outlines
+    /// ([`crate::scene_view::outline`]).
+    outlined: bool,
+    /// Whether a pixel's facts are its own sample 0's (not yet, or a preview block's, when
+    /// false): outlines are drawn only between such pixels.
+    own_facts: Vec<bool>,
 }
 
 impl Film {
@@ -31,6 +38,16 @@ impl Film {
             height,
             beauty: vec![Vec3::ZERO; n],
             aux: vec![SampleInfo::default(); n],
+            outlined: false,
+            own_facts: vec![false; n],
+        }
+    }
+
+    /// [`Film::new`] for the scene view: the render drawn with outlines.
+    pub fn outlined(width: u32, height: u32) -> Self {
+        Self {
+            outlined: true,
+            ..Self::new(width, height)
         }
     }
 
@@ -38,7 +55,10 @@ impl Film {
     /// shows the old image until the new tiles cover it.
     pub fn resize(&mut self, width: u32, height: u32) {
         if (width, height) != (self.width, self.height) {
-            *self = Self::new(width, height);
+            *self = Self {
+                outlined: self.outlined,
+                ..Self::new(width, height)
+            };
         }
     }
 
@@ -67,6 +87,16 @@ impl Film {
         }
     }
 
+    /// What pixel (`x`, `y`)'s centre ray met, as far as the film knows it.
+    fn seen(&self, x: u32, y: u32) -> Seen {
+        let i = (y * self.width + x) as usize;
+        if self.own_facts[i] {
+            Seen::of(self.aux[i].hit_t, self.aux[i].normal)
+        } else {
+            Seen::Unknown
+        }
+    }
+
     /// Whether `rect` lies inside the film (a tile of a render at another size does not).
     pub fn holds(&self, rect: Rect) -> bool {
         u64::from(rect.x) + u64::from(rect.width) <= u64::from(self.width)
@@ -83,6 +113,7 @@ impl Film {
         display: &mut DisplayState,
     ) {
         let r = tile.rect;
+        let own = tile.pass != Pass::Preview;
         for j in 0..r.height {
             for i in 0..r.width {
                 let src = (j * r.width + i) as usize;
@@ -90,11 +121,28 @@ impl Film {
                 self.beauty[dst] = tile.pixels[src];
                 if let Some(aux) = &tile.aux {
                     self.aux[dst] = aux[src];
+                    self.own_facts[dst] = own;
                 }
+            }
+        }
+        // An outline depends on the neighbours' facts: the pixels around the tile are drawn
+        // again with it.
+        let grow = u32::from(self.outlined && tile.aux.is_some());
+        let (x0, y0) = (r.x.saturating_sub(grow), r.y.saturating_sub(grow));
+        let x1 = (r.x + r.width + grow).min(self.width);
+        let y1 = (r.y + r.height + grow).min(self.height);
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let dst = (y * self.width + x) as usize;
                 display.rgba[dst] = self.display_rgba(dst, mode, max_depth);
             }
         }
-        display.mark(r);
+        display.mark(Rect {
+            x: x0,
+            y: y0,
+            width: x1 - x0,
+            height: y1 - y0,
+        });
     }
 
     /// Rewrites every pixel of `display` in `mode`'s colours (the caller marks it for upload
@@ -109,7 +157,12 @@ impl Film {
     /// of the pixel's facts.
     fn display_rgba(&self, i: usize, mode: ImageMode, max_depth: u32) -> [f32; 4] {
         let c = if mode == ImageMode::Render {
-            self.beauty[i]
+            let (x, y) = (i as u32 % self.width, i as u32 / self.width);
+            if self.outlined && on_outline(self.width, self.height, x, y, |x, y| self.seen(x, y)) {
+                lift(self.beauty[i])
+            } else {
+                self.beauty[i]
+            }
         } else {
             mode_color(mode, &self.aux[i], max_depth)
         };
@@ -184,6 +237,65 @@ mod tests {
         assert_eq!(display.rgba[5], [0.5, 0.5, 0.5, 1.0]);
     }
 
+    /// A black 4×3 film of the scene view, a black surface at distance 2 in its left two
+    /// columns and the background in the right ones, written as two 2×3 tiles of `pass`.
+    fn outlined_film(pass: Pass) -> (Film, DisplayState) {
+        let mut film = Film::outlined(4, 3);
+        let mut display = DisplayState::new(4, 3);
+        for x in [0, 2] {
+            let hit = |column: u32| SampleInfo {
+                hit_t: if column < 2 { 2.0 } else { f32::INFINITY },
+                normal: Vec3::Z,
+                ..SampleInfo::default()
+            };
+            let tile = TileUpdate {
+                generation: 1,
+                pass,
+                rect: Rect {
+                    x,
+                    y: 0,
+                    width: 2,
+                    height: 3,
+                },
+                pixels: vec![Vec3::ZERO; 6],
+                aux: Some((0..6).map(|i| hit(x + i % 2)).collect()),
+            };
+            film.write_tile(&tile, ImageMode::Render, 0, &mut display);
+        }
+        (film, display)
+    }
+
+    #[test]
+    fn the_scene_views_film_outlines_a_dark_surface_against_the_background() {
+        let (film, display) = outlined_film(Pass::Samples(1));
+        let level = crate::scene_view::outline::OUTLINE_LEVEL;
+        for y in 0..3 {
+            for x in 0..4 {
+                let [r, g, b, _] = display.rgba[(y * 4 + x) as usize];
+                // The surface's column beside the background is outline, drawn when the
+                // second tile brought the background: the first tile's edge was drawn again.
+                let want = if x == 1 { level } else { 0.0 };
+                assert!(
+                    (r - want).abs() < 1e-6 && r == g && g == b,
+                    "pixel ({x}, {y}): {r}, {g}, {b}"
+                );
+            }
+        }
+        // The film keeps the render's own colours: the outline is only drawn.
+        assert!(film.image().pixels.iter().all(|&p| p == Vec3::ZERO));
+        // A preview's block-filled facts are not the pixels' own: no outline from them, and
+        // the render view's film never outlines.
+        let (_, preview) = outlined_film(Pass::Preview);
+        assert!(preview.rgba.iter().all(|p| p[..3] == [0.0; 3]));
+        let mut plain = Film::new(4, 3);
+        let mut display = DisplayState::new(4, 3);
+        let (outlined, _) = outlined_film(Pass::Samples(1));
+        plain.aux = outlined.aux.clone();
+        plain.own_facts = outlined.own_facts.clone();
+        plain.paint(ImageMode::Render, 0, &mut display);
+        assert!(display.rgba.iter().all(|p| p[..3] == [0.0; 3]));
+    }
+
     #[test]
     fn resizing_clears_only_at_a_new_size() {
         let (mut film, _) = written(ImageMode::Render);
@@ -193,5 +305,9 @@ mod tests {
         film.resize(2, 2);
         assert_eq!(film, Film::new(2, 2));
         assert_eq!(film.image().pixels.len(), 4);
+        // The scene view's film stays outlined at its new size.
+        let mut outlined = Film::outlined(4, 3);
+        outlined.resize(2, 2);
+        assert_eq!(outlined, Film::outlined(2, 2));
     }
 }

@@ -96,7 +96,7 @@ impl SceneView {
             session: Session::new(threads)?,
             generation: 0,
             size: (320, 200),
-            film: Film::new(320, 200),
+            film: Film::outlined(320, 200),
             display: Arc::new(Mutex::new(DisplayState::new(320, 200))),
             filter: Filter::default(),
             playing: None,

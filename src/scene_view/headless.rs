@@ -4,14 +4,17 @@
 
 use std::sync::Arc;
 
+use rayon::prelude::*;
+
 use super::cutaway::{Cutaway, cut_triangles, with_cut};
 use super::occlusion::DepthImage;
+use super::outline::{Seen, outline};
 use super::raster::Canvas;
 use super::{Filter, Segment, TreeLook, camera_segments, extent, light_markers, tree_segments};
 use crate::export::srgb8_bytes;
 use crate::ray_tree::RayTree;
 use crate::render::{Image, RenderError, render};
-use crate::scene::{Camera, CameraFrame, Scene};
+use crate::scene::{Camera, CameraFrame, Scene, primary_ray};
 use crate::trace::{TraceSettings, Tracer};
 
 /// One tree of an exported picture: how it is drawn among the others (`None`: alone, in the
@@ -111,9 +114,21 @@ pub fn scene_view_image(
     seen.render.width = width;
     seen.render.height = height;
     let tracer = Tracer::new(Arc::new(seen), settings);
-    let (image, _) = render(&tracer, 1, 0, &|_, _| {})?;
+    let (mut image, _) = render(&tracer, 1, 0, &|_, _| {})?;
     let frame = CameraFrame::new(view, width, height);
-    let depth = DepthImage::of(&tracer, &frame, width, height);
+    let seen = centre_rays(&tracer, &frame, width, height);
+    outline(&mut image.pixels, width, height, &seen);
+    let depth = DepthImage {
+        width,
+        height,
+        t: seen
+            .iter()
+            .map(|s| match s {
+                Seen::Surface { t, .. } => *t,
+                _ => f32::INFINITY,
+            })
+            .collect(),
+    };
     let mut canvas = Canvas::from_srgb8(width, height, &srgb8_bytes(&image))
         .ok_or(SceneViewError::Empty { width, height })?;
 
@@ -126,6 +141,22 @@ pub fn scene_view_image(
     draw_layers(&mut canvas, &frame, &depth, layers, filter, extent(scene));
     canvas.draw_light_markers(&frame, &depth, &light_markers(scene));
     Ok(canvas)
+}
+
+/// What the centre ray (sample 0) of each pixel of a `width × height` view with `frame` met,
+/// row-major: the view's depth and its outlines. Rows run in parallel on rayon's pool.
+fn centre_rays(tracer: &Tracer, frame: &CameraFrame, width: u32, height: u32) -> Vec<Seen> {
+    (0..height)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            (0..width).map(
+                move |x| match tracer.first_hit_facts(&primary_ray(frame, x, y, 0)) {
+                    Some((t, normal)) => Seen::of(t, normal),
+                    None => Seen::Background,
+                },
+            )
+        })
+        .collect()
 }
 
 /// The render `image` of `tracer`'s scene (its own camera and size) with the `layers`' trees

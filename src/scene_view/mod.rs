@@ -7,6 +7,7 @@
 pub mod cutaway;
 pub mod headless;
 pub mod occlusion;
+pub mod outline;
 pub mod overview;
 pub mod raster;
 

@@ -365,6 +365,16 @@ impl Tracer {
         }
     }
 
+    /// [`Tracer::first_hit_t`] with the unit shading normal there, turned towards the ray
+    /// (zero on a visible light): the scene view's outlines.
+    pub fn first_hit_facts(&self, ray: &Ray) -> Option<(f32, Vec3)> {
+        match self.intersect(ray) {
+            Found::Nothing => None,
+            Found::Light(_, t) => Some((t, Vec3::ZERO)),
+            Found::Prim(hit) => Some((hit.t, self.surface(ray, &hit).0.normal)),
+        }
+    }
+
     /// Closest object or visible light along the ray, strictly after its origin (`t > 0`).
     fn intersect(&self, ray: &Ray) -> Found {
         let hit = self
