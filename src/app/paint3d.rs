@@ -161,14 +161,32 @@ pub fn draw_lights(painter: &egui::Painter, view: &ScreenView, lights: &[crate::
         );
         painter.circle_filled(p, 6.0, fill);
         painter.circle_stroke(p, 9.0, Stroke::new(2.0, Color32::BLACK));
-        painter.text(
-            p + egui::vec2(11.0, -11.0),
-            egui::Align2::LEFT_BOTTOM,
-            &l.name,
+        let galley = painter.layout_no_wrap(
+            l.name.clone(),
             egui::FontId::proportional(13.0),
             Color32::WHITE,
         );
+        if let Some(at) = label_place(p, galley.size(), painter.clip_rect()) {
+            painter.galley(at, galley, Color32::WHITE);
+        }
     }
+}
+
+/// Where the top-left corner of a marker's label of `size` goes: above and right of the marker
+/// at `marker`, or on its left where the right would leave `clip`, moved down or up to stay in
+/// it; `None` when the marker itself is outside `clip` (its label would name nothing shown).
+fn label_place(marker: Pos2, size: egui::Vec2, clip: Rect) -> Option<Pos2> {
+    if !clip.contains(marker) {
+        return None;
+    }
+    const GAP: f32 = 11.0;
+    let x = if marker.x + GAP + size.x <= clip.max.x {
+        marker.x + GAP
+    } else {
+        (marker.x - GAP - size.x).max(clip.min.x)
+    };
+    let y = (marker.y - GAP - size.y).clamp(clip.min.y, (clip.max.y - size.y).max(clip.min.y));
+    Some(Pos2::new(x, y))
 }
 
 /// The drawn segment nearest `pos`, within [`PICK_DISTANCE`].
@@ -194,6 +212,36 @@ fn distance_to_segment(p: Pos2, a: Pos2, b: Pos2) -> f32 {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_lights_label_stays_in_the_pane_and_goes_with_its_marker() {
+        use super::label_place;
+        use eframe::egui::{Pos2, Rect, vec2};
+        let clip = Rect::from_min_max(Pos2::new(100.0, 50.0), Pos2::new(400.0, 300.0));
+        let size = vec2(60.0, 14.0);
+        // In the open: above and right of the marker.
+        assert_eq!(
+            label_place(Pos2::new(200.0, 150.0), size, clip),
+            Some(Pos2::new(211.0, 125.0))
+        );
+        // Near the right edge: on the left. Near the top: moved down into the pane.
+        assert_eq!(
+            label_place(Pos2::new(380.0, 55.0), size, clip),
+            Some(Pos2::new(309.0, 50.0))
+        );
+        // Every label lies inside the pane, wherever in it the marker is.
+        for x in (100..400).step_by(7) {
+            for y in (50..300).step_by(7) {
+                let at = label_place(Pos2::new(x as f32, y as f32), size, clip).expect("a place");
+                assert!(
+                    clip.contains_rect(Rect::from_min_size(at, size)),
+                    "({x}, {y}): {at:?}"
+                );
+            }
+        }
+        // A marker left of the pane, as an eye just outside the view: no label.
+        assert_eq!(label_place(Pos2::new(90.0, 150.0), size, clip), None);
+    }
+
     use super::*;
     use crate::scene::builtin::load_builtin;
 
