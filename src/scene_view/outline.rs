@@ -16,7 +16,8 @@ const FOLD_COS: f32 = 0.766;
 
 /// How far in front of its two neighbours a pixel must stand to lie on a near edge: its
 /// inverse distance above their mean by this share of itself. A plane's inverse depth changes
-/// linearly across the image, so a plane seen at a grazing angle has no edge inside it.
+/// linearly across the image, and its inverse distance along the rays nearly so (from pixel to
+/// pixel far within this share), so a plane seen at a grazing angle has no edge inside it.
 const EDGE_STEP: f32 = 0.04;
 
 /// What one pixel's centre ray met.
