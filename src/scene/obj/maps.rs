@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use glam::Vec2;
 
+use super::mtl::statement_place;
 use super::paths::{file_stem, sibling};
 use super::read::quietly;
 use super::request::MeshRequest;
@@ -120,16 +121,7 @@ pub(super) fn load_texture(
     let file = texture_statement(value).0;
     let tails = candidates(file);
     let paths: Vec<String> = tails.iter().map(|c| sibling(req.key, c)).collect();
-    let place = mtl_texts
-        .iter()
-        .find_map(|(mtl, text)| {
-            text.lines()
-                .position(|l| {
-                    let l = l.trim_start();
-                    l.starts_with(key) && l.contains(file)
-                })
-                .map(|i| format!("`{mtl}` line {}", i + 1))
-        })
+    let place = statement_place(mtl_texts, material, key, Some(file))
         .unwrap_or_else(|| "its material library".into());
     let fail = |reason: String, warnings: &mut Vec<String>| {
         warnings.push(format!(

@@ -310,7 +310,7 @@ pub(super) fn mtl_material(
     let (id, fresh) = match scene.materials.iter().position(|x| x.name == name) {
         Some(i) => (MaterialId(i as u32), false),
         None => {
-            let material = material_from_mtl(m, name, req.label, warnings);
+            let material = material_from_mtl(m, name, req.label, mtl_texts, warnings);
             scene.materials.push(material);
             (MaterialId(scene.materials.len() as u32 - 1), true)
         }
@@ -396,12 +396,14 @@ fn material_from_mtl(
     m: &tobj::Material,
     name: String,
     label: &str,
+    mtl_texts: &[(String, String)],
     warnings: &mut Vec<String>,
 ) -> Material {
     let d = Material::default();
     let mut values = Values {
         m,
         label,
+        mtl_texts,
         warnings: &mut *warnings,
     };
     let ambient = values.rgb(m.ambient, "Ka", d.ambient);
@@ -447,17 +449,49 @@ fn material_from_mtl(
     }
 }
 
+/// Where material `material`'s `key` statement stands, as warnings name it ("`LIB` line N"):
+/// the last line (the one tobj keeps) of that material's block in the first of the libraries
+/// `mtl_texts` (name, text) that has one starting with `key` and holding `holding`, when
+/// given; `None` when none does.
+pub(super) fn statement_place(
+    mtl_texts: &[(String, String)],
+    material: &str,
+    key: &str,
+    holding: Option<&str>,
+) -> Option<String> {
+    mtl_texts.iter().find_map(|(mtl, text)| {
+        let (mut inside, mut last) = (false, None);
+        for (i, line) in text.lines().enumerate() {
+            let Some(first) = line.split_whitespace().next() else {
+                continue;
+            };
+            if first == "newmtl" {
+                // The name as tobj reads it: the rest of the line, trimmed.
+                inside = line.trim_start()[6..].trim() == material;
+            } else if inside && first == key && holding.is_none_or(|h| line.contains(h)) {
+                last = Some(i);
+            }
+        }
+        last.map(|i| format!("`{mtl}` line {}", i + 1))
+    })
+}
+
 /// The values of one MTL material as they are read, with one warning for each invalid one.
 struct Values<'a> {
     m: &'a tobj::Material,
     label: &'a str,
+    /// The material libraries read (name, text), to say on which line a value stands.
+    mtl_texts: &'a [(String, String)],
     warnings: &'a mut Vec<String>,
 }
 
 impl Values<'_> {
     fn invalid(&mut self, key: &str, got: String, fallback: String) {
+        let place = statement_place(self.mtl_texts, &self.m.name, key, None)
+            .map(|p| format!(" ({p})"))
+            .unwrap_or_default();
         self.warnings.push(format!(
-            "{}: material `{}` has an invalid `{key}` {got}; using {fallback}.",
+            "{}: material `{}`{place} has an invalid `{key}` {got}; using {fallback}.",
             self.label,
             short(&self.m.name)
         ));
@@ -526,6 +560,45 @@ impl Values<'_> {
 mod tests {
     use super::super::read::quietly;
     use super::*;
+
+    #[test]
+    fn a_statement_is_placed_on_its_materials_last_line_of_that_key() {
+        let libs = vec![
+            ("a.mtl".to_string(), "newmtl wood\nKd 1 1 1\n".to_string()),
+            (
+                "b.mtl".to_string(),
+                "# b\nnewmtl  red paint \nKd 1 0 0\nmap_Kd r.png\n\nKd nan 0 0\nnewmtl blue\nKd 0 0 1\nNi 0\n"
+                    .to_string(),
+            ),
+        ];
+        // tobj keeps a material's last `Kd`: the line named is that one, in its own block.
+        assert_eq!(
+            statement_place(&libs, "red paint", "Kd", None).as_deref(),
+            Some("`b.mtl` line 6")
+        );
+        assert_eq!(
+            statement_place(&libs, "blue", "Ni", None).as_deref(),
+            Some("`b.mtl` line 9")
+        );
+        assert_eq!(
+            statement_place(&libs, "wood", "Kd", None).as_deref(),
+            Some("`a.mtl` line 2")
+        );
+        assert_eq!(
+            statement_place(&libs, "red paint", "map_Kd", Some("r.png")).as_deref(),
+            Some("`b.mtl` line 4")
+        );
+        // Another material's key, a key the block lacks, a texture it does not name: nowhere.
+        assert_eq!(statement_place(&libs, "wood", "Ni", None), None);
+        assert_eq!(
+            statement_place(&libs, "red paint", "map_Kd", Some("q.png")),
+            None
+        );
+        assert_eq!(statement_place(&libs, "green", "Kd", None), None);
+        // A key is a whole word: `Kd` is not `Kds`, nor found inside another word.
+        let odd = vec![("c.mtl".to_string(), "newmtl x\nKds 1\n#Kd 1\n".to_string())];
+        assert_eq!(statement_place(&odd, "x", "Kd", None), None);
+    }
 
     #[test]
     fn mtl_colours_of_one_number_are_spelled_out_and_two_are_refused() {
