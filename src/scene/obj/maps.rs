@@ -6,7 +6,6 @@ use std::sync::Arc;
 
 use glam::Vec2;
 
-use super::mtl::statement_place;
 use super::paths::{file_stem, sibling};
 use super::read::quietly;
 use super::request::MeshRequest;
@@ -108,6 +107,33 @@ const ANCESTORS: usize = 2;
 /// found where the MTL says is looked for as [`candidates`] lists; one found so goes into
 /// `elsewhere` (as written, as found) for the caller's one note.
 #[allow(clippy::too_many_arguments)]
+/// Where material `material`'s `key` statement stands, as warnings name it ("`LIB` line N"):
+/// the last line (the one tobj keeps) of that material's block in the first of the libraries
+/// `mtl_texts` (name, text) that has one starting with `key` and holding `holding`, when
+/// given; `None` when none does.
+pub(super) fn statement_place(
+    mtl_texts: &[(String, String)],
+    material: &str,
+    key: &str,
+    holding: Option<&str>,
+) -> Option<String> {
+    mtl_texts.iter().find_map(|(mtl, text)| {
+        let (mut inside, mut last) = (false, None);
+        for (i, line) in text.lines().enumerate() {
+            let Some(first) = line.split_whitespace().next() else {
+                continue;
+            };
+            if first == "newmtl" {
+                // The name as tobj reads it: the rest of the line, trimmed.
+                inside = line.trim_start()[6..].trim() == material;
+            } else if inside && first == key && holding.is_none_or(|h| line.contains(h)) {
+                last = Some(i);
+            }
+        }
+        last.map(|i| format!("`{mtl}` line {}", i + 1))
+    })
+}
+
 pub(super) fn load_texture(
     scene: &mut Scene,
     req: &MeshRequest,

@@ -8,7 +8,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use super::maps::{candidates, load_texture, named_diffuse, texture_statement};
+use super::maps::{candidates, load_texture, named_diffuse, statement_place, texture_statement};
 use super::parse::Facts;
 use super::paths::sibling;
 use super::read::UNNAMED_MATERIAL;
@@ -447,33 +447,6 @@ fn material_from_mtl(
         diffuse_map_placement: Default::default(),
         ambient_map_placement: Default::default(),
     }
-}
-
-/// Where material `material`'s `key` statement stands, as warnings name it ("`LIB` line N"):
-/// the last line (the one tobj keeps) of that material's block in the first of the libraries
-/// `mtl_texts` (name, text) that has one starting with `key` and holding `holding`, when
-/// given; `None` when none does.
-pub(super) fn statement_place(
-    mtl_texts: &[(String, String)],
-    material: &str,
-    key: &str,
-    holding: Option<&str>,
-) -> Option<String> {
-    mtl_texts.iter().find_map(|(mtl, text)| {
-        let (mut inside, mut last) = (false, None);
-        for (i, line) in text.lines().enumerate() {
-            let Some(first) = line.split_whitespace().next() else {
-                continue;
-            };
-            if first == "newmtl" {
-                // The name as tobj reads it: the rest of the line, trimmed.
-                inside = line.trim_start()[6..].trim() == material;
-            } else if inside && first == key && holding.is_none_or(|h| line.contains(h)) {
-                last = Some(i);
-            }
-        }
-        last.map(|i| format!("`{mtl}` line {}", i + 1))
-    })
 }
 
 /// The values of one MTL material as they are read, with one warning for each invalid one.
