@@ -101,12 +101,6 @@ pub(super) fn candidates(file: &str) -> Vec<String> {
 /// How many folders above the OBJ's [`candidates`] looks in.
 const ANCESTORS: usize = 2;
 
-/// The texture `value` of MTL statement `key` of material `material`, loaded once per scene
-/// (materials that share a file share the texture); `None` with one warning naming the file
-/// and the MTL line when it cannot be read, decoded, or fit in the memory budget. A file not
-/// found where the MTL says is looked for as [`candidates`] lists; one found so goes into
-/// `elsewhere` (as written, as found) for the caller's one note.
-#[allow(clippy::too_many_arguments)]
 /// Where material `material`'s `key` statement stands, as warnings name it ("`LIB` line N"):
 /// the last line (the one tobj keeps) of that material's block in the first of the libraries
 /// `mtl_texts` (name, text) that has one starting with `key` and holding `holding`, when
@@ -134,6 +128,12 @@ pub(super) fn statement_place(
     })
 }
 
+/// The texture `value` of MTL statement `key` of material `material`, loaded once per scene
+/// (materials that share a file share the texture); `None` with one warning naming the file
+/// and the MTL line when it cannot be read, decoded, or fit in the memory budget. A file not
+/// found where the MTL says is looked for as [`candidates`] lists; one found so goes into
+/// `elsewhere` (as written, as found) for the caller's one note.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn load_texture(
     scene: &mut Scene,
     req: &MeshRequest,
