@@ -135,6 +135,12 @@ pub(crate) fn load_obj_scene(
     let aspect = scene.render.width.max(1) as f32 / scene.render.height.max(1) as f32;
     // A model whose detail is a small part of its bounds is framed on its detail.
     let detail = detail(&scene.triangles, lo, hi);
+    if scene.spheres.is_empty() {
+        // `lo..hi` are the triangles' own bounds: the scene view frames the same detail.
+        super::remember_detail_bounds(&scene.triangles, detail.as_ref().map(|d| d.bounds));
+    }
+    // The Morton order of every triangle, for the rays through the rest of the model.
+    let all_order = detail.as_ref().map(|_| morton_order(&scene.triangles));
     let (framed, (lo, hi)) = Detail::framed(&detail, &scene.triangles, (lo, hi));
     let mut look = first_view(framed, lo, hi, up, aspect);
     // Without `vn`, the winding alone says which side of a face is its front. A model that
@@ -175,9 +181,9 @@ pub(crate) fn load_obj_scene(
     // Framed on its detail from outside, the camera may stand behind the rest of the model (a
     // tunnel's wall): it moves to where the rest leaves it room to see.
     let outside = |p: Vec3| !(p.cmpge(lo).all() && p.cmple(hi).all());
-    if let Some(d) = &detail {
+    if let (Some(d), Some(all_order)) = (&detail, &all_order) {
         let moved = outside(look.camera.position)
-            .then(|| d.clear_view(&scene.triangles, &look.camera, aspect))
+            .then(|| d.clear_view(&scene.triangles, all_order, &look.camera, aspect))
             .flatten();
         let how = if let Some(camera) = moved {
             (look.camera, look.room) = (camera, None);
@@ -207,8 +213,8 @@ pub(crate) fn load_obj_scene(
             let above = camera.position + forward * (0.2 * distance);
             // Framed on its detail, the camera may stand inside the rest (a tunnel): the
             // light stays under what is above it.
-            let room = (detail.as_ref()).map_or(f32::INFINITY, |_| {
-                free_run(&scene.triangles, &morton_order(&scene.triangles), above, up)
+            let room = (all_order.as_ref()).map_or(f32::INFINITY, |order| {
+                free_run(&scene.triangles, order, above, up)
             });
             above + up * (0.5 * distance).min(0.8 * room)
         }
@@ -404,21 +410,30 @@ impl Detail {
             .map_or((all, bounds), |d| (&d.triangles[..], d.bounds))
     }
 
-    /// None when nothing else of the model (`all`) stands between the eye of `camera`, framed
-    /// on the detail, and the detail; else a camera that sees the detail from the first side
+    /// None when nothing else of the model (`all`, in `all_order`, [`morton_order`]) stands
+    /// between the eye of `camera`, framed on the detail, and the detail; else a camera that
+    /// sees the detail from the first side
     /// (front, back, right, left) where the rest leaves room enough to frame it, or from the
     /// side with the most room, as close as that room allows (a train seen end on, from inside
     /// its tunnel).
-    fn clear_view(&self, all: &[Triangle], camera: &Camera, aspect: f32) -> Option<Camera> {
+    fn clear_view(
+        &self,
+        all: &[Triangle],
+        all_order: &[u32],
+        camera: &Camera,
+        aspect: f32,
+    ) -> Option<Camera> {
         let center = camera.look_at;
         let eye = camera.position;
         let toward = (center - eye).normalize_or_zero();
+        if toward == Vec3::ZERO {
+            return None;
+        }
         let ray = [(eye, toward)];
-        let all_order = morton_order(all);
-        let in_front = nearest(all, &all_order, &ray)[0].0;
+        let in_front = nearest(all, all_order, &ray)[0].0;
         let order = morton_order(&self.triangles);
         let detail_in_front = nearest(&self.triangles, &order, &ray)[0].0;
-        if toward == Vec3::ZERO || in_front >= detail_in_front * (1.0 - 1e-3) {
+        if in_front >= detail_in_front * (1.0 - 1e-3) {
             return None;
         }
         let up = camera.up;
@@ -433,7 +448,7 @@ impl Detail {
                 .filter(|&a| back[a] != 0.0)
                 .map(|a| half[a] / back[a].abs())
                 .fold(f32::INFINITY, f32::min);
-            let room = exit + 0.8 * free_run(all, &all_order, center + back * exit, back);
+            let room = exit + 0.8 * free_run(all, all_order, center + back * exit, back);
             (framed, back, room)
         });
         let fits = sides

@@ -534,14 +534,22 @@ impl Scene {
     }
 }
 
+/// The last triangle list's [`detail_bounds`].
+static DETAIL_BOUNDS: Memo<Option<(Vec3, Vec3)>> = Mutex::new(None);
+
 /// The bounds of where most of `triangles` lie when that is a small part of their bounds
 /// (`first_look::detail`), remembered for the last list asked about ([`remembered`]).
 fn detail_bounds(triangles: &Arc<Vec<Triangle>>) -> Option<(Vec3, Vec3)> {
-    static LAST: Memo<Option<(Vec3, Vec3)>> = Mutex::new(None);
-    remembered(&LAST, triangles, || {
+    remembered(&DETAIL_BOUNDS, triangles, || {
         let (lo, hi) = triangle_bounds(triangles);
         first_look::detail(triangles, lo, hi).map(|d| d.bounds)
     })
+}
+
+/// Keeps `bounds` as the [`detail_bounds`] of `triangles`, worked out already by a bare OBJ's
+/// first look, so the views framing the scene do not work them out again.
+fn remember_detail_bounds(triangles: &Arc<Vec<Triangle>>, bounds: Option<(Vec3, Vec3)>) {
+    remember(&DETAIL_BOUNDS, triangles, bounds);
 }
 
 /// The smallest and largest corner of `triangles` (`+inf`, `-inf` when empty), remembered for
@@ -580,10 +588,15 @@ fn remembered<T: Copy>(
         return *value;
     }
     let value = compute();
+    remember(memo, triangles, value);
+    value
+}
+
+/// Puts `value` in `memo` as what was worked out for `triangles`.
+fn remember<T>(memo: &Memo<T>, triangles: &Arc<Vec<Triangle>>, value: T) {
     if let Ok(mut last) = memo.lock() {
         *last = Some((Arc::downgrade(triangles), value));
     }
-    value
 }
 
 #[cfg(test)]

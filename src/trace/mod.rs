@@ -366,7 +366,8 @@ impl Tracer {
     }
 
     /// [`Tracer::first_hit_t`] with the unit shading normal there, turned towards the ray
-    /// (zero on a visible light): the scene view's outlines.
+    /// (zero on a visible light), as a pixel's facts have them: the scene view's outlines.
+    /// [`Tracer::first_hit_normal`] is the geometric normal of objects alone.
     pub fn first_hit_facts(&self, ray: &Ray) -> Option<(f32, Vec3)> {
         match self.intersect(ray) {
             Found::Nothing => None,
